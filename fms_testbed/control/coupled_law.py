@@ -1,0 +1,292 @@
+"""The multi-coupled thrust/elevator law tracking altitude and speed (Kulikov et al., 2017).
+
+The law imposes second-order error dynamics on speed and altitude (paper eq. 2 and 5)::
+
+    T_V² ΔV'' + 2 ξ_V T_V ΔV' + ΔV = 0,      ΔV = V - V_cmd
+    T_H² ΔH'' + 2 ξ_H T_H ΔH' + ΔH = 0,      ΔH = H - H_cmd
+
+on the point-mass plant (eq. 1) ``V' = g (n_xa - sin θ)``, ``θ' = (g/V)(n_ya - cos θ)``,
+``H' = V sin θ``. Solving for the two load factors gives (eq. 7/8)::
+
+    n_ya  = cos θ - (n_xa - sin θ) tan θ - 2 ξ_H V sin θ / (g T_H cos θ) - ΔH_lim / (g T_H² cos θ)
+    n_xa' = (g/V) cos θ (n_ya - cos θ) - (2 ξ_V / T_V)(n_xa - sin θ) - ΔV / (g T_V²)
+
+The thrust channel commands the *derivative* of n_xa, so it carries an integrator initialised from
+the measured state on engagement (no bump). ``(g/V) cos θ (n_ya - cos θ)`` and the ``sin θ`` terms
+are the cross-couplings that make the closed-loop transfer matrix from (V_cmd, H_cmd) to (V, H)
+diagonal. ``ΔH_lim = clip(ΔH, ±dH_limit_m)`` turns a large step into a constant-V_y level change
+followed by a second-order capture. ``form="paper"`` uses the small-angle law of eq. 19 instead.
+
+Limits. n_ya is clipped to the aircraft's ``[ny_min, ny_max]``; the thrust-channel cross term uses
+the clipped value. When the throttle sits at a limit the n_xa integrator stops moving in the
+unachievable direction and is pulled back to the measured n_xa (back-calculation), so there is no
+wind-up at the top of a climb. With the throttle saturated, speed protection limits the flight-path
+angle to what the available thrust can fly without losing (max throttle) or gaining (idle) speed:
+no overspeed in an idle descent and no speed decay in a thrust-limited climb.
+
+Tuning (:class:`CoupledLawParams`, frozen) is apart from state (:class:`CoupledLawState`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from ..aircraft import AircraftConfig
+from ..state import AircraftState
+
+G_MPS2 = 9.80665
+"""Standard gravity, m/s²."""
+
+_SAT_EPS = 0.005
+"""Throttle within this of a limit counts as saturated (normalised throttle)."""
+
+
+@dataclass(frozen=True, slots=True)
+class CoupledLawParams:
+    """Tuning of the coupled law (units in names; load factors in g).
+
+    Attributes
+    ----------
+    T_V_s, xi_V : speed-channel time constant (s) and damping ratio (eq. 2)
+    T_H_s, xi_H : altitude-channel time constant (s) and damping ratio (eq. 5)
+    dH_limit_m : altitude-error limit of the level-change mode, m
+    ny_min, ny_max : normal-load-factor command limits, g
+    throttle_min, throttle_max : throttle range of the n_x inner loop (saturation detection)
+    form : ``"exact"`` (eq. 7/8, nonlinear, uses θ) or ``"paper"`` (eq. 19, small angles, V_y)
+    use_measured_nx : use the measured n_xa in the damping term (n_xa - sin θ) = V'/g instead of
+        the integrator's command; makes the law insensitive to n_x tracking error
+    speed_protection : limit the flight path when the throttle is saturated
+    gamma_tau_s : time constant with which speed protection pulls θ to its limit, s
+    """
+
+    T_V_s: float
+    xi_V: float
+    T_H_s: float
+    xi_H: float
+    dH_limit_m: float = 100.0
+    ny_min: float = 0.0
+    ny_max: float = 2.0
+    throttle_min: float = 0.0
+    throttle_max: float = 1.0
+    form: str = "exact"
+    use_measured_nx: bool = True
+    speed_protection: bool = True
+    gamma_tau_s: float = 2.0
+
+    def __post_init__(self):
+        for name in ("T_V_s", "xi_V", "T_H_s", "xi_H", "dH_limit_m", "gamma_tau_s"):
+            if not getattr(self, name) > 0:
+                raise ValueError(f"CoupledLawParams.{name} must be > 0, got {getattr(self, name)}")
+        if self.form not in ("exact", "paper"):
+            raise ValueError(f"CoupledLawParams.form must be 'exact' or 'paper', got {self.form!r}")
+        if not self.ny_min < 1.0 < self.ny_max:
+            raise ValueError("CoupledLawParams needs ny_min < 1 < ny_max")
+
+    @property
+    def vy_limit_mps(self) -> float:
+        """Steady climb/descent rate of the level-change mode, ``dH_limit / (2 ξ_H T_H)``, m/s."""
+        return self.dH_limit_m / (2.0 * self.xi_H * self.T_H_s)
+
+
+def params_from_config(cfg: AircraftConfig, **overrides) -> CoupledLawParams:
+    """Build :class:`CoupledLawParams` from an aircraft's ``coupled_law`` block and limits.
+
+    Parameters
+    ----------
+    cfg : aircraft configuration; its ``coupled_law`` block must be present
+    **overrides : any :class:`CoupledLawParams` field (e.g. ``T_V_s=8.0``)
+    """
+    gains = cfg.coupled_law
+    if gains is None:
+        from ..errors import ConfigError
+
+        raise ConfigError(f"{cfg.source_file or cfg.name}: no 'coupled_law' block (T_V_s, xi_V, "
+                          "T_H_s, xi_H) — run `fms-testbed tune` or add one")
+    p = CoupledLawParams(
+        T_V_s=gains.T_V_s, xi_V=gains.xi_V, T_H_s=gains.T_H_s, xi_H=gains.xi_H,
+        dH_limit_m=gains.dH_limit_m, ny_min=cfg.limits.ny_min, ny_max=cfg.limits.ny_max,
+        throttle_min=cfg.inner_loops.throttle_min, throttle_max=cfg.inner_loops.throttle_max)
+    return replace(p, **overrides) if overrides else p
+
+
+@dataclass(slots=True)
+class CoupledLawState:
+    """Run-time state of the law.
+
+    nxa_cmd: n_xa integrator (the tangential load-factor command), g
+    engaged: whether :meth:`CoupledLaw.engage` has been called
+    sat_hi, sat_lo: throttle at max / idle at the last update
+    protecting: speed protection limited n_ya at the last update
+    dny: last Δn_ya = n_ya - 1 command, g
+    """
+
+    nxa_cmd: float = 0.0
+    engaged: bool = False
+    sat_hi: bool = False
+    sat_lo: bool = False
+    protecting: bool = False
+    dny: float = 0.0
+
+
+# --- the law's steps as pure functions -----------------------------------------------------
+
+def clip_altitude_error(dH_m: float, limit_m: float) -> float:
+    """``ΔH_lim = clip(ΔH, -limit, +limit)`` (level-change mode, eq. 19), m."""
+    return min(max(dH_m, -limit_m), limit_m)
+
+
+def altitude_channel_ny(p: CoupledLawParams, dH_lim_m: float, tas_mps: float, gamma_rad: float,
+                        nxa: float) -> float:
+    """Normal load-factor command n_ya (g) giving the altitude error dynamics of eq. 5.
+
+    Parameters
+    ----------
+    p : law tuning
+    dH_lim_m : limited altitude error H - H_cmd, m
+    tas_mps : airspeed V, m/s
+    gamma_rad : flight-path angle θ, rad
+    nxa : tangential load factor used for the V' sin θ term, g
+
+    Returns
+    -------
+    n_ya (g), unclipped. ``exact``: eq. 7; ``paper``: 1 + Δn_ya of eq. 19 with V_y = V θ.
+    """
+    kd = 2.0 * p.xi_H / (G_MPS2 * p.T_H_s)
+    kp = 1.0 / (G_MPS2 * p.T_H_s ** 2)
+    if p.form == "paper":
+        return 1.0 - kd * tas_mps * gamma_rad - kp * dH_lim_m
+    s, c = math.sin(gamma_rad), math.cos(gamma_rad)
+    return c - (nxa - s) * s / c - (kd * tas_mps * s + kp * dH_lim_m) / c
+
+
+def thrust_channel_rate(p: CoupledLawParams, dV_mps: float, tas_mps: float, gamma_rad: float,
+                        nxa: float, ny_cmd: float) -> float:
+    """Rate of the n_xa command, g/s, giving the speed error dynamics of eq. 2 (eq. 8 / 19).
+
+    Parameters
+    ----------
+    p : law tuning
+    dV_mps : speed error V - V_cmd, m/s
+    tas_mps : airspeed V, m/s
+    gamma_rad : flight-path angle θ, rad
+    nxa : tangential load factor in the damping term (measured or commanded), g
+    ny_cmd : the (limited) normal load-factor command of the elevator channel, g
+
+    Returns
+    -------
+    dn_xa/dt, g/s. The first term is the cross-coupling that cancels the elevator's effect on V.
+    """
+    if p.form == "paper":
+        cross = (G_MPS2 / tas_mps) * (ny_cmd - 1.0)
+        damp = nxa - gamma_rad
+    else:
+        c = math.cos(gamma_rad)
+        cross = (G_MPS2 / tas_mps) * c * (ny_cmd - c)
+        damp = nxa - math.sin(gamma_rad)
+    return cross - (2.0 * p.xi_V / p.T_V_s) * damp - dV_mps / (G_MPS2 * p.T_V_s ** 2)
+
+
+def speed_protection_ny(p: CoupledLawParams, ny: float, dV_mps: float, tas_mps: float,
+                        gamma_rad: float, nx_meas: float, sat_hi: bool, sat_lo: bool
+                        ) -> tuple[float, bool]:
+    """Limit n_ya so that the available thrust can hold the speed (throttle saturated).
+
+    With the throttle at a limit, V' = g (n_x - sin θ) is set by θ alone. Demanding
+    V' = -ΔV / τ with τ = T_V / (2 ξ_V) gives the flight-path limit
+    ``sin θ_lim = n_x + ΔV / (g τ)``; n_ya is then limited to
+    ``cos θ + (V / g)(θ_lim - θ) / gamma_tau_s`` — a floor at idle (no overspeed in a descent),
+    a ceiling at max throttle (no speed decay in a climb).
+
+    Returns
+    -------
+    (n_ya, g; whether the limit was active)
+    """
+    if not (p.speed_protection and (sat_hi or sat_lo)):
+        return ny, False
+    tau = p.T_V_s / (2.0 * p.xi_V)
+    s_lim = min(max(nx_meas + dV_mps / (G_MPS2 * tau), -0.5), 0.5)
+    ny_lim = math.cos(gamma_rad) + (tas_mps / G_MPS2) * (math.asin(s_lim) - gamma_rad) / p.gamma_tau_s
+    if sat_lo and ny < ny_lim:
+        return ny_lim, True
+    if sat_hi and ny > ny_lim:
+        return ny_lim, True
+    return ny, False
+
+
+class CoupledLaw:
+    """The coupled thrust/elevator law as a vertical law (``engage`` / ``update``).
+
+    Parameters
+    ----------
+    aircraft_cfg : aircraft configuration (gains from its ``coupled_law`` block), or ``None``
+        when ``params`` is given
+    params : explicit tuning (overrides the config)
+    """
+
+    name = "coupled"
+
+    def __init__(self, aircraft_cfg: AircraftConfig | None = None,
+                 params: CoupledLawParams | None = None):
+        if params is None:
+            if aircraft_cfg is None:
+                raise ValueError("CoupledLaw needs an aircraft config or params")
+            params = params_from_config(aircraft_cfg)
+        self.params = params
+        self.state = CoupledLawState()
+
+    def reset(self) -> None:
+        """Forget the run-time state (the next update re-engages)."""
+        self.state = CoupledLawState()
+
+    def engage(self, state: AircraftState, alt_cmd_m: float, tas_cmd_mps: float) -> None:
+        """Take over: initialise the n_xa integrator from the measured n_xa (no bump).
+
+        Parameters
+        ----------
+        state : measured aircraft state (``nx``, g, is used)
+        alt_cmd_m, tas_cmd_mps : targets, m and m/s (unused; part of the protocol)
+        """
+        self.state = CoupledLawState(nxa_cmd=float(state.nx), engaged=True)
+
+    def update(self, dt_s: float, state: AircraftState, alt_cmd_m: float, tas_cmd_mps: float
+               ) -> tuple[float, float]:
+        """One outer-loop step: return ``(nx_cmd, ny_cmd)`` in g.
+
+        Steps: saturation → altitude channel (eq. 7) → n_y limits → speed protection →
+        thrust channel (eq. 8) → anti-windup → integrate.
+
+        Parameters
+        ----------
+        dt_s : step, s
+        state : measured aircraft state (tas_mps, alt_m, gamma_rad, nx, throttle)
+        alt_cmd_m : altitude target, m;  tas_cmd_mps : true-airspeed target, m/s
+        """
+        p, st = self.params, self.state
+        if not st.engaged:
+            self.engage(state, alt_cmd_m, tas_cmd_mps)
+        V = max(float(state.tas_mps), 1.0)
+        gam = float(state.gamma_rad)
+        nx_meas = float(state.nx)
+        st.sat_hi = state.throttle >= p.throttle_max - _SAT_EPS
+        st.sat_lo = state.throttle <= p.throttle_min + _SAT_EPS
+        nxa = nx_meas if p.use_measured_nx else st.nxa_cmd
+        dV = V - tas_cmd_mps
+        dH_lim = clip_altitude_error(float(state.alt_m) - alt_cmd_m, p.dH_limit_m)
+
+        ny = altitude_channel_ny(p, dH_lim, V, gam, nxa)
+        ny = min(max(ny, p.ny_min), p.ny_max)
+        ny, st.protecting = speed_protection_ny(p, ny, dV, V, gam, nx_meas, st.sat_hi, st.sat_lo)
+        ny = min(max(ny, p.ny_min), p.ny_max)
+
+        rate = thrust_channel_rate(p, dV, V, gam, nxa, ny)
+        # anti-windup: no motion into an unachievable command; back-calculate to the measurement
+        if st.sat_hi:
+            rate = min(rate, 0.0)
+            st.nxa_cmd = min(st.nxa_cmd, nx_meas + 0.01)
+        if st.sat_lo:
+            rate = max(rate, 0.0)
+            st.nxa_cmd = max(st.nxa_cmd, nx_meas - 0.01)
+        st.nxa_cmd += rate * dt_s
+        st.dny = ny - 1.0
+        return st.nxa_cmd, ny
