@@ -36,6 +36,8 @@ class Limits(_Frozen):
     mach_max: Annotated[float, Field(gt=0, lt=3)] = Field(description="maximum operating Mach (MMO)")
     alt_max_m: Pos = Field(description="service ceiling, m")
     bank_max_deg: Annotated[float, Field(gt=0, le=45)] = Field(description="max bank in guidance, deg")
+    roll_rate_max_dps: Annotated[float, Field(gt=0, le=60)] = Field(
+        5.0, description="rate limit on the bank command from heading hold/guidance, deg/s")
     ny_min: Annotated[float, Field(ge=-1, le=1)] = Field(description="min normal load factor, g")
     ny_max: Annotated[float, Field(ge=1, le=4)] = Field(description="max normal load factor, g")
     stall_alpha_deg: Pos = Field(description="alpha at which the run is declared stalled, deg")

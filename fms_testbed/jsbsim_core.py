@@ -1,0 +1,392 @@
+"""JSBSim aircraft: side-effect-free loading, trim, cached property access, inner-loop commands.
+
+Loading copies the wheel's model folder into a private temporary folder and strips every
+top-level ``<input>`` (telnet/UDP sockets) and ``<output>`` (CSV/socket logging) element, then
+adds the inner-loop ``<system>`` (:mod:`fms_testbed.inner_loops`). The temporary folder is removed
+when the process ends (or :func:`cleanup` is called). JSBSim's console output is routed to the
+``jsbsim`` Python logger.
+"""
+
+from __future__ import annotations
+
+import atexit
+import logging
+import math
+import shutil
+import tempfile
+import threading
+import xml.etree.ElementTree as ET
+from dataclasses import dataclass
+from pathlib import Path
+
+import jsbsim
+import numpy as np
+
+from .aircraft import AircraftConfig
+from .errors import TrimError, UserError
+from .inner_loops import gain_properties, system_xml
+from .state import AircraftState
+
+log = logging.getLogger("fms_testbed.jsbsim")
+
+FT = 0.3048
+KT = 1852.0 / 3600.0
+LBF = 4.4482216152605
+SLUG = 14.593902937
+G0 = 9.80665
+DT_S = 1.0 / 120.0
+
+# ----------------------------------------------------------------------------------- logging
+
+
+class _PyLogger(jsbsim.FGLogger):
+    """Route JSBSim log records to the ``jsbsim`` Python logger."""
+
+    _LEVELS = {0: logging.DEBUG, 1: logging.DEBUG, 2: logging.DEBUG, 3: logging.WARNING,
+               4: logging.ERROR, 5: logging.CRITICAL, 6: logging.DEBUG}
+
+    def __init__(self):
+        super().__init__()
+        self._level = logging.DEBUG
+        self._buf: list[str] = []
+        self._logger = logging.getLogger("jsbsim")
+
+    def set_level(self, level):
+        self._level = self._LEVELS.get(int(level), logging.DEBUG)
+        self._buf = []
+
+    def file_location(self, filename, line):
+        self._buf.append(f"{filename}:{line}: ")
+
+    def message(self, message):
+        self._buf.append(message)
+
+    def format(self, format):  # noqa: A002 - JSBSim's name
+        pass
+
+    def flush(self):
+        text = "".join(self._buf).strip()
+        self._buf = []
+        if text:
+            self._logger.log(self._level, "%s", text)
+
+
+_tls = threading.local()
+
+
+def _install_logger() -> None:
+    if not getattr(_tls, "logger", None):
+        _tls.logger = _PyLogger()
+        jsbsim.set_logger(_tls.logger)
+
+
+# ------------------------------------------------------------------------------ sanitising
+
+_sandbox_lock = threading.Lock()
+_sandbox: tempfile.TemporaryDirectory | None = None
+
+
+def _sandbox_dir() -> Path:
+    global _sandbox
+    with _sandbox_lock:
+        if _sandbox is None:
+            _sandbox = tempfile.TemporaryDirectory(prefix="fms-testbed-jsbsim-")
+            atexit.register(cleanup)
+        return Path(_sandbox.name)
+
+
+def cleanup() -> None:
+    """Remove the private folder of sanitised aircraft definitions."""
+    global _sandbox
+    with _sandbox_lock:
+        if _sandbox is not None:
+            _sandbox.cleanup()
+            _sandbox = None
+
+
+def count_engines(model: str) -> int:
+    """Number of ``<engine>`` elements in the wheel's model ``model``."""
+    root = ET.parse(Path(jsbsim.get_default_root_dir()) / "aircraft" / model / f"{model}.xml").getroot()
+    return len(root.findall("./propulsion/engine"))
+
+
+def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float) -> Path:
+    """Copy ``model`` from the jsbsim wheel into the sandbox without I/O elements.
+
+    Returns the sandbox's ``aircraft`` folder (to pass to ``set_aircraft_path``). Removes every
+    top-level ``<input>`` and ``<output>`` element and appends the inner-loop ``<system>``.
+    """
+    src = Path(jsbsim.get_default_root_dir()) / "aircraft" / model
+    if not (src / f"{model}.xml").exists():
+        raise UserError(f"JSBSim model '{model}' is not in the jsbsim package's aircraft folder")
+    key = f"{model}-er{elevator_rate_max_ps:g}"
+    dst_root = _sandbox_dir() / key
+    dst = dst_root / model
+    if (dst / f"{model}.xml").exists():
+        return dst_root
+    shutil.copytree(src, dst, dirs_exist_ok=True)
+    tree = ET.parse(src / f"{model}.xml")
+    root = tree.getroot()
+    removed = 0
+    for tag in ("input", "output"):
+        for el in root.findall(tag):
+            root.remove(el)
+            removed += 1
+    n_eng = len(root.findall("./propulsion/engine"))
+    root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S)))
+    tree.write(dst / f"{model}.xml", encoding="utf-8", xml_declaration=True)
+    log.debug("sanitised %s: removed %d I/O elements, %d engines", model, removed, n_eng)
+    return dst_root
+
+
+# --------------------------------------------------------------------------------- model
+
+
+@dataclass(frozen=True)
+class TrimResult:
+    """Trimmed condition: control positions and angles (SI/normalised)."""
+
+    alt_m: float
+    tas_mps: float
+    alpha_deg: float
+    pitch_deg: float
+    throttle: float
+    elevator: float
+    aileron: float
+    rudder: float
+
+
+_READ = {  # state field -> (property, scale)
+    "t_s": ("simulation/sim-time-sec", 1.0),
+    "lat_deg": ("position/lat-geod-deg", 1.0),
+    "lon_deg": ("position/long-gc-deg", 1.0),
+    "alt_m": ("position/h-sl-ft", FT),
+    "agl_m": ("position/h-agl-ft", FT),
+    "tas_mps": ("velocities/vt-fps", FT),
+    "cas_mps": ("velocities/vc-kts", KT),
+    "gs_mps": ("velocities/vg-fps", FT),
+    "vs_mps": ("velocities/h-dot-fps", FT),
+    "vn": ("velocities/v-north-fps", FT),
+    "ve": ("velocities/v-east-fps", FT),
+    "vd": ("velocities/v-down-fps", FT),
+    "roll_rad": ("attitude/phi-rad", 1.0),
+    "pitch_rad": ("attitude/theta-rad", 1.0),
+    "heading_rad": ("attitude/psi-rad", 1.0),
+    "track_rad": ("flight-path/psi-gt-rad", 1.0),
+    "alpha_rad": ("aero/alpha-rad", 1.0),
+    "beta_rad": ("aero/beta-rad", 1.0),
+    "gamma_rad": ("flight-path/gamma-rad", 1.0),
+    "p_rps": ("velocities/p-rad_sec", 1.0),
+    "q_rps": ("velocities/q-rad_sec", 1.0),
+    "r_rps": ("velocities/r-rad_sec", 1.0),
+    "nx": ("fms/meas/nx", 1.0),
+    "ny": ("fms/meas/ny", 1.0),
+    "fx": ("forces/fbx-total-lbs", LBF),
+    "fy": ("forces/fby-total-lbs", LBF),
+    "fz": ("forces/fbz-total-lbs", LBF),
+    "mach": ("velocities/mach", 1.0),
+    "throttle": ("fms/throttle-out", 1.0),
+    "mass_kg": ("inertia/mass-slugs", SLUG),
+    "elevator": ("fcs/elevator-cmd-norm", 1.0),
+    "aileron": ("fcs/aileron-cmd-norm", 1.0),
+    "rudder": ("fcs/rudder-cmd-norm", 1.0),
+    "throttle_sat": ("fms/throttle-sat", 1.0),
+}
+
+
+class JSBSimAircraft:
+    """One JSBSim instance flying one aircraft at 120 Hz, with the inner loops installed.
+
+    Parameters
+    ----------
+    cfg : aircraft configuration (model, limits, gains)
+    dt_s : frame time, s (default 1/120)
+    """
+
+    def __init__(self, cfg: AircraftConfig, dt_s: float = DT_S):
+        _install_logger()
+        self.cfg = cfg
+        self.dt_s = dt_s
+        self._trim: TrimResult | None = None
+        self._load()
+
+    def _load(self) -> None:
+        """(Re)create the JSBSim instance and cache the property nodes."""
+        cfg, dt_s = self.cfg, self.dt_s
+        root = jsbsim.get_default_root_dir()
+        ac_path = sanitized_aircraft_path(cfg.jsbsim_model, cfg.inner_loops.elevator_rate_max_ps)
+        fdm = jsbsim.FGFDMExec(root)
+        fdm.set_debug_level(0)
+        fdm.disable_output()
+        fdm.set_aircraft_path(str(ac_path))
+        if not fdm.load_model(cfg.jsbsim_model):
+            raise UserError(f"JSBSim could not load model '{cfg.jsbsim_model}' for aircraft {cfg.name}")
+        fdm.set_dt(dt_s)
+        self.fdm = fdm
+        self.n_engines = fdm.get_propulsion().get_num_engines()
+        pm = fdm.get_property_manager()
+        self._nodes = {k: pm.get_node(p, False) for k, (p, _) in _READ.items()}
+        missing = [_READ[k][0] for k, n in self._nodes.items() if n is None]
+        if missing:
+            raise UserError(f"{cfg.jsbsim_model}: JSBSim properties missing: {missing}")
+        self._scale = {k: s for k, (_, s) in _READ.items()}
+        self._w = {name: pm.get_node(name, True) for name in (
+            "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
+            "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle")}
+        self._write_gains()
+
+    # -- properties ------------------------------------------------------------------
+    def __getitem__(self, name: str) -> float:
+        return self.fdm[name]
+
+    def __setitem__(self, name: str, value: float) -> None:
+        self.fdm[name] = value
+
+    def set_gains(self, cfg: AircraftConfig) -> None:
+        """Use the inner-loop gains of ``cfg`` (same JSBSim model) from now on."""
+        self.cfg = cfg
+        self._write_gains()
+
+    def _write_gains(self) -> None:
+        for prop, val in gain_properties(self.cfg.inner_loops).items():
+            self.fdm[prop] = float(val)
+
+    # -- trim ------------------------------------------------------------------------
+    def trim(self, alt_m: float, tas_mps: float, heading_deg: float = 0.0,
+             lat_deg: float = 45.0, lon_deg: float = 0.0, gamma_deg: float = 0.0,
+             wind_ned_mps: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> TrimResult:
+        """Trim in steady straight flight; raise :class:`TrimError` naming aircraft and condition.
+
+        Bounded alpha search (``trim.alpha_max_deg``), engines running, gear up. JSBSim's trim
+        sometimes fails from the state a previous run left (engine and FCS internals survive
+        ``run_ic``); a failure is retried once on a freshly loaded instance before it is reported.
+        """
+        args = (alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg, wind_ned_mps)
+        if self.fdm.get_sim_time() > 0.0:
+            try:
+                return self._trim_once(*args)
+            except TrimError:
+                log.debug("trim retried on a fresh JSBSim instance")
+                self._load()
+        return self._trim_once(*args)
+
+    def _trim_once(self, alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg, wind_ned_mps):
+        fdm, c = self.fdm, self.cfg
+        cond = (f"{c.name} ({c.jsbsim_model}) at {alt_m:.0f} m / {tas_mps * 3.6:.0f} km/h TAS, "
+                f"gamma {gamma_deg:.1f} deg")
+        fdm["ic/lat-geod-deg"] = lat_deg
+        fdm["ic/long-gc-deg"] = lon_deg
+        fdm["ic/h-sl-ft"] = alt_m / FT
+        fdm["ic/vt-kts"] = tas_mps / KT
+        fdm["ic/psi-true-deg"] = heading_deg
+        fdm["ic/gamma-deg"] = gamma_deg
+        fdm["ic/phi-deg"] = 0.0
+        fdm["atmosphere/wind-north-fps"] = wind_ned_mps[0] / FT
+        fdm["atmosphere/wind-east-fps"] = wind_ned_mps[1] / FT
+        fdm["atmosphere/wind-down-fps"] = wind_ned_mps[2] / FT
+        fdm["aero/alpha-max-rad"] = math.radians(c.trim.alpha_max_deg)
+        fdm["aero/alpha-min-rad"] = math.radians(c.trim.alpha_min_deg)
+        fdm["fms/ap/master"] = 0.0
+        for name in ("fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage"):
+            fdm[name] = 0.0
+        for prop, val in (("fcs/elevator-cmd-norm", 0.0), ("fcs/aileron-cmd-norm", 0.0),
+                          ("fcs/rudder-cmd-norm", 0.0), ("fcs/pitch-trim-cmd-norm", 0.0)):
+            fdm[prop] = val
+        for i in range(self.n_engines):
+            fdm[f"fcs/throttle-cmd-norm[{i}]"] = 0.5
+        fdm["gear/gear-cmd-norm"] = 0.0
+        fdm["gear/gear-pos-norm"] = 0.0
+        for i in range(self.n_engines):
+            fdm[f"fcs/mixture-cmd-norm[{i}]"] = 1.0
+            fdm[f"fcs/advance-cmd-norm[{i}]"] = 1.0
+        if not fdm.run_ic():
+            raise TrimError(f"JSBSim rejected the initial condition: {cond}")
+        fdm["propulsion/set-running"] = -1
+        try:
+            fdm["simulation/do_simple_trim"] = 1
+        except jsbsim.TrimFailureError as exc:
+            raise TrimError(f"trim failed for {cond}: {str(exc).strip() or 'no convergence'}") from None
+        except RuntimeError as exc:
+            raise TrimError(f"trim failed for {cond}: {str(exc).strip()}") from None
+        alpha = math.degrees(fdm["aero/alpha-rad"])
+        if not math.isfinite(alpha) or alpha > c.trim.alpha_max_deg + 0.5:
+            raise TrimError(f"trim failed for {cond}: alpha {alpha:.1f} deg beyond bound")
+        thr = fdm["fcs/throttle-cmd-norm[0]"]
+        res = TrimResult(alt_m=alt_m, tas_mps=fdm["velocities/vt-fps"] * FT, alpha_deg=alpha,
+                         pitch_deg=math.degrees(fdm["attitude/theta-rad"]), throttle=thr,
+                         elevator=fdm["fcs/elevator-cmd-norm"], aileron=fdm["fcs/aileron-cmd-norm"],
+                         rudder=fdm["fcs/rudder-cmd-norm"])
+        if not (c.inner_loops.throttle_min - 1e-6 <= thr <= c.inner_loops.throttle_max + 1e-6):
+            raise TrimError(f"trim failed for {cond}: throttle {thr:.2f} outside "
+                            f"[{c.inner_loops.throttle_min}, {c.inner_loops.throttle_max}]")
+        fdm["fms/trim/elevator"] = res.elevator
+        fdm["fms/trim/aileron"] = res.aileron
+        fdm["fms/trim/rudder"] = res.rudder
+        fdm["fms/trim/throttle"] = thr
+        fdm["fms/cmd/throttle"] = thr
+        fdm["fms/cmd/bank-rad"] = 0.0
+        fdm["fms/cmd/ny"] = 1.0
+        fdm["fms/cmd/nx"] = 0.0
+        fdm["fms/ap/master"] = 1.0
+        self._trim = res
+        return res
+
+    @property
+    def trim_result(self) -> TrimResult | None:
+        """The last trim, or ``None``."""
+        return self._trim
+
+    # -- inner-loop commands -------------------------------------------------------------
+    def engage(self, bank: bool = True, yaw: bool = True, ny: bool = True, nx: bool = True) -> None:
+        """Engage (or release) the inner loops."""
+        w = self._w
+        w["fms/ap/bank-engage"].set_double_value(float(bank))
+        w["fms/ap/yaw-engage"].set_double_value(float(yaw))
+        w["fms/ap/ny-engage"].set_double_value(float(ny))
+        w["fms/ap/nx-engage"].set_double_value(float(nx))
+
+    def command(self, bank_rad: float | None = None, ny: float | None = None,
+                nx: float | None = None, throttle: float | None = None) -> None:
+        """Set inner-loop targets: bank (rad), normal/tangential load factor (g), throttle (0..1).
+
+        A throttle command disengages the n_x loop; an n_x command engages it.
+        """
+        w = self._w
+        if bank_rad is not None:
+            w["fms/cmd/bank-rad"].set_double_value(bank_rad)
+        if ny is not None:
+            w["fms/cmd/ny"].set_double_value(ny)
+        if nx is not None:
+            w["fms/cmd/nx"].set_double_value(nx)
+            w["fms/ap/nx-engage"].set_double_value(1.0)
+        if throttle is not None:
+            w["fms/cmd/throttle"].set_double_value(throttle)
+            w["fms/ap/nx-engage"].set_double_value(0.0)
+
+    # -- stepping and state ----------------------------------------------------------------
+    def run(self, n_steps: int = 1) -> bool:
+        """Advance ``n_steps`` frames; return False if JSBSim stops."""
+        run = self.fdm.run
+        for _ in range(n_steps):
+            if not run():
+                return False
+        return True
+
+    def read(self) -> dict[str, float]:
+        """Read every logged property through its cached node (SI units)."""
+        sc = self._scale
+        return {k: n.get_double_value() * sc[k] for k, n in self._nodes.items()}
+
+    def state(self, raw: dict[str, float] | None = None) -> AircraftState:
+        """Return the true state as an :class:`AircraftState`."""
+        r = raw if raw is not None else self.read()
+        m = r["mass_kg"]
+        return AircraftState(
+            t_s=r["t_s"], lat_rad=math.radians(r["lat_deg"]), lon_rad=math.radians(r["lon_deg"]),
+            alt_m=r["alt_m"], tas_mps=r["tas_mps"], cas_mps=r["cas_mps"], gs_mps=r["gs_mps"],
+            vs_mps=r["vs_mps"], v_enu_mps=np.array([r["ve"], r["vn"], -r["vd"]]),
+            roll_rad=r["roll_rad"], pitch_rad=r["pitch_rad"], heading_rad=r["heading_rad"],
+            track_rad=r["track_rad"], alpha_rad=r["alpha_rad"], beta_rad=r["beta_rad"],
+            gamma_rad=r["gamma_rad"], p_rps=r["p_rps"], q_rps=r["q_rps"], r_rps=r["r_rps"],
+            nx=r["nx"], ny=r["ny"], f_body_mps2=np.array([r["fx"], r["fy"], r["fz"]]) / m,
+            mach=r["mach"], agl_m=r["agl_m"], throttle=r["throttle"], mass_kg=m)

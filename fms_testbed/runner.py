@@ -1,0 +1,400 @@
+"""Fly a scenario: trim, then the closed loop JSBSim → navigation → guidance/laws → inner loops.
+
+Rates: JSBSim and the inner loops at 120 Hz (inside JSBSim); navigation, guidance, heading hold and
+the vertical law at ``outer_rate_hz`` (default 40 Hz); logging at ``log_rate_hz``.
+
+A run ends with a status: ``ok`` (duration flown or guidance finished) or ``diverged`` with a
+reason (non-finite state, ground contact, stall, overspeed) — never a hang or a bare traceback.
+"""
+
+from __future__ import annotations
+
+import json
+import logging
+import math
+import time
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any, Protocol
+
+import numpy as np
+import pandas as pd
+
+from .aircraft import AircraftConfig, load_aircraft
+from .atmosphere import cas_to_tas
+from .errors import UserError
+from .jsbsim_core import FT, JSBSimAircraft
+from .navigation import make_source
+from .scenario import Event, Scenario, load_scenario, parse_scenario
+from .state import AircraftState, NavSolution
+from .timeseries import COLUMNS, build_row
+
+log = logging.getLogger(__name__)
+
+_TURB_SEVERITY = {"light": (3, 25.0), "moderate": (4, 50.0), "severe": (6, 75.0)}  # (index, kt@20ft)
+
+
+@dataclass
+class GuidanceOutput:
+    """What a path guidance returns each outer step (issue-6 procedures plug in here)."""
+
+    bank_rad: float | None = None
+    alt_m: float | None = None
+    tas_mps: float | None = None
+    done: bool = False
+    log: dict[str, float] = field(default_factory=dict)
+
+
+class Guidance(Protocol):
+    """Lateral/vertical guidance flying on the navigation solution."""
+
+    def update(self, dt_s: float, nav: NavSolution, truth: AircraftState) -> GuidanceOutput: ...
+
+
+@dataclass
+class RunResult:
+    """A flown run: the timeseries, the summary, and where they were written (if anywhere)."""
+
+    df: pd.DataFrame
+    summary: dict[str, Any]
+    out_dir: Path | None = None
+
+
+@dataclass
+class _Targets:
+    bank_rad: float = 0.0
+    heading_rad: float | None = None
+    ny: float = 1.0
+    nx: float | None = None
+    throttle: float | None = None
+    alt_m: float | None = None
+    speed_kind: str = "tas"
+    speed_mps: float | None = None
+    vertical: bool = False
+
+
+def _wrap_pi(a: float) -> float:
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def _wind_ned(scn: Scenario) -> tuple[float, float, float]:
+    if scn.wind is None:
+        return (0.0, 0.0, 0.0)
+    to = math.radians(scn.wind.from_deg + 180.0)
+    return (scn.wind.speed_ms * math.cos(to), scn.wind.speed_ms * math.sin(to), 0.0)
+
+
+class _EventQueue:
+    """Timed and conditional events, each fired once, in file order."""
+
+    def __init__(self, events: list[Event]):
+        self.pending = list(events)
+
+    def due(self, t_s: float, alt_m: float) -> list[Event]:
+        fired, keep = [], []
+        for ev in self.pending:
+            if ev.t_s is not None:
+                ok = t_s + 1e-9 >= ev.t_s
+            else:
+                w = ev.when
+                ok = ((w.alt_m_above is None or alt_m >= w.alt_m_above)
+                      and (w.alt_m_below is None or alt_m <= w.alt_m_below)
+                      and (w.t_s_after is None or t_s >= w.t_s_after))
+            (fired if ok else keep).append(ev)
+        self.pending = keep
+        return fired
+
+
+def _apply(ev: Event, tg: _Targets) -> None:
+    if ev.bank_deg is not None:
+        tg.bank_rad, tg.heading_rad = math.radians(ev.bank_deg), None
+    if ev.heading_deg is not None:
+        tg.heading_rad = math.radians(ev.heading_deg)
+    if ev.ny is not None:
+        tg.ny, tg.vertical = ev.ny, False
+    if ev.nx is not None:
+        tg.nx, tg.throttle, tg.vertical = ev.nx, None, False
+    if ev.throttle is not None:
+        tg.throttle, tg.nx, tg.vertical = ev.throttle, None, False
+    if ev.altitude_m is not None:
+        tg.alt_m, tg.vertical = ev.altitude_m, True
+    kind, spd = ev.speed
+    if spd is not None:
+        tg.speed_kind, tg.speed_mps, tg.vertical = kind, spd, True
+
+
+def _divergence(s: AircraftState, cfg: AircraftConfig) -> str | None:
+    lim = cfg.limits
+    vals = (s.alt_m, s.tas_mps, s.roll_rad, s.pitch_rad, s.alpha_rad, s.nx, s.ny)
+    if not all(math.isfinite(v) for v in vals):
+        return "non-finite state (JSBSim diverged)"
+    if s.agl_m < 1.0:
+        return f"ground contact at t={s.t_s:.1f} s"
+    if math.degrees(s.alpha_rad) > lim.stall_alpha_deg:
+        return (f"stall: alpha {math.degrees(s.alpha_rad):.1f} deg > {lim.stall_alpha_deg} deg "
+                f"at t={s.t_s:.1f} s")
+    if s.cas_mps > lim.cas_max_mps * 1.1:
+        return (f"overspeed: CAS {s.cas_mps / 0.514444:.0f} kt > 1.1 x VMO "
+                f"{lim.cas_max_mps / 0.514444:.0f} kt at t={s.t_s:.1f} s")
+    if s.mach > lim.mach_max + 0.05:
+        return f"overspeed: Mach {s.mach:.3f} > MMO + 0.05 at t={s.t_s:.1f} s"
+    if abs(s.roll_rad) > math.radians(75) or abs(s.pitch_rad) > math.radians(45):
+        return f"upset: roll {math.degrees(s.roll_rad):.0f} deg, pitch {math.degrees(s.pitch_rad):.0f} deg"
+    return None
+
+
+class _NavHold:
+    """Apply the last navigation errors to truth between navigation updates."""
+
+    def __init__(self, source, dt_s: float):
+        self.source, self.dt_s = source, dt_s
+        self.next_t = 0.0
+        self.err = None
+        self.errors: dict[str, float] = {}
+
+    def __call__(self, s: AircraftState) -> NavSolution:
+        if self.err is None or s.t_s + 1e-9 >= self.next_t:
+            nav = self.source.update(s)
+            self.err = (nav.lat_rad - s.lat_rad, nav.lon_rad - s.lon_rad, nav.alt_m - s.alt_m,
+                        nav.v_enu_mps - s.v_enu_mps, nav.roll_rad - s.roll_rad,
+                        nav.pitch_rad - s.pitch_rad, _wrap_pi(nav.heading_rad - s.heading_rad))
+            self.errors = dict(nav.errors)
+            self.next_t = s.t_s + self.dt_s
+            return nav
+        e = self.err
+        return NavSolution(t_s=s.t_s, lat_rad=s.lat_rad + e[0], lon_rad=s.lon_rad + e[1],
+                           alt_m=s.alt_m + e[2], v_enu_mps=s.v_enu_mps + e[3],
+                           roll_rad=s.roll_rad + e[4], pitch_rad=s.pitch_rad + e[5],
+                           heading_rad=_wrap_pi(s.heading_rad + e[6]) % (2 * math.pi),
+                           errors=self.errors)
+
+
+def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = None,
+        guidance: Guidance | None = None, progress: bool | None = None,
+        vertical_law=None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """Fly a validated scenario and return (timeseries DataFrame, summary dict).
+
+    Parameters
+    ----------
+    scn : validated scenario
+    cfg : aircraft configuration (default: the one the scenario names)
+    seed : seed for every stochastic part (turbulence, navigation errors); default 0
+    guidance : optional path guidance (sets bank and vertical targets every outer step)
+    progress : show a progress bar (default: when stderr is a terminal)
+    vertical_law : a vertical-law instance overriding ``scn.vertical_law``
+    """
+    from .control import VERTICAL_LAWS
+
+    seed = 0 if seed is None else int(seed)
+    cfg = cfg or load_aircraft(scn.aircraft)
+    wall0 = time.perf_counter()
+    ac = JSBSimAircraft(cfg)
+    fdm = ac.fdm
+    fdm["simulation/randomseed"] = seed
+    ini = scn.initial
+    kind, spd = ini.speed
+    tas0 = float(cas_to_tas(spd, ini.altitude_m)) if kind == "cas" else spd
+    if scn.turbulence is not None:
+        idx, w20 = _TURB_SEVERITY[scn.turbulence.severity]
+        fdm["atmosphere/turb-type"] = 4
+        fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20 * 1.6878
+        fdm["atmosphere/turbulence/milspec/severity"] = idx
+    ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
+            lon_deg=ini.lon_deg, wind_ned_mps=_wind_ned(scn))
+    trim = ac.trim_result
+    ac.engage()
+    ac.command(bank_rad=0.0, ny=1.0, nx=0.0)
+
+    nav_spec = scn.navigation or {}
+    nav_seed = int(nav_spec.get("seed", seed))
+    source = make_source(nav_spec, seed=nav_seed)
+    nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
+    navigate = _NavHold(source, nav_dt)
+
+    law = vertical_law or VERTICAL_LAWS[scn.vertical_law](cfg)
+    tg = _Targets()
+    if scn.hold:
+        tg.alt_m, tg.speed_kind, tg.speed_mps, tg.vertical = ini.altitude_m, kind, spd, True
+    events = _EventQueue(scn.events)
+    n_outer = max(1, int(round(1.0 / (scn.outer_rate_hz * ac.dt_s))))
+    dt_outer = n_outer * ac.dt_s
+    log_every = max(1, int(round(1.0 / (scn.log_rate_hz * dt_outer))))
+    n_total = int(math.ceil(scn.duration_s / dt_outer))
+    lim = cfg.limits
+    bank_max = math.radians(lim.bank_max_deg)
+    roll_rate = math.radians(lim.roll_rate_max_dps)
+    last_bank = 0.0
+    rows: list[tuple] = []
+    extra_rows: list[dict] = []
+    status, reason = "ok", "duration flown"
+    law_engaged = False
+    cmd_nx = cmd_ny = float("nan")
+    bar = None
+    if progress or (progress is None and scn.duration_s > 300):
+        from tqdm import tqdm
+        bar = tqdm(total=int(scn.duration_s), unit="sim s", disable=None if progress is None else False,
+                   desc=scn.name or "run", leave=False)
+    raw = ac.read()
+    for k in range(n_total + 1):
+        s = ac.state(raw)
+        why = _divergence(s, cfg)
+        if why:
+            status, reason = "diverged", why
+            break
+        nav = navigate(s)
+        for ev in events.due(s.t_s, s.alt_m):
+            _apply(ev, tg)
+        gout = guidance.update(dt_outer, nav, s) if guidance is not None else None
+        if gout is not None:
+            if gout.bank_rad is not None:
+                tg.bank_rad, tg.heading_rad = gout.bank_rad, None
+            if gout.alt_m is not None:
+                tg.alt_m, tg.vertical = gout.alt_m, True
+            if gout.tas_mps is not None:
+                tg.speed_kind, tg.speed_mps, tg.vertical = "tas", gout.tas_mps, True
+        # lateral: heading hold on the navigation heading, else bank hold
+        if tg.heading_rad is not None:
+            err = _wrap_pi(tg.heading_rad - nav.heading_rad)
+            bank_cmd = max(-bank_max, min(bank_max, cfg.inner_loops.heading_kp * err))
+        else:
+            bank_cmd = tg.bank_rad
+        if tg.heading_rad is not None or gout is not None:
+            # guidance/heading-hold bank commands are rate limited (passenger-comfort roll rate)
+            step = roll_rate * dt_outer
+            bank_cmd = min(max(bank_cmd, last_bank - step), last_bank + step)
+        last_bank = bank_cmd
+        # vertical: the law when an altitude/speed target is active
+        if tg.vertical:
+            alt_cmd = tg.alt_m if tg.alt_m is not None else s.alt_m
+            if tg.alt_m is None:
+                tg.alt_m = s.alt_m
+            if tg.speed_mps is None:
+                tg.speed_kind, tg.speed_mps = "tas", s.tas_mps
+            tas_cmd = (float(cas_to_tas(tg.speed_mps, s.alt_m)) if tg.speed_kind == "cas"
+                       else tg.speed_mps)
+            # the law works in the vertical plane: give it the vertical component of n_y
+            s_v = replace(s, ny=s.ny * math.cos(s.roll_rad))
+            if not law_engaged:
+                law.engage(s_v, alt_cmd, tas_cmd)
+                law_engaged = True
+            cmd_nx, ny_vert = law.update(dt_outer, s_v, alt_cmd, tas_cmd)
+            cmd_ny = ny_vert / max(math.cos(s.roll_rad), 0.5)
+            ac.command(bank_rad=bank_cmd, ny=cmd_ny, nx=cmd_nx)
+        else:
+            law_engaged = False
+            alt_cmd = tas_cmd = float("nan")
+            cmd_ny = tg.ny
+            if tg.throttle is not None:
+                cmd_nx = float("nan")
+                ac.command(bank_rad=bank_cmd, ny=cmd_ny, throttle=tg.throttle)
+            else:
+                cmd_nx = tg.nx if tg.nx is not None else 0.0
+                ac.command(bank_rad=bank_cmd, ny=cmd_ny, nx=cmd_nx)
+        if k % log_every == 0:
+            rows.append(build_row(raw, nav, bank_cmd, tg.heading_rad, cmd_nx, cmd_ny,
+                                  tg.throttle, alt_cmd, tas_cmd))
+            ex = dict(nav.errors)
+            if gout is not None:
+                ex.update(gout.log)
+            extra_rows.append(ex)
+        if gout is not None and gout.done:
+            reason = "guidance complete"
+            break
+        if k == n_total:
+            break
+        if not ac.run(n_outer):
+            status, reason = "diverged", "JSBSim stopped"
+            break
+        raw = ac.read()
+        if bar is not None and k % 40 == 0:
+            bar.n = int(raw["t_s"])
+            bar.refresh()
+    if bar is not None:
+        bar.close()
+    wall = time.perf_counter() - wall0
+    df = pd.DataFrame.from_records(rows, columns=[c for c, _ in COLUMNS])
+    if extra_rows and any(extra_rows):
+        df = pd.concat([df, pd.DataFrame.from_records(extra_rows)], axis=1)
+    flown = float(df["t_s"].iloc[-1]) if len(df) else 0.0
+    summary = {
+        "scenario": scn.name, "aircraft": cfg.name, "jsbsim_model": cfg.jsbsim_model,
+        "status": status, "reason": reason, "seed": seed,
+        "duration_s": round(flown, 3), "wall_time_s": round(wall, 3),
+        "real_time_factor": round(flown / wall, 1) if wall > 0 else None,
+        "trim": {"alt_m": trim.alt_m, "tas_mps": round(trim.tas_mps, 3),
+                 "alpha_deg": round(trim.alpha_deg, 3), "pitch_deg": round(trim.pitch_deg, 3),
+                 "throttle": round(trim.throttle, 4), "elevator": round(trim.elevator, 4)},
+        "metrics": _metrics(df),
+    }
+    return df, summary
+
+
+def _metrics(df: pd.DataFrame) -> dict[str, float]:
+    if df.empty:
+        return {}
+    out = {
+        "alt_min_m": df["alt_m"].min(), "alt_max_m": df["alt_m"].max(),
+        "tas_min_mps": df["tas_mps"].min(), "tas_max_mps": df["tas_mps"].max(),
+        "roll_max_abs_deg": df["roll_deg"].abs().max(), "alpha_max_deg": df["alpha_deg"].max(),
+        "ny_min": df["ny"].min(), "ny_max": df["ny"].max(),
+        "throttle_min": df["throttle"].min(), "throttle_max": df["throttle"].max(),
+        "distance_flown_m": float(np.sum(df["gs_mps"].to_numpy()[1:] * np.diff(df["t_s"]))),
+    }
+    e = df["alt_m"] - df["cmd_alt_m"]
+    if e.notna().any():
+        out["alt_err_final_m"] = float(e.dropna().iloc[-1])
+    e = df["tas_mps"] - df["cmd_tas_mps"]
+    if e.notna().any():
+        out["tas_err_final_mps"] = float(e.dropna().iloc[-1])
+    return {k: round(float(v), 4) for k, v in out.items()}
+
+
+def write_outputs(df: pd.DataFrame, summary: dict, out_dir: Path, csv: bool = False,
+                  plots: bool = True) -> None:
+    """Write ``timeseries.parquet``, ``summary.json``, PNG plots (and CSV) into ``out_dir``."""
+    out_dir.mkdir(parents=True, exist_ok=True)
+    df.to_parquet(out_dir / "timeseries.parquet", index=False)
+    if csv:
+        df.to_csv(out_dir / "timeseries.csv", index=False, float_format="%.7g")
+    if plots:
+        from .plots import plot_run
+
+        summary["plots"] = [p.name for p in plot_run(df, summary, out_dir)]
+    (out_dir / "summary.json").write_text(json.dumps(summary, indent=2, default=float) + "\n")
+
+
+def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None = None,
+                 overrides: dict | None = None, csv: bool = False, plots: bool = True,
+                 progress: bool | None = None, guidance: Guidance | None = None) -> RunResult:
+    """Fly a scenario (path, mapping or :class:`Scenario`) and optionally write its outputs.
+
+    Parameters
+    ----------
+    scenario : path to a YAML file, a mapping, or a validated :class:`Scenario`
+    out_dir : folder for ``timeseries.parquet``, ``summary.json`` and plots (None: write nothing)
+    seed : seed for turbulence and navigation errors
+    overrides : mapping merged into the scenario before validation; the key ``aircraft_config``
+        (an :class:`AircraftConfig`) replaces the aircraft's configuration (e.g. for tuning), and
+        ``vertical_law_instance`` passes a ready law object
+    """
+    overrides = dict(overrides or {})
+    cfg = overrides.pop("aircraft_config", None)
+    law = overrides.pop("vertical_law_instance", None)
+    if isinstance(scenario, Scenario):
+        scn = scenario if not overrides else parse_scenario(
+            {**scenario.model_dump(exclude_none=True), **overrides}, scenario.source_file)
+    elif isinstance(scenario, dict):
+        scn = parse_scenario({**scenario, **overrides})
+    else:
+        scn = load_scenario(scenario, overrides)
+    if cfg is not None and not isinstance(cfg, AircraftConfig):
+        raise UserError("overrides['aircraft_config'] must be an AircraftConfig")
+    df, summary = fly(scn, cfg=cfg, seed=seed, guidance=guidance, progress=progress,
+                      vertical_law=law)
+    out = Path(out_dir) if out_dir is not None else None
+    if out is not None:
+        write_outputs(df, summary, out, csv=csv, plots=plots)
+    return RunResult(df=df, summary=summary, out_dir=out)
+
+
+__all__ = ["run_scenario", "fly", "write_outputs", "RunResult", "Guidance", "GuidanceOutput", "FT"]
