@@ -20,7 +20,8 @@
         Δn_y = (V / g) [k_L L_err + k_LI ∫ L_err],             L_err = (γ_c - V'_c/g) - (γ - V'/g)
 
     with the TECS defaults k_T = 0.5 (throttle damping) and k_TI = 0.3 1/s (integrator gain), and
-    an elevator PI of time constant τ_E = min(T_V, T_H) / 4: k_L = 1/τ_E, k_LI = 1/(4 τ_E²).
+    an elevator PI of time constant τ_E = min(T_V, T_H) / 2: k_L = 1/τ_E, k_LI = 1/(4 τ_E²).
+    As in AP_TECS the demands are rate limited: γ_c slews at most ``0.1 g / V`` rad/s.
     Integrators freeze at throttle / n_y limits (anti-windup).
 """
 
@@ -32,7 +33,7 @@ from dataclasses import dataclass
 from ..aircraft import AircraftConfig
 from ..state import AircraftState
 from .coupled_law import (G_MPS2, CoupledLawParams, altitude_channel_ny, clip_altitude_error,
-                          params_from_config)
+                          gravity_ratio, params_from_config)
 
 
 @dataclass(slots=True)
@@ -77,7 +78,9 @@ class SeparateChannelsLaw:
             st.i1 += di * dt_s
         nx = st.i1 - 2.0 * p.xi_V / (G_MPS2 * p.T_V_s) * dV
         dH = clip_altitude_error(float(state.alt_m) - alt_cmd_m, p.dH_limit_m)
-        ny = altitude_channel_ny(p, dH, V, float(state.gamma_rad), float(state.nx))
+        gr = gravity_ratio(float(state.lat_rad), float(state.alt_m), float(state.v_enu_mps[0]),
+                           float(state.v_enu_mps[1]))
+        ny = altitude_channel_ny(p, dH, V, float(state.gamma_rad), float(state.nx), gr)
         return nx, min(max(ny, p.ny_min), p.ny_max)
 
 
@@ -88,7 +91,7 @@ class TecsLaw:
     ----------
     aircraft_cfg : aircraft configuration (T_V, ξ_V, T_H, ξ_H, limits), or ``None`` with params
     params : explicit tuning
-    tau_E_s : energy-loop time constant, s (default ``min(T_V, T_H) / 4``)
+    tau_E_s : energy-loop time constant, s (default ``min(T_V, T_H) / 2``)
     """
 
     name = "tecs"
@@ -97,13 +100,14 @@ class TecsLaw:
                  params: CoupledLawParams | None = None, tau_E_s: float | None = None):
         self.params = params if params is not None else params_from_config(aircraft_cfg)
         self.tau_E_s = tau_E_s if tau_E_s is not None else min(self.params.T_V_s,
-                                                               self.params.T_H_s) / 4.0
+                                                               self.params.T_H_s) / 2.0
         self.k_T, self.k_TI_ps = 0.5, 0.3
         self.state = _IntegratorState()
 
     def engage(self, state: AircraftState, alt_cmd_m: float, tas_cmd_mps: float) -> None:
-        """Start with zero integrators: the feed-forward already carries the trim n_x."""
+        """Start with zero integrators and the measured γ: the feed-forward carries the trim."""
         self.state = _IntegratorState(engaged=True)
+        self.gamma_c_rad = float(state.gamma_rad)
 
     def demands(self, state: AircraftState, alt_cmd_m: float, tas_cmd_mps: float
                 ) -> tuple[float, float]:
@@ -123,8 +127,13 @@ class TecsLaw:
             self.engage(state, alt_cmd_m, tas_cmd_mps)
         V = max(float(state.tas_mps), 1.0)
         gam = float(state.gamma_rad)
-        acc = float(state.nx) - math.sin(gam)          # V'/g from the measured n_x
+        gr = gravity_ratio(float(state.lat_rad), float(state.alt_m), float(state.v_enu_mps[0]),
+                           float(state.v_enu_mps[1]))
+        acc = float(state.nx) - gr * math.sin(gam)     # V'/g0 from the measured n_x
         gamma_c, acc_c = self.demands(state, alt_cmd_m, tas_cmd_mps)
+        step = 0.1 * G_MPS2 / V * dt_s
+        gamma_c = self.gamma_c_rad = min(max(gamma_c, self.gamma_c_rad - step),
+                                         self.gamma_c_rad + step)
         e_err = (gamma_c + acc_c) - (gam + acc)
         l_err = (gamma_c - acc_c) - (gam - acc)
         k, ki = 1.0 / self.tau_E_s, 1.0 / (4.0 * self.tau_E_s ** 2)
@@ -134,7 +143,7 @@ class TecsLaw:
             st.i1 += self.k_TI_ps * e_err * dt_s
         nx = math.sin(gamma_c) + acc_c + self.k_T * e_err + st.i1
         dny = (V / G_MPS2) * (k * l_err + st.i2)
-        ny = math.cos(gam) + dny
+        ny = gr * math.cos(gam) + dny
         ny_c = min(max(ny, p.ny_min), p.ny_max)
         if ny_c == ny:
             st.i2 += ki * l_err * dt_s

@@ -38,6 +38,11 @@ from ..state import AircraftState
 G_MPS2 = 9.80665
 """Standard gravity, m/s²."""
 
+_WGS84_A_M = 6378137.0
+_WGS84_F = 1.0 / 298.257223563
+_WGS84_M = 0.00344978650684  # ω² a² b / GM
+_OMEGA_E_RPS = 7.292115e-5
+
 _SAT_EPS = 0.005
 """Throttle within this of a limit counts as saturated (normalised throttle)."""
 
@@ -58,6 +63,14 @@ class CoupledLawParams:
         the integrator's command; makes the law insensitive to n_x tracking error
     speed_protection : limit the flight path when the throttle is saturated
     gamma_tau_s : time constant with which speed protection pulls θ to its limit, s
+    ny_trim_tau_s : time constant of the n_y tracking-error integrator, s (0 = off). The
+        altitude channel is static in n_y, so an inner-loop tracking error (lift change with speed,
+        thrust pitching moment) goes straight into ΔH; this integrator adds
+        ``∫ (lag(n_ya_law) - n_y_meas) dt / ny_trim_tau_s`` to the command, bounded to ±0.1 g —
+        the altitude-channel counterpart of ``use_measured_nx``
+    ny_model_tau_s : first-order model of the n_y inner loop, s: the integrator compares the
+        measurement with the law's command passed through it, so the loop's normal lag during a
+        manoeuvre is not mistaken for a tracking error
     """
 
     T_V_s: float
@@ -73,6 +86,8 @@ class CoupledLawParams:
     use_measured_nx: bool = True
     speed_protection: bool = True
     gamma_tau_s: float = 2.0
+    ny_trim_tau_s: float = 2.0
+    ny_model_tau_s: float = 0.5
 
     def __post_init__(self):
         for name in ("T_V_s", "xi_V", "T_H_s", "xi_H", "dH_limit_m", "gamma_tau_s"):
@@ -119,6 +134,8 @@ class CoupledLawState:
     sat_hi, sat_lo: throttle at max / idle at the last update
     protecting: speed protection limited n_ya at the last update
     dny: last Δn_ya = n_ya - 1 command, g
+    ny_trim: n_y tracking-error integrator, g
+    ny_model: the law's n_y command through the inner-loop model, g
     """
 
     nxa_cmd: float = 0.0
@@ -127,9 +144,38 @@ class CoupledLawState:
     sat_lo: bool = False
     protecting: bool = False
     dny: float = 0.0
+    ny_trim: float = 0.0
+    ny_model: float = 1.0
 
 
 # --- the law's steps as pure functions -----------------------------------------------------
+
+def gravity_ratio(lat_rad: float, alt_m: float, ve_mps: float = 0.0, vn_mps: float = 0.0
+                  ) -> float:
+    """Apparent gravity over standard gravity, g_eff / g0, dimensionless.
+
+    Parameters
+    ----------
+    lat_rad : geodetic latitude, rad;  alt_m : altitude, m
+    ve_mps, vn_mps : ground velocity east / north, m/s (Eötvös and path-curvature terms)
+
+    Notes
+    -----
+    WGS-84 Somigliana normal gravity with the second-order free-air correction, minus the
+    Eötvös term 2 Ω v_E cos φ and the curvature term v² / (R + h). Load factors are forces over
+    m·g0, so level flight reads n_y = g_eff / g0, not 1 (0.99901 at 3000 m, 45° N, at rest;
+    0.9978 flying east at 400 km/h at 47° N). Ignoring it leaves a steady altitude offset
+    ΔH = (1 - g_eff/g0) g0 T_H² (0.8 m for T_H = 8 s). The normal-gravity part matches JSBSim's
+    trimmed n_y to 1e-5 (measured at 0/45/70° and 1000/3000/10000 m).
+    """
+    s2 = math.sin(lat_rad) ** 2
+    g = 9.7803253359 * (1 + 0.00193185265241 * s2) / math.sqrt(1 - 0.00669437999013 * s2)
+    h = alt_m / _WGS84_A_M
+    g *= 1 - 2 * h * (1 + _WGS84_F + _WGS84_M - 2 * _WGS84_F * s2) + 3 * h * h
+    g -= 2.0 * _OMEGA_E_RPS * ve_mps * math.cos(lat_rad) + (ve_mps ** 2 + vn_mps ** 2) / (
+        _WGS84_A_M + alt_m)
+    return g / G_MPS2
+
 
 def clip_altitude_error(dH_m: float, limit_m: float) -> float:
     """``ΔH_lim = clip(ΔH, -limit, +limit)`` (level-change mode, eq. 19), m."""
@@ -137,7 +183,7 @@ def clip_altitude_error(dH_m: float, limit_m: float) -> float:
 
 
 def altitude_channel_ny(p: CoupledLawParams, dH_lim_m: float, tas_mps: float, gamma_rad: float,
-                        nxa: float) -> float:
+                        nxa: float, g_ratio: float = 1.0) -> float:
     """Normal load-factor command n_ya (g) giving the altitude error dynamics of eq. 5.
 
     Parameters
@@ -147,21 +193,23 @@ def altitude_channel_ny(p: CoupledLawParams, dH_lim_m: float, tas_mps: float, ga
     tas_mps : airspeed V, m/s
     gamma_rad : flight-path angle θ, rad
     nxa : tangential load factor used for the V' sin θ term, g
+    g_ratio : local gravity over g0 (:func:`gravity_ratio`); 1 reproduces the paper
 
     Returns
     -------
-    n_ya (g), unclipped. ``exact``: eq. 7; ``paper``: 1 + Δn_ya of eq. 19 with V_y = V θ.
+    n_ya (g), unclipped. ``exact``: eq. 7 with weight terms scaled by g/g0;
+    ``paper``: g/g0 + Δn_ya of eq. 19 with V_y = V θ.
     """
     kd = 2.0 * p.xi_H / (G_MPS2 * p.T_H_s)
     kp = 1.0 / (G_MPS2 * p.T_H_s ** 2)
     if p.form == "paper":
-        return 1.0 - kd * tas_mps * gamma_rad - kp * dH_lim_m
+        return g_ratio - kd * tas_mps * gamma_rad - kp * dH_lim_m
     s, c = math.sin(gamma_rad), math.cos(gamma_rad)
-    return c - (nxa - s) * s / c - (kd * tas_mps * s + kp * dH_lim_m) / c
+    return g_ratio * c - (nxa - g_ratio * s) * s / c - (kd * tas_mps * s + kp * dH_lim_m) / c
 
 
 def thrust_channel_rate(p: CoupledLawParams, dV_mps: float, tas_mps: float, gamma_rad: float,
-                        nxa: float, ny_cmd: float) -> float:
+                        nxa: float, ny_cmd: float, g_ratio: float = 1.0) -> float:
     """Rate of the n_xa command, g/s, giving the speed error dynamics of eq. 2 (eq. 8 / 19).
 
     Parameters
@@ -172,24 +220,25 @@ def thrust_channel_rate(p: CoupledLawParams, dV_mps: float, tas_mps: float, gamm
     gamma_rad : flight-path angle θ, rad
     nxa : tangential load factor in the damping term (measured or commanded), g
     ny_cmd : the (limited) normal load-factor command of the elevator channel, g
+    g_ratio : local gravity over g0 (:func:`gravity_ratio`)
 
     Returns
     -------
     dn_xa/dt, g/s. The first term is the cross-coupling that cancels the elevator's effect on V.
     """
     if p.form == "paper":
-        cross = (G_MPS2 / tas_mps) * (ny_cmd - 1.0)
+        cross = (G_MPS2 / tas_mps) * (ny_cmd - g_ratio)
         damp = nxa - gamma_rad
     else:
-        c = math.cos(gamma_rad)
+        c = g_ratio * math.cos(gamma_rad)
         cross = (G_MPS2 / tas_mps) * c * (ny_cmd - c)
-        damp = nxa - math.sin(gamma_rad)
+        damp = nxa - g_ratio * math.sin(gamma_rad)
     return cross - (2.0 * p.xi_V / p.T_V_s) * damp - dV_mps / (G_MPS2 * p.T_V_s ** 2)
 
 
 def speed_protection_ny(p: CoupledLawParams, ny: float, dV_mps: float, tas_mps: float,
-                        gamma_rad: float, nx_meas: float, sat_hi: bool, sat_lo: bool
-                        ) -> tuple[float, bool]:
+                        gamma_rad: float, nx_meas: float, sat_hi: bool, sat_lo: bool,
+                        g_ratio: float = 1.0) -> tuple[float, bool]:
     """Limit n_ya so that the available thrust can hold the speed (throttle saturated).
 
     With the throttle at a limit, V' = g (n_x - sin θ) is set by θ alone. Demanding
@@ -205,8 +254,8 @@ def speed_protection_ny(p: CoupledLawParams, ny: float, dV_mps: float, tas_mps: 
     if not (p.speed_protection and (sat_hi or sat_lo)):
         return ny, False
     tau = p.T_V_s / (2.0 * p.xi_V)
-    s_lim = min(max(nx_meas + dV_mps / (G_MPS2 * tau), -0.5), 0.5)
-    ny_lim = math.cos(gamma_rad) + (tas_mps / G_MPS2) * (math.asin(s_lim) - gamma_rad) / p.gamma_tau_s
+    s_lim = min(max((nx_meas + dV_mps / (G_MPS2 * tau)) / g_ratio, -0.5), 0.5)
+    ny_lim = g_ratio * math.cos(gamma_rad) + (tas_mps / G_MPS2) * (math.asin(s_lim) - gamma_rad) / p.gamma_tau_s
     if sat_lo and ny < ny_lim:
         return ny_lim, True
     if sat_hi and ny > ny_lim:
@@ -247,7 +296,8 @@ class CoupledLaw:
         state : measured aircraft state (``nx``, g, is used)
         alt_cmd_m, tas_cmd_mps : targets, m and m/s (unused; part of the protocol)
         """
-        self.state = CoupledLawState(nxa_cmd=float(state.nx), engaged=True)
+        self.state = CoupledLawState(nxa_cmd=float(state.nx), engaged=True,
+                                     ny_model=float(state.ny))
 
     def update(self, dt_s: float, state: AircraftState, alt_cmd_m: float, tas_cmd_mps: float
                ) -> tuple[float, float]:
@@ -273,13 +323,25 @@ class CoupledLaw:
         nxa = nx_meas if p.use_measured_nx else st.nxa_cmd
         dV = V - tas_cmd_mps
         dH_lim = clip_altitude_error(float(state.alt_m) - alt_cmd_m, p.dH_limit_m)
+        v = state.v_enu_mps
+        gr = gravity_ratio(float(state.lat_rad), float(state.alt_m), float(v[0]), float(v[1]))
 
-        ny = altitude_channel_ny(p, dH_lim, V, gam, nxa)
+        ny = altitude_channel_ny(p, dH_lim, V, gam, nxa, gr)
         ny = min(max(ny, p.ny_min), p.ny_max)
-        ny, st.protecting = speed_protection_ny(p, ny, dV, V, gam, nx_meas, st.sat_hi, st.sat_lo)
+        ny, st.protecting = speed_protection_ny(p, ny, dV, V, gam, nx_meas, st.sat_hi, st.sat_lo,
+                                                gr)
         ny = min(max(ny, p.ny_min), p.ny_max)
 
-        rate = thrust_channel_rate(p, dV, V, gam, nxa, ny)
+        if p.ny_trim_tau_s > 0:
+            ny_law = ny
+            ny = min(max(ny + st.ny_trim, p.ny_min), p.ny_max)
+            a = min(dt_s / p.ny_model_tau_s, 1.0) if p.ny_model_tau_s > 0 else 1.0
+            st.ny_model += a * (ny_law - st.ny_model)
+            if p.ny_min < ny < p.ny_max:
+                st.ny_trim += (st.ny_model - float(state.ny)) * dt_s / p.ny_trim_tau_s
+                st.ny_trim = min(max(st.ny_trim, -0.1), 0.1)
+
+        rate = thrust_channel_rate(p, dV, V, gam, nxa, ny, gr)
         # anti-windup: no motion into an unachievable command; back-calculate to the measurement
         if st.sat_hi:
             rate = min(rate, 0.0)

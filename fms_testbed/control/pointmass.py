@@ -2,6 +2,7 @@
 
     V' = g (n_x - sin θ),   θ' = (g / V)(n_y - cos θ),   H' = V sin θ           (eq. 1)
 
+with g the local normal gravity at the equator (load factors stay referred to g0, as JSBSim's).
 The load factors the plant feels follow the commands through first-order lags (``tau_nx_s``,
 ``tau_ny_s``; zero = the paper's lag-free realisation, "безынерционная отработка") and n_x is
 limited to ``[nx_idle, nx_max]`` (thrust limits). A pseudo-throttle 0..1 maps the n_x command onto
@@ -19,7 +20,7 @@ import numpy as np
 import pandas as pd
 
 from ..state import AircraftState
-from .coupled_law import G_MPS2
+from .coupled_law import G_MPS2, gravity_ratio
 
 _ZERO3 = np.zeros(3)
 
@@ -77,10 +78,11 @@ def make_state(t_s: float, tas_mps: float, gamma_rad: float, alt_m: float, nx: f
 
 def _derivs(x: np.ndarray, nx_cmd: float, ny_cmd: float, pm: PointMassParams) -> np.ndarray:
     """State derivative of [V, θ, H, n_x, n_y] (eq. 1 plus lags)."""
-    V, th, _, nx, ny = x
+    V, th, H, nx, ny = x
+    gr = gravity_ratio(0.0, H)
     d = np.empty(5)
-    d[0] = G_MPS2 * (nx - math.sin(th))
-    d[1] = G_MPS2 / V * (ny - math.cos(th))
+    d[0] = G_MPS2 * (nx - gr * math.sin(th))
+    d[1] = G_MPS2 / V * (ny - gr * math.cos(th))
     d[2] = V * math.sin(th)
     d[3] = (nx_cmd - nx) / pm.tau_nx_s if pm.tau_nx_s > 0 else 0.0
     d[4] = (ny_cmd - ny) / pm.tau_ny_s if pm.tau_ny_s > 0 else 0.0
@@ -107,7 +109,7 @@ def simulate(law, pm: PointMassParams, alt0_m: float, tas0_mps: float, duration_
     DataFrame with the runner's column names: t_s, alt_m, tas_mps, vs_mps, gamma_deg, nx, ny,
     throttle, cmd_alt_m, cmd_tas_mps, cmd_nx, cmd_ny.
     """
-    x = np.array([tas0_mps, 0.0, alt0_m, 0.0, 1.0])
+    x = np.array([tas0_mps, 0.0, alt0_m, 0.0, gravity_ratio(0.0, alt0_m)])
     alt_cmd, tas_cmd = alt0_m, tas0_mps
     pending = list(events)
     n = int(round(duration_s / dt_s)) + 1
