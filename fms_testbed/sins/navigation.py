@@ -1,0 +1,184 @@
+"""SINS navigation source: truth ⊕ the 33-state error model, one step per navigation update.
+
+Scenario block (``navigation:``)::
+
+    source: sins
+    imu: STIM300            # preset name (imu/*.yaml), a .yaml path, or an inline mapping
+    seed: 7                 # optional; otherwise the run seed
+    method: picard          # picard | vanloan | trapezoid
+    dt_s: 0.1               # nominal navigation step, s (the step actually used is Δt of truth)
+    vertical: baro          # baro (damped, default) | free (unstable vertical channel)
+    baro_tau_s: 60          # baro loop time constant, s
+    tol: 1.0e-12            # adaptive Picard tolerance
+
+Each :meth:`SinsNavigation.update` builds F at the previous true state, discretises over the
+elapsed Δt, propagates x_k = Φ x_{k-1} + S N_k (paper eq. 6.11) and returns truth ⊕ errors.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from ..errors import ConfigError, UserError
+from ..state import AircraftState, NavSolution
+from .analysis import SinsOptions
+from .discretize import (PICARD_MAX_ORDER, PICARD_MAX_RATE_DT, DiscretisationError,
+                         _picard_sins, discretize)
+from .euler import eps_to_euler_errors
+from .model import baro_gains, build_F, earth_radii
+from .presets import G0_MPS2, ImuModel, load_imu
+from .simulate import FACTOR_RTOL, IndefiniteCovarianceError, _psd_cholesky
+
+SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol"}
+RAD2DPH = 180.0 / math.pi * 3600.0
+
+
+@njit(cache=True)
+def _c_bn(roll, pitch, heading):
+    cr, sr = math.cos(roll), math.sin(roll)
+    cp, sp = math.cos(pitch), math.sin(pitch)
+    ch, sh = math.cos(heading), math.sin(heading)
+    c = np.empty((3, 3))
+    c[0, 0] = cp * sh
+    c[0, 1] = sr * sp * sh + cr * ch
+    c[0, 2] = cr * sp * sh - sr * ch
+    c[1, 0] = cp * ch
+    c[1, 1] = sr * sp * ch - cr * sh
+    c[1, 2] = cr * sp * ch + sr * sh
+    c[2, 0] = sp
+    c[2, 1] = -sr * cp
+    c[2, 2] = -cr * cp
+    return c
+
+
+@njit(cache=True)
+def _sins_step(x, noise, lat, alt, v, rpy, w_eb, f_b, decay, q_diag, k1, k2, dt, tol, rtol):
+    """Fused kernel: F at the true state → Picard (Φ, Q_k) → S → Φ x + S N. Status 0 ok,
+    1 Picard range, 2 no convergence, 3 indefinite Q_k."""
+    c = _c_bn(rpy[0], rpy[1], rpy[2])
+    w_ie = np.array([0.0, 7.292115e-5 * math.cos(lat), 7.292115e-5 * math.sin(lat)])
+    w_ib = w_eb + c.T @ w_ie
+    F = build_F(lat, alt, v, f_b, w_ib, c, decay, k1, k2)
+    rate = 0.0
+    for i in range(F.shape[0]):
+        rate = max(rate, abs(F[i, i]))
+    if rate * dt > PICARD_MAX_RATE_DT:
+        return x, 1
+    phi, qk, _, ok = _picard_sins(F, q_diag, dt, tol, PICARD_MAX_ORDER)
+    if not ok:
+        return x, 2
+    L, bad = _psd_cholesky(qk, rtol)
+    if bad >= 0:
+        return x, 3
+    return phi @ x + L @ noise, 0
+
+
+class SinsNavigation:
+    """Navigation source with SINS errors; see the module docstring for the scenario keys."""
+
+    def __init__(self, imu: ImuModel, seed: int = 0, opts: SinsOptions = SinsOptions(),
+                 dt_s: float = 0.1):
+        self.imu = imu
+        self.opts = opts
+        self.dt_s = float(dt_s)
+        self.seed = int(seed)
+        self.rng = np.random.default_rng(self.seed)
+        self.x = np.sqrt(imu.p0_var) * self.rng.standard_normal(imu.p0_var.size)
+        self._prev: AircraftState | None = None
+
+    @classmethod
+    def from_spec(cls, spec: dict, seed: int | None = None) -> "SinsNavigation":
+        """Build from a scenario's ``navigation`` mapping (``spec['seed']`` wins over ``seed``).
+
+        Raises
+        ------
+        ConfigError : unknown key, missing ``imu``, or a bad value (named ``navigation.<key>``).
+        """
+        if not isinstance(spec, dict):
+            raise ConfigError(f"navigation: expected a mapping, got {type(spec).__name__}")
+        unknown = sorted(set(spec) - SPEC_KEYS)
+        if unknown:
+            raise ConfigError(f"navigation.{unknown[0]}: unknown key; allowed: "
+                              f"{', '.join(sorted(SPEC_KEYS))}")
+        if "imu" not in spec:
+            raise ConfigError("navigation.imu: missing (a preset name, a .yaml path or a mapping)")
+        imu = load_imu(spec["imu"])
+        try:
+            opts = SinsOptions(method=str(spec.get("method", "picard")),
+                               tol=float(spec.get("tol", 1e-12)),
+                               vertical=str(spec.get("vertical", "baro")),
+                               baro_tau_s=float(spec.get("baro_tau_s", 60.0)))
+            dt_s = float(spec.get("dt_s", 0.1))
+            sd = spec.get("seed", seed)
+            sd = 0 if sd is None else int(sd)
+        except (TypeError, ValueError) as exc:
+            raise ConfigError(f"navigation: bad value: {exc}") from None
+        if not dt_s > 0:
+            raise ConfigError(f"navigation.dt_s: must be > 0 s, got {dt_s}")
+        return cls(imu, seed=sd, opts=opts, dt_s=dt_s)
+
+    def _propagate(self, prev: AircraftState, dt: float) -> None:
+        noise = self.rng.standard_normal(self.x.size)
+        o = self.opts
+        k1, k2 = baro_gains(o.baro_tau_s if o.vertical == "baro" else None, prev.lat_rad)
+        rpy = np.array([prev.roll_rad, prev.pitch_rad, prev.heading_rad])
+        w_eb = np.array([prev.p_rps, prev.q_rps, prev.r_rps])
+        v = np.asarray(prev.v_enu_mps, float)
+        f_b = np.asarray(prev.f_body_mps2, float)
+        if o.method == "picard":
+            x, status = _sins_step(self.x, noise, prev.lat_rad, prev.alt_m, v, rpy, w_eb, f_b,
+                                   self.imu.decay_rps, self.imu.q_psd, k1, k2, dt, o.tol,
+                                   FACTOR_RTOL)
+            if status == 1 or status == 2:
+                raise DiscretisationError(
+                    f"navigation: Picard series unsuitable at dt = {dt:g} s (Δt/τ > "
+                    f"{PICARD_MAX_RATE_DT} or no convergence); set navigation.method: vanloan")
+            if status == 3:
+                raise IndefiniteCovarianceError(f"navigation: Q_k indefinite at t = {prev.t_s} s")
+            self.x = x
+            return
+        from .analysis import system_matrix
+        F = system_matrix(prev.lat_rad, prev.alt_m, v, rpy, w_eb, f_b, self.imu, o)
+        phi, qk = discretize(F, np.diag(self.imu.q_psd), dt, method=o.method)
+        L, bad = _psd_cholesky(np.ascontiguousarray(qk), FACTOR_RTOL)
+        if bad >= 0:
+            raise IndefiniteCovarianceError(f"navigation: Q_k indefinite at t = {prev.t_s} s "
+                                            f"(method {o.method})")
+        self.x = phi @ self.x + L @ noise
+
+    def update(self, truth: AircraftState) -> NavSolution:
+        """Advance the error state to ``truth.t_s`` and return truth ⊕ errors."""
+        prev = self._prev
+        if prev is not None:
+            dt = truth.t_s - prev.t_s
+            if dt < 0:
+                raise UserError(f"navigation: time went backwards ({prev.t_s} -> {truth.t_s} s)")
+            if dt > 0:
+                self._propagate(prev, dt)
+        self._prev = truth
+        return self.solution(truth)
+
+    def solution(self, truth: AircraftState) -> NavSolution:
+        """Truth ⊕ the current error state (position, velocity, attitude; errors dict for logs)."""
+        x = self.x
+        rm, rn, _, _ = earth_radii(truth.lat_rad)
+        lat = truth.lat_rad + x[1] / (rm + truth.alt_m)
+        lon = truth.lon_rad + x[0] / ((rn + truth.alt_m) * math.cos(truth.lat_rad))
+        d_roll, d_pitch, d_head = eps_to_euler_errors(x[6], x[7], x[8], truth.pitch_rad,
+                                                      truth.heading_rad)
+        errors = {
+            "nse_east_m": float(x[0]), "nse_north_m": float(x[1]), "nse_up_m": float(x[2]),
+            "ve_err_mps": float(x[3]), "vn_err_mps": float(x[4]), "vu_err_mps": float(x[5]),
+            "att_err_roll_deg": math.degrees(d_roll), "att_err_pitch_deg": math.degrees(d_pitch),
+            "att_err_heading_deg": math.degrees(d_head),
+            "bias_accel_x_ug": float(x[9]) / G0_MPS2 * 1e6,
+            "bias_gyro_x_dph": float(x[12]) * RAD2DPH, "bias_gyro_z_dph": float(x[14]) * RAD2DPH,
+        }
+        return NavSolution(
+            t_s=truth.t_s, lat_rad=lat, lon_rad=lon, alt_m=truth.alt_m + float(x[2]),
+            v_enu_mps=np.asarray(truth.v_enu_mps, float) + x[3:6],
+            roll_rad=truth.roll_rad + d_roll, pitch_rad=truth.pitch_rad + d_pitch,
+            heading_rad=(truth.heading_rad + d_head) % (2 * math.pi), errors=errors)
