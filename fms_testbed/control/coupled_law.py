@@ -243,7 +243,9 @@ def speed_protection_ny(p: CoupledLawParams, ny: float, dV_mps: float, tas_mps: 
 
     With the throttle at a limit, V' = g (n_x - sin θ) is set by θ alone. Demanding
     V' = -ΔV / τ with τ = T_V / (2 ξ_V) gives the flight-path limit
-    ``sin θ_lim = n_x + ΔV / (g τ)``; n_ya is then limited to
+    ``sin θ_lim = n_x + ΔV / (g τ)``, bounded to θ_lim ≥ 0 at max throttle and θ_lim ≤ 0 at idle
+    (the protection gives up the climb or the descent, never trades altitude the other way);
+    n_ya is then limited to
     ``cos θ + (V / g)(θ_lim - θ) / gamma_tau_s`` — a floor at idle (no overspeed in a descent),
     a ceiling at max throttle (no speed decay in a climb).
 
@@ -255,6 +257,9 @@ def speed_protection_ny(p: CoupledLawParams, ny: float, dV_mps: float, tas_mps: 
         return ny, False
     tau = p.T_V_s / (2.0 * p.xi_V)
     s_lim = min(max((nx_meas + dV_mps / (G_MPS2 * tau)) / g_ratio, -0.5), 0.5)
+    # only give up the climb (max throttle) or the descent (idle): never dive for speed nor
+    # climb to shed it
+    s_lim = max(s_lim, 0.0) if sat_hi else min(s_lim, 0.0)
     ny_lim = g_ratio * math.cos(gamma_rad) + (tas_mps / G_MPS2) * (math.asin(s_lim) - gamma_rad) / p.gamma_tau_s
     if sat_lo and ny < ny_lim:
         return ny_lim, True

@@ -79,7 +79,8 @@ def rise_time(t_s: np.ndarray, y: np.ndarray, y0: float, target: float) -> float
 
 def step_metrics(df: pd.DataFrame, channel: str, band_frac: float = 0.02,
                  band_min: float | None = None, throttle_min: float = 0.0,
-                 throttle_max: float = 1.0, t_end_s: float | None = None) -> StepMetrics:
+                 throttle_max: float = 1.0, t_end_s: float | None = None,
+                 reference: pd.DataFrame | None = None) -> StepMetrics:
     """Measure the first step of ``channel`` (``"alt"`` or ``"speed"``) in a run.
 
     Parameters
@@ -89,45 +90,62 @@ def step_metrics(df: pd.DataFrame, channel: str, band_frac: float = 0.02,
     band_frac : settling band as a fraction of the step (default 2 %)
     band_min : lower bound on the band (m or m/s), e.g. sensor-level noise
     throttle_min, throttle_max : throttle limits for the saturation fraction
-    t_end_s : evaluate up to this time (default: end of run, or the next command change)
+    t_end_s : evaluate up to this time (default: end of run or the channel's next command change)
+    reference : optional run of the same commands (e.g. the ideal point-mass response); when
+        given, the cross deviation is the other channel's distance from the reference over the
+        whole step (for overlapping steps), else its distance from its command until either
+        command changes again
+
+    Notes
+    -----
+    A command that appears (NaN before the law engages) counts as a step from the measured
+    value when it differs from it by more than 0.5 (m or m/s).
     """
     ycol, ccol, xcol, xc = (("alt_m", "cmd_alt_m", "tas_mps", "cmd_tas_mps") if channel == "alt"
                             else ("tas_mps", "cmd_tas_mps", "alt_m", "cmd_alt_m"))
-    steps = find_steps(df, ccol)
+    steps = find_steps(df, ccol) + _appearing(df, ccol, ycol)
     if not steps:
         raise ValueError(f"no {channel} command change in the run")
-    i0 = steps[0]
+    i0 = min(steps)
     t = df["t_s"].to_numpy()
     end = len(df)
-    later = [i for i in find_steps(df, ccol) + find_steps(df, xc) if i > i0]
+    later = [i for i in find_steps(df, ccol) if i > i0]
     if later:
         end = min(later)
     if t_end_s is not None:
         end = min(end, int(np.searchsorted(t, t_end_s)))
     seg = slice(i0, end)
     ts, y = t[seg], df[ycol].to_numpy()[seg]
-    y0 = float(df[ycol].iloc[i0 - 1])
+    prev = float(df[ccol].iloc[i0 - 1])
+    y0 = prev if np.isfinite(prev) else float(df[ycol].iloc[i0 - 1])
     target = float(df[ccol].iloc[i0])
     step = target - y0
     band = abs(step) * band_frac
     if band_min is not None:
         band = max(band, band_min)
     over = max(0.0, float(np.max((y - target) * np.sign(step)))) / abs(step) * 100.0
-    cross = np.abs(df[xcol].to_numpy()[seg] - df[xc].to_numpy()[seg])
+    if reference is not None:
+        xr = np.interp(ts, reference["t_s"].to_numpy(), reference[xcol].to_numpy())
+        cross = np.abs(df[xcol].to_numpy()[seg] - xr)
+    else:
+        other = [i for i in find_steps(df, xc) if i > i0]
+        cend = min([end] + other)
+        cross = np.abs(df[xcol].to_numpy()[i0:cend] - df[xc].to_numpy()[i0:cend])
     thr = df["throttle"].to_numpy()[seg]
     act = float(np.sum(np.abs(np.diff(thr))) / max(ts[-1] - ts[0], 1e-9))
     sat = float(np.mean((thr >= throttle_max - 0.005) | (thr <= throttle_min + 0.005)))
     ny = df["ny"].to_numpy()[seg]
     return StepMetrics(channel, float(t[i0]), step, settling_time(ts, y, target, band),
-                       rise_time(ts, y, y0, target), over, float(cross.max()), act, sat,
+                       rise_time(ts, y, y0, target), over, float(np.nanmax(cross)), act, sat,
                        float(ny.min()), float(ny.max()))
 
 
-def first_cross_deviation(df: pd.DataFrame, channel: str) -> float:
-    """Max |deviation| of the non-stepped channel over the whole run (m/s or m)."""
-    if channel == "alt":
-        return float(np.max(np.abs(df["tas_mps"] - df["cmd_tas_mps"])))
-    return float(np.max(np.abs(df["alt_m"] - df["cmd_alt_m"])))
+def _appearing(df: pd.DataFrame, ccol: str, ycol: str, tol: float = 0.5) -> list[int]:
+    """Rows where the command goes from NaN to a value more than ``tol`` from the measurement."""
+    c = df[ccol].to_numpy()
+    y = df[ycol].to_numpy()
+    idx = np.flatnonzero(~np.isfinite(c[:-1]) & np.isfinite(c[1:])) + 1
+    return [int(i) for i in idx if abs(c[i] - y[i - 1]) > tol]
 
 
 def relative_difference(a: float, b: float) -> float:
