@@ -37,7 +37,15 @@ def _psd_cholesky(Q, rtol):
         if d < -rtol * scale or Q[j, j] < 0.0:
             return L, j
         if d <= rtol * scale:
-            continue                     # null pivot: column j stays zero
+            # null pivot: column j stays zero, which is only right if the rest of the Schur
+            # column is zero too (|s|² ≤ d_j d_i for a PSD matrix); otherwise Q is indefinite
+            for i in range(j + 1, n):
+                s = Q[i, j]
+                for k in range(j):
+                    s -= L[i, k] * L[j, k]
+                if s * s > 4.0 * rtol * scale * abs(Q[i, i]):
+                    return L, j
+            continue
         ljj = np.sqrt(d)
         L[j, j] = ljj
         for i in range(j + 1, n):

@@ -1,0 +1,58 @@
+"""Simulation x_k = Φ x + S N: semidefinite factorisation, Monte-Carlo statistics, seeding."""
+
+import numpy as np
+import pytest
+
+from fms_testbed.sins.discretize import discretize
+from fms_testbed.sins.simulate import IndefiniteCovarianceError, factor_psd, simulate_lti
+from sins_helpers import flight_F
+
+
+def test_factor_reproduces_a_singular_psd_matrix():
+    F, q, _ = flight_F()
+    _, qk = discretize(F, np.diag(q), 0.1)
+    S = factor_psd(qk)
+    assert S.shape[1] < qk.shape[0]                          # undriven constants: singular
+    assert np.abs(S @ S.T - qk).max() <= 1e-12 * np.abs(qk).max()
+    with pytest.raises(np.linalg.LinAlgError):               # why plain Cholesky is not enough
+        np.linalg.cholesky(qk)
+
+
+def test_factor_handles_zero_rows_and_rejects_indefinite():
+    Q = np.array([[4.0, 0.0, 2.0], [0.0, 0.0, 0.0], [2.0, 0.0, 1.0]])   # rank 1, zero row
+    S = factor_psd(Q)
+    assert S.shape == (3, 1) and np.allclose(S @ S.T, Q)
+    with pytest.raises(IndefiniteCovarianceError, match="indefinite"):
+        factor_psd(np.array([[1.0, 2.0], [2.0, 1.0]]))
+    with pytest.raises(IndefiniteCovarianceError):
+        factor_psd(np.array([[0.0, 1e-3], [1e-3, 1.0]]))            # zero pivot, live column
+
+
+def test_factor_tolerates_rounding_level_negative_pivot():
+    v = np.array([1.0, 1.0 / 3.0, 2.0 / 3.0])
+    Q = np.outer(v, v)                                       # rank 1; pivots 2, 3 ≈ ±1e-17
+    S = factor_psd(Q)
+    assert S.shape[1] == 1 and np.allclose(S @ S.T, Q, atol=1e-15)
+
+
+def test_monte_carlo_variances_pass_z_test_for_every_state():
+    F, q, imu = flight_F()
+    n_real, n_steps, dt = 20_000, 100, 0.1
+    x = simulate_lti(F, np.diag(q), dt, n_steps, imu.p0_var, n_real, seed=11)
+    phi, qk = discretize(F, np.diag(q), dt)
+    P = np.diag(imu.p0_var)
+    for _ in range(n_steps):
+        P = phi @ P @ phi.T + qk
+    s2 = x[-1].var(axis=1, ddof=1)
+    live = np.diag(P) > 0
+    z = (s2[live] / np.diag(P)[live] - 1) / np.sqrt(2 / n_real)
+    assert live.sum() >= 21
+    assert np.all(np.abs(z) < 4), z
+
+
+def test_simulation_is_reproducible_from_its_seed():
+    F, q, imu = flight_F()
+    a = simulate_lti(F, np.diag(q), 0.1, 20, imu.p0_var, 5, seed=3)
+    b = simulate_lti(F, np.diag(q), 0.1, 20, imu.p0_var, 5, seed=3)
+    c = simulate_lti(F, np.diag(q), 0.1, 20, imu.p0_var, 5, seed=4)
+    assert np.array_equal(a, b) and not np.allclose(a, c)
