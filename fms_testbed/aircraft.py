@@ -76,6 +76,8 @@ class PIDGains(_Frozen):
     kp: float
     ki: NonNeg = 0.0
     kd: float = 0.0
+    kff: float = Field(0.0, description="feed-forward of the command's deviation from trim "
+                                        "(n_y - 1, n_x), control units per g")
 
 
 class InnerLoopGains(_Frozen):
@@ -97,6 +99,22 @@ class InnerLoopGains(_Frozen):
     elevator_rate_max_ps: Pos = Field(1.5, description="elevator command rate limit, norm/s")
     throttle_min: Annotated[float, Field(ge=0, le=1)] = 0.0
     throttle_max: Annotated[float, Field(ge=0, le=1.0)] = 1.0
+
+
+class InnerLoopSpec(_Frozen):
+    """Step-response specification the inner loops must meet on this aircraft (tests check it).
+
+    Settling: last time outside ±5 % of the step around the target; overshoot in % of the step.
+    """
+
+    bank_step_deg: Pos = 25.0
+    bank_settle_max_s: Pos = 6.0
+    ny_step: Pos = Field(0.1, description="n_y step size, g (flown up and down)")
+    ny_settle_max_s: Pos = 2.0
+    nx_step: Pos = Field(0.05, description="n_x step size, g (flown up and down)")
+    nx_settle_max_s: Pos = 1.5
+    overshoot_max_pct: Pos = 10.0
+    nx_overshoot_max_pct: Pos = 10.0
 
 
 class CoupledLawGains(_Frozen):
@@ -121,6 +139,7 @@ class AircraftConfig(_Frozen):
     envelope: list[EnvelopePoint] = Field(min_length=1)
     default_condition: EnvelopePoint
     inner_loops: InnerLoopGains
+    inner_spec: InnerLoopSpec = Field(default_factory=InnerLoopSpec)
     coupled_law: CoupledLawGains | None = None
     source_file: str = ""
 

@@ -7,13 +7,17 @@ Four loops, each with proportional and integral action and an engage flag:
 * yaw coordination: rudder from sideslip with yaw-rate damping,
   ``δr = δr_trim - (kp β + ki ∫β) + kd (r - g tanφ / V)`` (positive rudder yaws nose left)
 * normal load factor: elevator from the n_y error with pitch-rate damping,
-  ``δe = δe_trim - (kp e_ny + ki ∫e_ny) + kd q``, rate limited
+  ``δe = δe_trim - (kp e_ny + ki ∫e_ny + kff (n_y,cmd - 1)) + kd q``, rate limited
 * tangential load factor: throttle from the n_x error,
-  ``δT = δT_trim + kp e_nx + ki ∫e_nx``, clipped to [idle, max], integrator held while clipped.
+  ``δT = δT_trim + kff n_x,cmd + kp e_nx + ki ∫e_nx``, clipped to [idle, max], integrator held while clipped.
 
 Measured load factors behave like an accelerometer along the wind axes (coupled-law note):
 ``n_x = (F_x cos α + F_z sin α) / W``, ``n_y = (F_x sin α - F_z cos α) / W`` from JSBSim's total
 body forces (gravity excluded).
+
+Gain schedule: the surface loops' errors and damping terms are multiplied by
+``q̄_ref / q̄`` (clipped to [0.25, 4]), the reference being the aircraft's design point (``default_condition``), where the gains
+in its file were tuned.
 
 Gains and commands are properties under ``fms/`` that Python writes; the XML never holds numbers
 from the aircraft file, so tuning stays in ``aircraft/*.yaml``. The property names are the contract
@@ -32,8 +36,9 @@ INPUT_PROPERTIES = (
     "fms/gain/bank-kp", "fms/gain/bank-ki", "fms/gain/bank-kd",
     "fms/gain/yaw-kp", "fms/gain/yaw-ki", "fms/gain/yaw-kd",
     "fms/gain/ny-kp", "fms/gain/ny-ki", "fms/gain/ny-kd",
-    "fms/gain/nx-kp", "fms/gain/nx-ki",
+    "fms/gain/ny-kff", "fms/gain/nx-kp", "fms/gain/nx-ki", "fms/gain/nx-kff",
     "fms/limit/throttle-min", "fms/limit/throttle-max",
+    "fms/sched/qbar-ref-psf",
 )
 
 #: Properties the system computes and Python reads.
@@ -81,6 +86,10 @@ def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float) -> str:
               f"<quotient><difference><product>{_p('forces/fbx-total-lbs')}<sin>{_p(alpha)}</sin>"
               f"</product><product>{_p('forces/fbz-total-lbs')}<cos>{_p(alpha)}</cos></product>"
               f"</difference>{_p(w)}</quotient>")
+        # gain schedule: surface loops scale with 1/qbar relative to the design point (the aircraft's default condition)
+        + _fn("fms/sched/qbar-ratio",
+              f"<max><v>0.25</v><min><v>4</v><quotient>{_p('fms/sched/qbar-ref-psf')}"
+              f"<max>{_p('aero/qbar-psf')}<v>1</v></max></quotient></min></max>")
         + "</channel>\n")
 
     def reset_trigger(loop: str) -> str:
@@ -90,11 +99,13 @@ def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float) -> str:
     lateral = (
         '<channel name="fms-lateral">\n'
         + reset_trigger("bank")
-        + _fn("fms/bank-err-rad", f"<difference>{_p('fms/cmd/bank-rad')}{_p('attitude/phi-rad')}</difference>")
+        + _fn("fms/bank-err-rad", f"<product>{_p('fms/sched/qbar-ratio')}<difference>{_p('fms/cmd/bank-rad')}"
+              f"{_p('attitude/phi-rad')}</difference></product>")
         + _pid("fms/bank-pid", "fms/bank-err-rad", "bank", "fms/bank-trigger")
         + _fn("fms/aileron-out", _master("fcs/aileron-cmd-norm",
               f"<sum>{_p('fms/trim/aileron')}<product>{_p('fms/ap/bank-engage')}<difference>"
-              f"{_p('fms/bank-pid')}<product>{_p('fms/gain/bank-kd')}{_p('velocities/p-rad_sec')}</product>"
+              f"{_p('fms/bank-pid')}<product>{_p('fms/sched/qbar-ratio')}{_p('fms/gain/bank-kd')}"
+              f"{_p('velocities/p-rad_sec')}</product>"
               "</difference></product></sum>"))
         + '  <pure_gain name="fms/aileron-clip"><input>fms/aileron-out</input><gain>1</gain>'
           '<clipto><min>-1</min><max>1</max></clipto><output>fcs/aileron-cmd-norm</output></pure_gain>\n'
@@ -115,11 +126,15 @@ def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float) -> str:
     longitudinal = (
         '<channel name="fms-longitudinal">\n'
         + reset_trigger("ny")
-        + _fn("fms/ny-err", f"<difference>{_p('fms/cmd/ny')}{_p('fms/meas/ny')}</difference>")
+        + _fn("fms/ny-err", f"<product>{_p('fms/sched/qbar-ratio')}<difference>{_p('fms/cmd/ny')}"
+              f"{_p('fms/meas/ny')}</difference></product>")
         + _pid("fms/ny-pid", "fms/ny-err", "ny", "fms/ny-trigger")
         + _fn("fms/elevator-out", _master("fcs/elevator-cmd-norm",
               f"<sum>{_p('fms/trim/elevator')}<product>{_p('fms/ap/ny-engage')}<difference>"
-              f"<product>{_p('fms/gain/ny-kd')}{_p('velocities/q-rad_sec')}</product>{_p('fms/ny-pid')}"
+              f"<product>{_p('fms/sched/qbar-ratio')}{_p('fms/gain/ny-kd')}{_p('velocities/q-rad_sec')}"
+              f"</product>{_p('fms/ny-pid')}"
+              f"<product>{_p('fms/sched/qbar-ratio')}{_p('fms/gain/ny-kff')}<difference>{_p('fms/cmd/ny')}<v>1</v></difference>"
+              "</product>"
               "</difference></product></sum>"))
         + '  <actuator name="fms/elevator-act"><input>fms/elevator-out</input>'
           f"<rate_limit>{elevator_rate_max_ps:.6g}</rate_limit>"
@@ -135,7 +150,8 @@ def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float) -> str:
         + _fn("fms/throttle-raw", _master(
               "fcs/throttle-cmd-norm[0]",
               f"<ifthen><gt>{_p('fms/ap/nx-engage')}<v>0.5</v></gt>"
-              f"<sum>{_p('fms/trim/throttle')}{_p('fms/nx-pid')}</sum>{_p('fms/cmd/throttle')}</ifthen>"))
+              f"<sum>{_p('fms/trim/throttle')}{_p('fms/nx-pid')}<product>{_p('fms/gain/nx-kff')}"
+              f"{_p('fms/cmd/nx')}</product></sum>{_p('fms/cmd/throttle')}</ifthen>"))
         + _fn("fms/throttle-sat",
               f"<ifthen><ge>{_p('fms/throttle-raw')}{_p('fms/limit/throttle-max')}</ge><v>1</v>"
               f"<ifthen><le>{_p('fms/throttle-raw')}{_p('fms/limit/throttle-min')}</le><v>-1</v><v>0</v>"
@@ -151,15 +167,23 @@ def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float) -> str:
             f"frame {dt_s:.6f} s ({1.0 / dt_s:.0f} Hz) -->\n{decl}{meas}{lateral}{longitudinal}</system>\n")
 
 
-def gain_properties(gains) -> dict[str, float]:
-    """Map an :class:`~fms_testbed.aircraft.InnerLoopGains` to the ``fms/gain/*`` properties."""
+def gain_properties(cfg) -> dict[str, float]:
+    """Map an :class:`~fms_testbed.aircraft.AircraftConfig`'s inner-loop tuning to ``fms/*``
+    properties (gains, limits, and the schedule's reference dynamic pressure)."""
+    from .atmosphere import isa
+
+    gains = cfg.inner_loops
+    _, _, rho = isa(cfg.default_condition.alt_m)
+    qbar_pa = 0.5 * float(rho) * cfg.default_condition.tas_mps ** 2
     return {
+        "fms/sched/qbar-ref-psf": qbar_pa / 47.88025898,
         "fms/gain/bank-kp": gains.bank.kp, "fms/gain/bank-ki": gains.bank.ki,
         "fms/gain/bank-kd": gains.bank.kd,
         "fms/gain/yaw-kp": gains.yaw.kp, "fms/gain/yaw-ki": gains.yaw.ki,
         "fms/gain/yaw-kd": gains.yaw.kd,
         "fms/gain/ny-kp": gains.ny.kp, "fms/gain/ny-ki": gains.ny.ki, "fms/gain/ny-kd": gains.ny.kd,
         "fms/gain/nx-kp": gains.nx.kp, "fms/gain/nx-ki": gains.nx.ki,
+        "fms/gain/nx-kff": gains.nx.kff, "fms/gain/ny-kff": gains.ny.kff,
         "fms/limit/throttle-min": gains.throttle_min, "fms/limit/throttle-max": gains.throttle_max,
     }
 

@@ -1,7 +1,7 @@
 """Step responses of the inner loops on JSBSim, their metrics, and a small gain search.
 
-Used by the tests (each shipped aircraft must meet :data:`SPECS`) and by
-``fms-testbed inner-tune`` when a new aircraft is added.
+Used by the tests (each shipped aircraft must meet its ``inner_spec``) and by
+``fms-testbed inner --aircraft NAME [--tune]`` when a new aircraft is added.
 
 Metrics: settling time is the last time the response is outside ±5 % of the step size around the
 target (s, from the step); overshoot is the peak beyond the target in % of the step size.
@@ -29,14 +29,18 @@ class StepSpec:
     overshoot_max_pct: float
 
 
-#: The inner-loop specification every shipped aircraft meets (tests/test_inner_loops.py).
-SPECS = (
-    StepSpec("bank", math.radians(25.0), 12.0, 6.0, 10.0),
-    StepSpec("ny", 0.1, 6.0, 2.0, 10.0),
-    StepSpec("ny", -0.1, 6.0, 2.0, 10.0),
-    StepSpec("nx", 0.05, 5.0, 1.5, 10.0),
-    StepSpec("nx", -0.05, 5.0, 1.5, 10.0),
-)
+def specs_for(cfg: AircraftConfig) -> tuple[StepSpec, ...]:
+    """The step specs of ``cfg`` (its ``inner_spec`` block; defaults are the issue's values)."""
+    sp = cfg.inner_spec
+    bank = math.radians(sp.bank_step_deg)
+    return (
+        StepSpec("bank", bank, 12.0, sp.bank_settle_max_s, sp.overshoot_max_pct),
+        StepSpec("ny", sp.ny_step, 6.0, sp.ny_settle_max_s, sp.overshoot_max_pct),
+        StepSpec("ny", -sp.ny_step, 6.0, sp.ny_settle_max_s, sp.overshoot_max_pct),
+        StepSpec("nx", sp.nx_step, 6.0, sp.nx_settle_max_s, sp.nx_overshoot_max_pct),
+        StepSpec("nx", -sp.nx_step, 6.0, sp.nx_settle_max_s, sp.nx_overshoot_max_pct),
+    )
+
 
 _KEY = {"bank": "roll_rad", "ny": "ny", "nx": "nx"}
 
@@ -99,10 +103,10 @@ def step_response(ac: JSBSimAircraft, spec: StepSpec, point: EnvelopePoint,
 
 
 def check_aircraft(cfg: AircraftConfig, point: EnvelopePoint | None = None) -> list[StepResult]:
-    """Run every spec in :data:`SPECS` on ``cfg`` at ``point`` (default: its default condition)."""
+    """Run every spec of ``cfg`` at ``point`` (default: its default condition)."""
     ac = JSBSimAircraft(cfg)
     pt = point or cfg.default_condition
-    return [step_response(ac, s, pt) for s in SPECS]
+    return [step_response(ac, s, pt) for s in specs_for(cfg)]
 
 
 def tune_loop(cfg: AircraftConfig, loop: str, max_evals: int = 60) -> tuple[PIDGains, float]:
@@ -110,7 +114,7 @@ def tune_loop(cfg: AircraftConfig, loop: str, max_evals: int = 60) -> tuple[PIDG
     overshoot penalised beyond 5 %; return the gains and the cost. Deterministic."""
     from scipy.optimize import minimize
 
-    specs = [s for s in SPECS if s.loop == loop]
+    specs = [s for s in specs_for(cfg) if s.loop == loop]
     ac = JSBSimAircraft(cfg)
     g0 = getattr(cfg.inner_loops, loop)
     use_kd = loop != "nx"
@@ -144,5 +148,5 @@ def replace_gains(cfg: AircraftConfig, loop: str, gains: PIDGains) -> AircraftCo
     return cfg.model_copy(update={"inner_loops": inner})
 
 
-__all__ = ["SPECS", "StepSpec", "StepResult", "step_metrics", "step_response", "check_aircraft",
+__all__ = ["specs_for", "StepSpec", "StepResult", "step_metrics", "step_response", "check_aircraft",
            "tune_loop", "replace_gains"]

@@ -110,16 +110,17 @@ def count_engines(model: str) -> int:
     return len(root.findall("./propulsion/engine"))
 
 
-def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float) -> Path:
+def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None) -> Path:
     """Copy ``model`` from the jsbsim wheel into the sandbox without I/O elements.
 
     Returns the sandbox's ``aircraft`` folder (to pass to ``set_aircraft_path``). Removes every
-    top-level ``<input>`` and ``<output>`` element and appends the inner-loop ``<system>``.
+    top-level ``<input>`` and ``<output>`` element and appends the inner-loop ``<system>``
+    (not when ``elevator_rate_max_ps`` is None: the bare model, for benchmarks).
     """
     src = Path(jsbsim.get_default_root_dir()) / "aircraft" / model
     if not (src / f"{model}.xml").exists():
         raise UserError(f"JSBSim model '{model}' is not in the jsbsim package's aircraft folder")
-    key = f"{model}-er{elevator_rate_max_ps:g}"
+    key = f"{model}-er{elevator_rate_max_ps:g}" if elevator_rate_max_ps else f"{model}-bare"
     dst_root = _sandbox_dir() / key
     dst = dst_root / model
     if (dst / f"{model}.xml").exists():
@@ -133,10 +134,24 @@ def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float) -> Path:
             root.remove(el)
             removed += 1
     n_eng = len(root.findall("./propulsion/engine"))
-    root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S)))
+    if elevator_rate_max_ps:
+        root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S)))
     tree.write(dst / f"{model}.xml", encoding="utf-8", xml_declaration=True)
     log.debug("sanitised %s: removed %d I/O elements, %d engines", model, removed, n_eng)
     return dst_root
+
+
+def bare_fdm(model: str, dt_s: float = DT_S) -> "jsbsim.FGFDMExec":
+    """A sanitised JSBSim instance of ``model`` without the inner loops (for benchmarks)."""
+    _install_logger()
+    fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir())
+    fdm.set_debug_level(0)
+    fdm.disable_output()
+    fdm.set_aircraft_path(str(sanitized_aircraft_path(model, None)))
+    if not fdm.load_model(model):
+        raise UserError(f"JSBSim could not load model '{model}'")
+    fdm.set_dt(dt_s)
+    return fdm
 
 
 # --------------------------------------------------------------------------------- model
@@ -191,6 +206,7 @@ _READ = {  # state field -> (property, scale)
     "aileron": ("fcs/aileron-cmd-norm", 1.0),
     "rudder": ("fcs/rudder-cmd-norm", 1.0),
     "throttle_sat": ("fms/throttle-sat", 1.0),
+    "wow": ("gear/wow", 1.0),
 }
 
 
@@ -229,7 +245,9 @@ class JSBSimAircraft:
         missing = [_READ[k][0] for k, n in self._nodes.items() if n is None]
         if missing:
             raise UserError(f"{cfg.jsbsim_model}: JSBSim properties missing: {missing}")
-        self._scale = {k: s for k, (_, s) in _READ.items()}
+        self._keys = tuple(_READ)
+        self._getters = tuple(self._nodes[k].get_double_value for k in self._keys)
+        self._scaled = tuple((k, sc) for k, (_, sc) in _READ.items() if sc != 1.0)
         self._w = {name: pm.get_node(name, True) for name in (
             "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
             "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle")}
@@ -248,7 +266,7 @@ class JSBSimAircraft:
         self._write_gains()
 
     def _write_gains(self) -> None:
-        for prop, val in gain_properties(self.cfg.inner_loops).items():
+        for prop, val in gain_properties(self.cfg).items():
             self.fdm[prop] = float(val)
 
     # -- trim ------------------------------------------------------------------------
@@ -374,8 +392,10 @@ class JSBSimAircraft:
 
     def read(self) -> dict[str, float]:
         """Read every logged property through its cached node (SI units)."""
-        sc = self._scale
-        return {k: n.get_double_value() * sc[k] for k, n in self._nodes.items()}
+        r = dict(zip(self._keys, [g() for g in self._getters]))
+        for k, sc in self._scaled:
+            r[k] *= sc
+        return r
 
     def state(self, raw: dict[str, float] | None = None) -> AircraftState:
         """Return the true state as an :class:`AircraftState`."""

@@ -13,7 +13,7 @@ import json
 import logging
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -123,12 +123,11 @@ def _apply(ev: Event, tg: _Targets) -> None:
         tg.speed_kind, tg.speed_mps, tg.vertical = kind, spd, True
 
 
-def _divergence(s: AircraftState, cfg: AircraftConfig) -> str | None:
+def _divergence(s: AircraftState, cfg: AircraftConfig, wow: float) -> str | None:
     lim = cfg.limits
-    vals = (s.alt_m, s.tas_mps, s.roll_rad, s.pitch_rad, s.alpha_rad, s.nx, s.ny)
-    if not all(math.isfinite(v) for v in vals):
+    if not math.isfinite(s.alt_m + s.tas_mps + s.roll_rad + s.pitch_rad + s.alpha_rad + s.ny):
         return "non-finite state (JSBSim diverged)"
-    if s.agl_m < 1.0:
+    if s.agl_m < 1.0 or wow > 0.5:
         return f"ground contact at t={s.t_s:.1f} s"
     if math.degrees(s.alpha_rad) > lim.stall_alpha_deg:
         return (f"stall: alpha {math.degrees(s.alpha_rad):.1f} deg > {lim.stall_alpha_deg} deg "
@@ -141,6 +140,19 @@ def _divergence(s: AircraftState, cfg: AircraftConfig) -> str | None:
     if abs(s.roll_rad) > math.radians(75) or abs(s.pitch_rad) > math.radians(45):
         return f"upset: roll {math.degrees(s.roll_rad):.0f} deg, pitch {math.degrees(s.pitch_rad):.0f} deg"
     return None
+
+
+class _VerticalPlane:
+    """A view of an :class:`AircraftState` whose ``ny`` is the vertical-plane component
+    ``n_y cos φ`` (what the vertical laws work with); every other attribute is the state's."""
+
+    __slots__ = ("_s", "ny")
+
+    def __init__(self, s: AircraftState, ny_vert: float):
+        self._s, self.ny = s, ny_vert
+
+    def __getattr__(self, name):
+        return getattr(self._s, name)
 
 
 class _NavHold:
@@ -194,13 +206,13 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     ini = scn.initial
     kind, spd = ini.speed
     tas0 = float(cas_to_tas(spd, ini.altitude_m)) if kind == "cas" else spd
-    if scn.turbulence is not None:
+    ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
+            lon_deg=ini.lon_deg, wind_ned_mps=_wind_ned(scn))
+    if scn.turbulence is not None:  # after trim: JSBSim cannot trim in turbulence
         idx, w20 = _TURB_SEVERITY[scn.turbulence.severity]
         fdm["atmosphere/turb-type"] = 4
         fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20 * 1.6878
         fdm["atmosphere/turbulence/milspec/severity"] = idx
-    ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
-            lon_deg=ini.lon_deg, wind_ned_mps=_wind_ned(scn))
     trim = ac.trim_result
     ac.engage()
     ac.command(bank_rad=0.0, ny=1.0, nx=0.0)
@@ -209,7 +221,7 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     nav_seed = int(nav_spec.get("seed", seed))
     source = make_source(nav_spec, seed=nav_seed)
     nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
-    navigate = _NavHold(source, nav_dt)
+    navigate = _NavHold(source, nav_dt) if nav_dt > 0 else source.update
 
     law = vertical_law or VERTICAL_LAWS[scn.vertical_law](cfg)
     tg = _Targets()
@@ -237,7 +249,7 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     raw = ac.read()
     for k in range(n_total + 1):
         s = ac.state(raw)
-        why = _divergence(s, cfg)
+        why = _divergence(s, cfg, raw["wow"])
         if why:
             status, reason = "diverged", why
             break
@@ -273,7 +285,7 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
             tas_cmd = (float(cas_to_tas(tg.speed_mps, s.alt_m)) if tg.speed_kind == "cas"
                        else tg.speed_mps)
             # the law works in the vertical plane: give it the vertical component of n_y
-            s_v = replace(s, ny=s.ny * math.cos(s.roll_rad))
+            s_v = _VerticalPlane(s, s.ny * math.cos(s.roll_rad))
             if not law_engaged:
                 law.engage(s_v, alt_cmd, tas_cmd)
                 law_engaged = True

@@ -1,0 +1,96 @@
+"""Running scenarios: outputs, columns, reproducibility, divergence handling."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from fms_testbed.runner import run_scenario
+from fms_testbed.timeseries import COLUMNS
+
+BASE = {"aircraft": "737", "initial": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 3000,
+                                        "tas_kmh": 400, "heading_deg": 90}}
+
+REQUIRED = ("t_s lat_deg lon_deg alt_m tas_mps gs_mps vs_mps heading_deg track_deg pitch_deg "
+            "roll_deg alpha_deg gamma_deg nx ny throttle elevator aileron rudder nav_lat_deg "
+            "nav_lon_deg nav_alt_m nav_heading_deg").split()
+
+
+def test_run_writes_outputs_and_documented_columns(tmp_path):
+    scn = {**BASE, "name": "turn", "duration_s": 60, "hold": True,
+           "events": [{"t_s": 2, "heading_deg": 150}]}
+    res = run_scenario(scn, out_dir=tmp_path / "o", csv=True)
+    files = {p.name for p in (tmp_path / "o").iterdir()}
+    assert {"timeseries.parquet", "timeseries.csv", "summary.json", "ground_track.png",
+            "time_histories.png"} <= files
+    df = pd.read_parquet(tmp_path / "o" / "timeseries.parquet")
+    assert list(df.columns[:len(COLUMNS)]) == [c for c, _ in COLUMNS]
+    assert set(REQUIRED) <= set(df.columns)
+    assert any(c.startswith("cmd_") for c in df.columns)
+    summ = json.loads((tmp_path / "o" / "summary.json").read_text())
+    for key in ("status", "reason", "duration_s", "wall_time_s", "real_time_factor", "metrics"):
+        assert key in summ
+    assert summ["status"] == "ok"
+    # heading hold reached the target on the navigation (= true) heading
+    assert df["heading_deg"].iloc[-1] == pytest.approx(150, abs=1.0)
+    assert np.allclose(df["nav_lat_deg"], df["lat_deg"]) and np.allclose(df["nav_alt_m"], df["alt_m"])
+    assert df["roll_deg"].abs().max() <= 25.0 + 1.5
+    # logged at 10 Hz
+    assert np.diff(df["t_s"]).mean() == pytest.approx(0.1, abs=1e-6)
+
+
+def test_direct_inner_loop_targets_are_tracked():
+    scn = {**BASE, "duration_s": 20, "events": [{"t_s": 1, "bank_deg": -20}, {"t_s": 1, "ny": 1.08},
+                                                 {"t_s": 1, "nx": 0.03}]}
+    df = run_scenario(scn).df
+    late = df[df.t_s > 12]
+    assert late["roll_deg"].mean() == pytest.approx(-20, abs=0.5)
+    assert late["ny"].mean() == pytest.approx(1.08, abs=0.01)
+    assert late["nx"].mean() == pytest.approx(0.03, abs=0.005)
+
+
+def test_throttle_event_disengages_the_nx_loop():
+    df = run_scenario({**BASE, "duration_s": 6, "events": [{"t_s": 1, "throttle": 0.3}]}).df
+    assert df["throttle"].iloc[-1] == pytest.approx(0.3, abs=1e-6)
+    assert math.isnan(df["cmd_nx"].iloc[-1])
+
+
+def test_same_seed_same_numbers_with_turbulence():
+    scn = {**BASE, "duration_s": 15, "hold": True, "turbulence": {"severity": "moderate"}}
+    a = run_scenario(scn, seed=3).df
+    b = run_scenario(scn, seed=3).df
+    c = run_scenario(scn, seed=4).df
+    pd.testing.assert_frame_equal(a, b)
+    assert not np.allclose(a["alt_m"], c["alt_m"])
+
+
+@pytest.mark.parametrize("events, aircraft, reason", [
+    ([{"t_s": 1, "throttle": 0.0}, {"t_s": 1, "ny": 1.15}], "c172p", "stall"),
+    ([{"t_s": 1, "throttle": 1.0}, {"t_s": 1, "ny": 0.6}], "737", "overspeed"),
+])
+def test_divergence_ends_with_status_and_reason(tmp_path, events, aircraft, reason):
+    ini = {"alt_m": 3000, "tas_mps": 111.1} if aircraft == "737" else {"alt_m": 1500, "tas_mps": 50}
+    res = run_scenario({"aircraft": aircraft, "initial": ini, "duration_s": 300, "events": events},
+                       out_dir=tmp_path / "d")
+    assert res.summary["status"] == "diverged"
+    assert reason in res.summary["reason"]
+    assert res.summary["duration_s"] < 300
+    assert (tmp_path / "d" / "time_histories.png").exists()
+
+
+def test_ground_contact_is_a_divergence():
+    res = run_scenario({"aircraft": "c172p", "initial": {"alt_m": 60, "tas_mps": 50},
+                        "duration_s": 120, "events": [{"t_s": 1, "ny": 0.9}]})
+    assert res.summary["status"] == "diverged" and "ground" in res.summary["reason"]
+
+
+def test_cas_target_converted_with_altitude():
+    scn = {**BASE, "duration_s": 5, "hold": True, "events": [{"t_s": 1, "cas_kt": 200}]}
+    df = run_scenario(scn).df
+    from fms_testbed.atmosphere import cas_to_tas
+    last = df.iloc[-1]
+    assert last["cmd_tas_mps"] == pytest.approx(float(cas_to_tas(200 * 0.514444, last["alt_m"])), rel=1e-4)
