@@ -126,7 +126,8 @@ class Fix:
     airport: str = ""
     dme_lat_deg: float | None = None
     dme_lon_deg: float | None = None
-    bearing_deg: float | None = None   # runway: magnetic bearing; localizer: course (true if 'T')
+    bearing_deg: float | None = None   # runway: magnetic bearing, deg
+    length_m: float | None = None      # runway: length, m
     line: int = 0
 
 
@@ -176,11 +177,13 @@ def parse_airport(rec: str, line: int) -> Fix:
 def parse_runway(rec: str, line: int) -> Fix:
     """Runway threshold (PG): bearing (magnetic, tenths) at 28, threshold elevation at 67."""
     brg = _int(rec, 28, 31, "runway bearing")
+    length = _int(rec, 23, 27, "runway length")
     elev = _int(rec, 67, 71, "threshold elevation", signed=True)
     return Fix(ident=_f(rec, 14, 18), region=_f(rec, 11, 12), section="PG",
                lat_deg=parse_lat(rec, 33), lon_deg=parse_lon(rec, 42),
                elev_m=None if elev is None else elev * FT_M, airport=_f(rec, 7, 10),
-               bearing_deg=None if brg is None else brg / 10.0, line=line)
+               bearing_deg=None if brg is None else brg / 10.0,
+               length_m=None if length is None else length * FT_M, line=line)
 
 
 def parse_localizer(rec: str, line: int) -> Fix:

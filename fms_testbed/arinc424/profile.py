@@ -1,0 +1,150 @@
+"""Planned vertical profile from the coded altitude constraints and climb/descent gradients.
+
+Nodes are the path start and every leg end (distance along the built path, m). Climb phases
+(SIDs, missed approaches) climb at the aircraft's gradient and level off below every 'at or
+below' constraint ahead; descent phases are planned backwards from the last constrained fix at
+the coded vertical angle (else 3°), clamped into each fix's altitude window. One geometry feeds
+both: the distances come from the same segments the map and guidance use.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from .model import ProcedurePath
+
+
+@dataclass(frozen=True, slots=True)
+class AltitudeWindow:
+    """Altitude constraint at a leg end: lo_m ≤ alt ≤ hi_m (None = unbounded), m."""
+
+    leg_index: int
+    fix_ident: str
+    along_m: float
+    desc: str
+    lo_m: float | None
+    hi_m: float | None
+
+
+@dataclass(frozen=True)
+class VerticalProfile:
+    """Planned altitude along the path.
+
+    along_m, alt_m: node distances from the path start (m) and planned altitudes (m);
+    climb: per node, True where the segment ending at that node is a climb phase;
+    windows: the coded constraints.
+    """
+
+    along_m: np.ndarray
+    alt_m: np.ndarray
+    climb: np.ndarray
+    windows: tuple[AltitudeWindow, ...]
+
+    def alt_at(self, s_m: float | np.ndarray) -> float | np.ndarray:
+        """Planned altitude at distance ``s_m`` (m) along the path, m."""
+        return np.interp(s_m, self.along_m, self.alt_m)
+
+    def gradients(self) -> np.ndarray:
+        """Rise over run of each node-to-node piece (dimensionless; NaN for zero length)."""
+        ds = np.diff(self.along_m)
+        dh = np.diff(self.alt_m)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(ds > 1.0, dh / ds, np.nan)
+
+
+def window(desc: str, alt1_m: float | None, alt2_m: float | None
+           ) -> tuple[float | None, float | None]:
+    """(lo_m, hi_m) from an ARINC-424 altitude descriptor (column 83) and its two altitudes."""
+    if alt1_m is None:
+        return None, None
+    if desc in ("+", "H", "J", "V"):
+        return alt1_m, None
+    if desc in ("-", "Y"):
+        return None, alt1_m
+    if desc == "B" and alt2_m is not None:
+        return min(alt1_m, alt2_m), max(alt1_m, alt2_m)
+    if desc == "C" and alt2_m is not None:
+        return alt2_m, None
+    return alt1_m, alt1_m  # '', '@', 'X', 'G', 'I': at
+
+
+def leg_end_distances(path: ProcedurePath) -> np.ndarray:
+    """Distance along the path (m) at the end of each built leg."""
+    ends = np.zeros(len(path.legs))
+    s = 0.0
+    per_leg: dict[int, float] = {}
+    for seg in path.segments:
+        s += seg.geom.length_m()
+        per_leg[seg.leg_index] = s
+    last = 0.0
+    for k, lg in enumerate(path.legs):
+        last = per_leg.get(lg.index, last)
+        ends[k] = last
+    return ends
+
+
+def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
+                 descent_angle_deg: float = 3.0) -> VerticalProfile:
+    """Plan the vertical profile of a built path.
+
+    Parameters
+    ----------
+    path : the built procedure transition
+    climb_gradient : planned climb gradient (rise over run) for climb phases
+    start_alt_m : altitude at the path start, m
+    descent_angle_deg : default descent path angle where no vertical angle is coded, deg
+    """
+    n = len(path.legs)
+    ends = leg_end_distances(path)
+    windows = []
+    climb = np.zeros(n + 1, dtype=bool)
+    climbing = path.proc_type == "D"
+    for k, lg in enumerate(path.legs):
+        r = lg.record
+        if r.missed_approach_start:
+            climbing = True
+        climb[k + 1] = climbing
+        lo, hi = window(r.alt_desc, r.alt1_m, r.alt2_m)
+        if lo is not None or hi is not None:
+            windows.append(AltitudeWindow(k, r.fix.ident if r.fix else "", ends[k], r.alt_desc,
+                                          lo, hi))
+    along = np.concatenate(([0.0], ends))
+    alt = np.full(n + 1, start_alt_m)
+    lo_at = [None] * (n + 1)
+    hi_at = [None] * (n + 1)
+    for w in windows:
+        lo_at[w.leg_index + 1], hi_at[w.leg_index + 1] = w.lo_m, w.hi_m
+    # descent: backward pass from the last descent node, then clamp into windows
+    desc_idx = [k for k in range(1, n + 1) if not climb[k]]
+    if desc_idx:
+        last = desc_idx[-1]
+        h = next((lo_at[k] if lo_at[k] is not None else hi_at[k]
+                  for k in reversed(desc_idx) if lo_at[k] is not None or hi_at[k] is not None),
+                 start_alt_m)
+        alt[last] = h
+        for k in range(last - 1, -1, -1):
+            ang = descent_angle_deg
+            vpa = path.legs[k].record.vpa_deg if k < n else None
+            if vpa:
+                ang = abs(vpa)
+            h = alt[k + 1] + math.tan(math.radians(ang)) * (along[k + 1] - along[k])
+            if hi_at[k] is not None:
+                h = min(h, hi_at[k])
+            if lo_at[k] is not None:
+                h = max(h, lo_at[k])
+            alt[k] = h if k > 0 else min(h, max(start_alt_m, alt[1]))
+    # climb: forward pass, capped by every 'at or below' ahead
+    cap = np.full(n + 1, np.inf)
+    run = np.inf
+    for k in range(n, -1, -1):
+        if hi_at[k] is not None and climb[k]:
+            run = min(run, hi_at[k])
+        cap[k] = run
+    for k in range(1, n + 1):
+        if climb[k]:
+            base = alt[k - 1]
+            alt[k] = min(base + climb_gradient * (along[k] - along[k - 1]), max(cap[k], base))
+    return VerticalProfile(along, alt, climb, tuple(windows))

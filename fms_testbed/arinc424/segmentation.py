@@ -1,0 +1,298 @@
+"""Segmentation of a procedure transition into geodesic lines and circular arcs.
+
+:func:`build_sequence` resolves the legs, chooses the start (departure end of the runway for a
+SID runway transition, else the first fix), runs each leg's class, then rounds every fly-by
+corner with an arc of radius R = V²/(g tan γ) and turn anticipation L = R tan(Ω/2) (Danilin 2017,
+Fig. 2). When the lead does not fit between the neighbouring fixes the paper's monitor
+corrections apply in order (R; V,γ; V,γ,φ,λ) with the formulas
+
+    R_geom = L_avail / tan(Ω/2)
+    γ_reg  = atan(V² / (R_geom g))      (when ≤ γ_max: branch R, V kept)
+    V_reg  = sqrt(R_geom g tan γ_max)   (branch V,γ, when V_reg ≥ V_min)
+
+and, failing both, the turn is flown over the fix and rejoins (branch V,γ,φ,λ).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from ..path.geodesy import direct, gravity_mps2, wrap180, wrap360
+from ..path.segments import Arc, Line
+from .builder import LegBuilder, ResolvedLeg
+from .construct import direct_to_arc, turn_arc
+from .database import Database, Sequence
+from .legs import LEG_TYPES, LegError
+from .model import (BuildParams, BuiltLeg, Finding, FlightState, Performance, PathSegment,
+                    ProcedurePath, isa_tas_mps, turn_radius_m)
+
+FT_M = 0.3048
+#: Leg types that end at their fix (the next TF starts from that fix).
+FIX_ENDING = frozenset({"IF", "TF", "CF", "DF", "RF", "AF", "HF", "HA", "HM"})
+
+
+def resolve_legs(db: Database, seq: Sequence) -> tuple[list[ResolvedLeg], list[Finding]]:
+    """Look up the fixes of each leg and turn magnetic courses true."""
+    apt = db.airports.get(seq.airport)
+    apt_var = apt.magvar_deg if apt else 0.0
+    out, findings = [], []
+    for i, rec in enumerate(seq.legs):
+        fix = db.find_fix(rec.fix, seq.airport)
+        nav = db.find_fix(rec.navaid, seq.airport)
+        ctr = db.find_fix(rec.centre, seq.airport)
+        for ref, got in ((rec.fix, fix), (rec.navaid, nav), (rec.centre, ctr)):
+            if ref is not None and got is None:
+                findings.append(Finding(i, "impossible",
+                                        f"fix {ref.ident} ({ref.region} {ref.section}) not in "
+                                        f"the database (line {rec.line})"))
+        var = nav.magvar_deg if nav is not None and nav.section in ("D ", "PI") else apt_var
+        crs = None
+        if rec.course_deg is not None:
+            crs = wrap360(rec.course_deg + (0.0 if rec.course_true else var))
+        out.append(ResolvedLeg(rec, fix, nav, ctr, crs, var))
+    return out, findings
+
+
+def _runway(db: Database, airport: str, transition: str):
+    cands = db.terminal.get((airport, transition), [])
+    for f in cands:
+        if f.section == "PG":
+            return f
+    if transition.startswith("RW") and transition.endswith("B"):
+        for suffix in ("L", "R", "C"):
+            for f in db.terminal.get((airport, transition[:-1] + suffix), []):
+                if f.section == "PG":
+                    return f
+    return None
+
+
+def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightState:
+    """Planned start: a SID runway transition starts at the departure end of the runway
+    (threshold + length along the runway's true bearing, 35 ft above the threshold); other
+    transitions start at their first fix (STAR/approach altitude: the first coded altitude, else
+    airport elevation + 10,000 ft / 3,000 ft); a SID without either starts over the airport."""
+    apt = db.airports.get(seq.airport)
+    elev = (apt.elev_m if apt and apt.elev_m is not None else 0.0)
+    first = legs[0]
+    if seq.proc_type == "D":
+        rwy = _runway(db, seq.airport, seq.transition) if seq.transition.startswith("RW") else None
+        if rwy is not None and first.pt != "IF":
+            brg = wrap360((rwy.bearing_deg or 0.0) + (apt.magvar_deg if apt else 0.0))
+            lat, lon, az = direct(rwy.lat_deg, rwy.lon_deg, brg, rwy.length_m or 0.0)
+            alt = (rwy.elev_m if rwy.elev_m is not None else elev) + 35 * FT_M
+            return FlightState(lat, lon, wrap360(az), alt)
+        alt = elev + 35 * FT_M
+    else:
+        alt = next((lg.rec.alt1_m for lg in legs if lg.rec.alt1_m is not None), None)
+        if alt is None:
+            alt = elev + (10000 if seq.proc_type == "E" else 3000) * FT_M
+    if first.fix is not None:
+        return FlightState(first.fix.lat_deg, first.fix.lon_deg, None, alt,
+                           fix_ident=first.fix.ident)
+    if apt is not None:
+        return FlightState(apt.lat_deg, apt.lon_deg, first.course_true_deg, alt)
+    raise LegError(f"{seq.name}: no runway, fix or airport to start from")
+
+
+def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float) -> float:
+    """Planned TAS: the aircraft's planned TAS capped by an 'at' or 'at or below' speed limit
+    (coded as IAS, turned to TAS in the ISA), m/s."""
+    v = perf.tas_plan_mps
+    lim = leg.rec.speed_limit_mps
+    if lim is not None and leg.rec.speed_desc in ("", "-", "@"):
+        v = min(v, isa_tas_mps(lim, alt_m))
+    return v
+
+
+def build_sequence(db: Database, seq: Sequence, perf: Performance,
+                   params: BuildParams | None = None, start: FlightState | None = None
+                   ) -> ProcedurePath:
+    """Build one procedure transition into a :class:`ProcedurePath` (segments + legs).
+
+    Parameters
+    ----------
+    db : the database the sequence comes from (fix look-ups)
+    seq : the procedure transition
+    perf : aircraft performance (planned TAS, climb gradient, bank limit)
+    params : build settings; defaults :class:`BuildParams`
+    start : planned start state (position deg, track deg true, altitude m); default
+        :func:`start_state`. Guidance uses this to rebuild from the aircraft's actual state.
+
+    Returns
+    -------
+    ProcedurePath with findings from the builder and the fly-by corrections; the vertical
+    profile and monitor outcome are added by :func:`fms_testbed.arinc424.monitor.check_path`.
+    """
+    params = params or BuildParams()
+    legs, findings = resolve_legs(db, seq)
+    path = ProcedurePath(seq.name, seq.airport, seq.proc_type, seq.proc_id, seq.transition,
+                         (), (), tuple(findings), status="impossible")
+    if any(f.category == "impossible" for f in findings):
+        return path
+    try:
+        state = start or start_state(db, seq, legs)
+        kind = "given" if start else _start_kind(db, seq, legs, state)
+    except LegError as exc:
+        return replace(path, findings=path.findings + (Finding(-1, "impossible", str(exc)),))
+    ref = legs[0].fix or db.airports.get(seq.airport)
+    g = gravity_mps2(ref.lat_deg if ref else state.lat_deg)
+    prev_fixes = [None] + [lg.fix if lg.pt in FIX_ENDING else None for lg in legs[:-1]]
+    b = LegBuilder(legs, perf, params, g, prev_fixes)
+    b.climbing = seq.proc_type == "D"
+    bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
+    built: list[BuiltLeg] = []
+    for i, leg in enumerate(legs):
+        b.i = i
+        if leg.rec.missed_approach_start:
+            b.climbing = True
+        b.speed_mps = planned_speed_mps(perf, leg, state.alt_m)
+        b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
+        b.radius_m = turn_radius_m(b.speed_mps, bank, g)
+        start_st = state
+        try:
+            state, term = LEG_TYPES[leg.pt].build(b, state)
+        except LegError as exc:
+            b.finding("impossible", f"leg {i + 1} {leg.pt}: {exc} (line {leg.rec.line})")
+            break
+        if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
+            state = replace(state, alt_m=_descent_target(leg))
+        built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps))
+    segs = round_corners(b, perf, params, bank)
+    built = _attach_segments(built, segs)
+    status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
+    return replace(path, legs=tuple(built), segments=tuple(segs),
+                   findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
+
+
+def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
+    if st.track_deg is not None and seq.proc_type == "D" and legs[0].pt != "IF" \
+            and seq.transition.startswith("RW") and _runway(db, seq.airport, seq.transition):
+        return "runway"
+    return "fix" if legs[0].fix is not None else "airport"
+
+
+def _descent_target(leg: ResolvedLeg) -> float:
+    r = leg.rec
+    if r.alt_desc == "B" and r.alt2_m is not None:
+        return 0.5 * (r.alt1_m + r.alt2_m)
+    return r.alt1_m
+
+
+def _attach_segments(built: list[BuiltLeg], segs: list[PathSegment]) -> list[BuiltLeg]:
+    first: dict[int, int] = {}
+    count: dict[int, int] = {}
+    for k, s in enumerate(segs):
+        first.setdefault(s.leg_index, k)
+        count[s.leg_index] = count.get(s.leg_index, 0) + 1
+    return [replace(lg, seg_first=first.get(lg.index, first.get(lg.index - 1, 0)),
+                    seg_count=count.get(lg.index, 0)) for lg in built]
+
+
+def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_deg: float
+                  ) -> list[PathSegment]:
+    """Replace every sharp fly-by corner by a tangent arc (with the monitor's corrections)."""
+    segs = b.segments
+    out: list[PathSegment] = []
+    trim_prev = 0.0
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    for k, seg in enumerate(segs):
+        if k not in b.corners or not out or not isinstance(seg.geom, Line) \
+                or not isinstance(out[-1].geom, Line):
+            out.append(seg)
+            trim_prev = 0.0
+            continue
+        a = out[-1]
+        omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
+        if abs(omega) < 0.5:
+            out.append(seg)
+            trim_prev = 0.0
+            continue
+        v = min(a.speed_mps, seg.speed_mps)
+        r = turn_radius_m(v, bank_deg, b.g)
+        t = math.tan(math.radians(abs(omega)) / 2.0)
+        avail_a = a.geom.length_m() - trim_prev
+        avail_c = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
+        l_avail = max(min(avail_a, avail_c), 0.0)
+        bank = bank_deg
+        fix = a.fix_ident or seg.fix_ident
+        if r * t > l_avail:
+            r_geom = l_avail / t
+            b.i = a.leg_index
+            if r_geom <= 1.0:
+                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v, gmax, b.g)))
+                trim_prev = 0.0
+                continue
+            g_reg = math.degrees(math.atan(v * v / (r_geom * b.g)))
+            if g_reg <= gmax:
+                b.finding("correction", f"fly-by at {fix}: radius {r:.0f} -> {r_geom:.0f} m, "
+                          f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°)", "R")
+                r, bank = r_geom, g_reg
+            else:
+                v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax)))
+                if v_reg >= perf.tas_min_mps:
+                    b.finding("correction", f"fly-by at {fix}: speed {v / 0.514444:.0f} -> "
+                              f"{v_reg / 0.514444:.0f} kt, bank {gmax:.0f}°, radius "
+                              f"{r_geom:.0f} m (turn {omega:+.0f}°)", "V,γ")
+                    r, bank, v = r_geom, gmax, v_reg
+                else:
+                    out.extend(_flyover(b, a, seg, omega, turn_radius_m(
+                        perf.tas_min_mps, gmax, b.g)))
+                    trim_prev = 0.0
+                    continue
+        lead = r * t
+        la = a.geom.length_m()
+        t1 = a.geom.point_at(la - lead)
+        crs1 = a.geom.course_at(la - lead)
+        arc = turn_arc(t1[0], t1[1], crs1, omega, r)
+        new_a = Line(a.geom.start_lat_deg, a.geom.start_lon_deg, *arc.start)
+        out[-1] = replace(a, geom=new_a)
+        if new_a.length_m() < 0.01:
+            out.pop()
+        out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "flyby", v, bank))
+        t2 = seg.geom.point_at(lead)
+        # end the arc exactly where the next line resumes
+        fixed = _retarget_arc(arc, t2)
+        out[-1] = replace(out[-1], geom=fixed)
+        out.append(replace(seg, geom=Line(*fixed.end, seg.geom.end_lat_deg,
+                                          seg.geom.end_lon_deg)))
+        trim_prev = 0.0
+    return out
+
+
+def _retarget_arc(arc: Arc, pt: tuple[float, float]) -> Arc:
+    from ..path.geodesy import inverse
+    _, az, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, pt[0], pt[1])
+    if arc.sweep_deg >= 0:
+        sweep = wrap360(az - arc.start_radial_deg)
+        if sweep > 359.0:
+            sweep -= 360.0
+    else:
+        sweep = -wrap360(arc.start_radial_deg - az)
+        if sweep < -359.0:
+            sweep += 360.0
+    if abs(sweep - arc.sweep_deg) > 5.0:
+        return arc
+    return Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, arc.start_radial_deg, sweep)
+
+
+def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: float
+             ) -> list[PathSegment]:
+    """Branch V,γ,φ,λ: the turn cannot be cut inside the fixes; fly over the corner, turn at
+    the lowest speed and maximum bank, then go direct to the end of the next line."""
+    b.finding("correction", f"fly-by at {a.fix_ident or seg.fix_ident} (turn {omega:+.0f}°) "
+              f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
+              "V,γ,φ,λ")
+    lat, lon = a.geom.end
+    end = seg.geom.end
+    arc, ok = direct_to_arc(lat, lon, a.geom.end_course_deg, end[0], end[1],
+                            "R" if omega > 0 else "L", r)
+    out = []
+    if ok and arc is not None:
+        out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "turn",
+                               seg.speed_mps, 0.0))
+        start = arc.end
+    else:
+        start = (lat, lon)
+    out.append(replace(seg, geom=Line(*start, *end)))
+    return out  # 'a' is already in the caller's output list
