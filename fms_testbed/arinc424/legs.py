@@ -271,14 +271,15 @@ def _intercept(b: LegBuilder, s: FlightState, course: float) -> tuple[FlightStat
     return s, Termination("intercept", s.lat_deg, s.lon_deg, next_leg=b.i + 1)
 
 
-def _from_fix(b: LegBuilder, s: FlightState) -> tuple[FlightState, float]:
+def _from_fix(b: LegBuilder, s: FlightState, direction: str | None = "coded"
+              ) -> tuple[FlightState, float]:
     f, c = _fix(b), _course(b)
     if s.track_deg is None:
         s = replace(b.fix_state(s, f), track_deg=c)
     elif inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[0] > 1.0:
         s = b.direct_to(s, f, None, not b.leg.rec.fly_over)
         s = b.fix_state(s, f)
-    return b.start_course(s, c, b.turn_dir()), c
+    return b.start_course(s, c, b.turn_dir() if direction == "coded" else direction), c
 
 
 class _CourseLeg(Leg):
@@ -522,8 +523,7 @@ class PI(Leg):
 
     @classmethod
     def build(cls, b, s):
-        f, c = _fix(b), _course(b)
-        s, c = _from_fix(b, s)
+        s, c = _from_fix(b, s, None)  # the coded direction is the procedure turn's
         d = b.turn_dir() or "L"
         sign = 1.0 if d == "R" else -1.0
         limit = b.leg.rec.distance_m or 10 * 1852.0

@@ -149,6 +149,10 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
             continue
         if path.legs[w.leg_index].path_term in ("HA", "HF", "HM", "CA", "FA", "VA"):
             continue  # altitude-terminated or reached in the hold: met by construction
+        nxt = path.legs[w.leg_index + 1] if w.leg_index + 1 < len(path.legs) else None
+        if nxt is not None and nxt.path_term in ("HA", "HF", "HM") and nxt.record.fix \
+                and nxt.record.fix.ident == w.fix_ident:
+            continue  # climb in the hold that follows at the same fix
         # find the last node where the climb was free to start from
         j = k - 1
         ds = prof.along_m[k] - prof.along_m[j]
@@ -171,8 +175,8 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                                f"{v / KT:.0f} -> {vv / KT:.0f} kt", "V,Θ"))
         else:
             out.append(Finding(w.leg_index, "impossible", f"{w.fix_ident} at or above "
-                               f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.1f}% climb, aircraft "
-                               f"max {100 * perf.climb_gradient_at(perf.tas_min_mps):.1f}% at "
+                               f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.2f}% climb, aircraft "
+                               f"max {100 * perf.climb_gradient_at(perf.tas_min_mps):.2f}% at "
                                "minimum speed"))
     grads = prof.gradients()
     for k in range(1, len(prof.alt_m)):

@@ -1,0 +1,94 @@
+"""Plot a built procedure transition like Danilin (2017), Fig. 2: legs labelled with their path
+terminator codes, arcs visible with their centres, fixes marked. Plotting never computes the
+path; it only draws the segments it is given, in an azimuthal-equidistant plane (NM) about the
+first fix."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from ..path.geodesy import LocalFrame  # noqa: E402
+from ..path.segments import Arc  # noqa: E402
+from .model import ProcedurePath  # noqa: E402
+
+NM_M = 1852.0
+_STYLE = {"leg": ("tab:blue", "-"), "turn": ("tab:orange", "-"), "flyby": ("tab:red", "-"),
+          "hold": ("tab:purple", "-"), "connector": ("grey", ":")}
+
+
+def _xy(fr: LocalFrame, lat: float, lon: float) -> tuple[float, float]:
+    x, y = fr.to_xy(lat, lon)
+    return x / NM_M, y / NM_M
+
+
+def plot_path(path: ProcedurePath, out_file: str | Path) -> Path:
+    """Draw the path to a PNG; return its path."""
+    if not path.segments:
+        raise ValueError(f"{path.name}: nothing to plot (no segments)")
+    lat0, lon0 = path.segments[0].geom.start
+    fr = LocalFrame(lat0, lon0)
+    fig, ax = plt.subplots(figsize=(9, 8))
+    used = set()
+    for seg in path.segments:
+        g = seg.geom
+        n = max(2, int(abs(g.sweep_deg) / 3) + 2) if isinstance(g, Arc) else 2
+        pts = [g.point_at(g.length_m() * k / (n - 1)) for k in range(n)]
+        xs, ys = zip(*(_xy(fr, *p) for p in pts))
+        colour, ls = _STYLE.get(seg.role, ("black", "-"))
+        label = None
+        kind = f"{seg.role} {'arc' if isinstance(g, Arc) else 'line'}"
+        if kind not in used:
+            used.add(kind)
+            label = kind
+        ax.plot(xs, ys, color=colour, ls=ls, lw=2 if seg.role == "leg" else 1.5, label=label)
+        if isinstance(g, Arc) and seg.role == "leg":
+            cx, cy = _xy(fr, *g.centre)
+            ax.plot(cx, cy, "+", color="tab:green", ms=9,
+                    label=None if "arc centre" in used else "arc centre")
+            used.add("arc centre")
+    # leg codes at the middle of each leg's own path
+    for lg in path.legs:
+        segs = [s for s in path.segments if s.leg_index == lg.index and s.role != "flyby"]
+        if not segs:
+            continue
+        mid = max(segs, key=lambda s: s.geom.length_m())
+        x, y = _xy(fr, *mid.geom.point_at(0.5 * mid.geom.length_m()))
+        ax.annotate(f"{lg.index + 1}:{lg.path_term}", (x, y), fontsize=8, color="navy",
+                    xytext=(4, 4), textcoords="offset points",
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="navy", alpha=0.7))
+    marked = set()
+    for lg in path.legs:
+        f = lg.record.fix
+        t = lg.termination
+        if f is None or t.lat_deg is None or f.ident in marked or t.kind not in (
+                "fix", "circuit", "manual", "altitude") or not t.fix_ident and t.kind != "fix":
+            continue
+        marked.add(f.ident)
+        x, y = _xy(fr, t.lat_deg, t.lon_deg)
+        fo = lg.record.fly_over
+        ax.plot(x, y, marker="^" if not fo else "o", color="k", mfc="none" if fo else "k",
+                ms=7, ls="none",
+                label=None if ("fly-over fix" if fo else "fly-by fix") in used
+                else ("fly-over fix" if fo else "fly-by fix"))
+        used.add("fly-over fix" if fo else "fly-by fix")
+        ax.annotate(f.ident, (x, y), fontsize=8, xytext=(5, -10), textcoords="offset points")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    first = path.legs[0].record.fix if path.legs else None
+    origin = first.ident if first is not None and path.legs[0].path_term == "IF" else "start"
+    ax.set_xlabel(f"east of {origin} [NM]")
+    ax.set_ylabel("north [NM]")
+    ax.set_title(f"{path.name} — {path.status}\n"
+                 + " ".join(f"{lg.path_term}" for lg in path.legs), fontsize=10)
+    ax.legend(loc="best", fontsize=8)
+    out = Path(out_file)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+    return out
