@@ -1,0 +1,208 @@
+"""SINS error-model speed figures (issue 5 goals), each a ratio or a time measured in this run.
+
+1. Discretisation of the 33-state model at Δt = 0.1 s, tol 1e-12: adaptive Picard (numba, dense and
+   block-structured) vs scipy Van Loan (66×66 expm) — goal: Picard ≥ 2× faster. Calls are
+   interleaved in rounds; the median round is reported.
+2. Monte-Carlo: N realisations over a straight-and-level trajectory at 10 Hz on one core
+   (OpenBLAS limited to one thread) — goal: 1000 × 1 h ≤ 30 s.
+3. Navigation step (F + Picard + factor + propagation + solution) vs 12 bare JSBSim steps
+   (one 10 Hz navigation period at 120 Hz) — budget ≈ 70 µs.
+4. Closed loop with SINS injection: JSBSim frames per wall second of a scenario with
+   ``navigation: {source: sins}`` over the bare JSBSim rate — goal ≥ 0.5.
+
+    python bench/bench_sins.py [--mc-duration-s 3600] [-n 1000] [--sim-s 300] [--skip-jsbsim]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import statistics
+import time
+
+import numpy as np
+
+from fms_testbed.sins.analysis import SinsOptions, montecarlo_run, system_matrix
+from fms_testbed.sins.discretize import discretize, discretize_sins, picard_order_used
+from fms_testbed.sins.presets import load_imu
+from fms_testbed.sins.trajectory import straight_level
+
+
+def _flight_F(imu):
+    return system_matrix(0.82, 3000.0, np.array([150.0, 100.0, 5.0]), np.array([0.3, 0.05, 1.0]),
+                         np.array([0.01, -0.02, 0.05]), np.array([0.5, 0.3, -10.2]), imu,
+                         SinsOptions(vertical="free"))
+
+
+def _per_call_us(fn, n):
+    t0 = time.perf_counter()
+    for _ in range(n):
+        fn()
+    return (time.perf_counter() - t0) / n * 1e6
+
+
+def bench_discretisation(imu, rounds: int = 7, n: int = 300) -> dict:
+    """Median µs per call of each method, interleaved rounds, plus accuracy against Van Loan."""
+    from fms_testbed.sins._blas import single_thread_blas
+
+    F = _flight_F(imu)
+    q = imu.q_psd
+    Q = np.diag(q)
+    fns = {"vanloan": lambda: discretize(F, Q, 0.1, method="vanloan"),
+           "picard": lambda: discretize(F, Q, 0.1, method="picard"),
+           "picard_structured": lambda: discretize_sins(F, q, 0.1)}
+    times = {k: [] for k in fns}
+    with single_thread_blas():
+        for f in fns.values():
+            f()
+        for _ in range(rounds):
+            for k, f in fns.items():
+                times[k].append(_per_call_us(f, n))
+    med = {k: statistics.median(v) for k, v in times.items()}
+    pv, qv = discretize(F, Q, 0.1, method="vanloan")
+    pp, qp = discretize(F, Q, 0.1)
+    return {**med, "order": picard_order_used(F, Q, 0.1),
+            "phi_rel": float(np.abs(pp - pv).max() / np.abs(pv).max()),
+            "qk_rel": float(np.abs(qp - qv).max() / np.abs(qv).max())}
+
+
+def bench_montecarlo(imu, n_real: int, duration_s: float) -> dict:
+    traj = straight_level(duration_s, 0.1, speed_mps=200.0, heading_deg=45.0)
+    montecarlo_run(straight_level(2.0, 0.1), imu, 10, seed=0)              # compile
+    t0 = time.perf_counter()
+    res = montecarlo_run(traj, imu, n_real, seed=0)
+    wall = time.perf_counter() - t0
+    return {"wall_s": wall, "steps": len(traj) - 1, "h95_end_m": float(res.h95_m[-1])}
+
+
+def _bare_fdm_trimmed():
+    from fms_testbed.aircraft import load_aircraft
+    from fms_testbed.jsbsim_core import FT, KT, bare_fdm
+
+    cfg = load_aircraft("737")
+    fdm = bare_fdm(cfg.jsbsim_model)
+    fdm["aero/alpha-max-rad"] = math.radians(cfg.trim.alpha_max_deg)
+    fdm["ic/h-sl-ft"] = 3000.0 / FT
+    fdm["ic/vt-kts"] = 120.0 / KT
+    fdm["ic/lat-geod-deg"] = 47.0
+    fdm["gear/gear-cmd-norm"] = 0
+    fdm.run_ic()
+    fdm["propulsion/set-running"] = -1
+    try:
+        fdm["simulation/do_simple_trim"] = 1
+    except Exception:  # the timing does not need a perfect trim
+        pass
+    return fdm
+
+
+def bench_nav_step(imu_name: str, with_jsbsim: bool, n: int = 3000) -> dict:
+    """µs per SinsNavigation.update (warm) and per 12 bare JSBSim steps."""
+    from fms_testbed.sins.navigation import SinsNavigation
+    from fms_testbed.state import AircraftState
+
+    tr = straight_level(n * 0.1 + 1, 0.1, speed_mps=200.0, heading_deg=30.0)
+    states = [AircraftState(
+        t_s=tr.t_s[k], lat_rad=tr.lat_rad[k], lon_rad=tr.lon_rad[k], alt_m=tr.alt_m[k],
+        tas_mps=200.0, cas_mps=170.0, gs_mps=200.0, vs_mps=0.0, v_enu_mps=tr.v_enu_mps[k],
+        roll_rad=0.0, pitch_rad=0.0, heading_rad=tr.rpy_rad[k, 2], track_rad=0.0, alpha_rad=0.0,
+        beta_rad=0.0, gamma_rad=0.0, p_rps=tr.w_eb_b_rps[k, 0], q_rps=tr.w_eb_b_rps[k, 1],
+        r_rps=tr.w_eb_b_rps[k, 2], nx=0.0, ny=1.0, f_body_mps2=tr.f_b_mps2[k], mach=0.6,
+        agl_m=3000.0, throttle=0.6, mass_kg=6e4) for k in range(n)]
+    out = {}
+    for method in ("picard", "vanloan"):
+        nav = SinsNavigation.from_spec({"source": "sins", "imu": imu_name, "method": method})
+        for s in states[:20]:
+            nav.update(s)
+        nav = SinsNavigation.from_spec({"source": "sins", "imu": imu_name, "method": method})
+        m = n if method == "picard" else n // 5
+        t0 = time.perf_counter()
+        for s in states[:m]:
+            nav.update(s)
+        out[f"nav_step_{method}_us"] = (time.perf_counter() - t0) / m * 1e6
+    if with_jsbsim:
+        fdm = _bare_fdm_trimmed()
+        run = fdm.run
+        k = 12 * n
+        t0 = time.perf_counter()
+        for _ in range(k):
+            run()
+        out["jsbsim_12_steps_us"] = (time.perf_counter() - t0) / n * 1e6
+    return out
+
+
+def bench_closed_loop(sim_s: float, imu_name: str) -> dict:
+    """JSBSim frames per wall second: bare, closed loop with truth nav, closed loop with SINS."""
+    from fms_testbed.jsbsim_core import DT_S
+    from fms_testbed.runner import run_scenario
+
+    def closed(nav):
+        scn = {"name": "bench-sins", "aircraft": "737", "duration_s": sim_s, "hold": True,
+               "initial": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 3000.0, "tas_mps": 120.0,
+                           "heading_deg": 90},
+               "events": [{"t_s": 10, "heading_deg": 180}, {"t_s": 60, "alt_m": 3300.0}]}
+        if nav:
+            scn["navigation"] = nav
+        t0 = time.perf_counter()
+        res = run_scenario(scn, progress=False)
+        wall = time.perf_counter() - t0
+        return res.summary["duration_s"] / DT_S / wall, res.summary.get("status")
+
+    fdm = _bare_fdm_trimmed()
+    n = int(sim_s / DT_S)
+    t0 = time.perf_counter()
+    for _ in range(n):
+        fdm.run()
+    bare = n / (time.perf_counter() - t0)
+    truth, st_t = closed(None)
+    sins, st_s = closed({"source": "sins", "imu": imu_name, "seed": 1, "method": "picard",
+                         "dt_s": 0.1})
+    return {"bare_fps": bare, "closed_truth_fps": truth, "closed_sins_fps": sins,
+            "status_truth": st_t, "status_sins": st_s}
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--imu", default="STIM300")
+    ap.add_argument("-n", type=int, default=1000, help="Monte-Carlo realisations")
+    ap.add_argument("--mc-duration-s", type=float, default=3600.0)
+    ap.add_argument("--sim-s", type=float, default=300.0, help="closed-loop simulated time, s")
+    ap.add_argument("--skip-jsbsim", action="store_true")
+    args = ap.parse_args()
+    imu = load_imu(args.imu)
+
+    d = bench_discretisation(imu)
+    print(f"[1] discretisation, 33 states, dt 0.1 s, tol 1e-12 ({d['order']} terms):")
+    print(f"    scipy Van Loan      {d['vanloan']:8.1f} us/call")
+    print(f"    Picard (dense)      {d['picard']:8.1f} us/call   ratio {d['vanloan'] / d['picard']:.1f}x")
+    print(f"    Picard (structured) {d['picard_structured']:8.1f} us/call   ratio "
+          f"{d['vanloan'] / d['picard_structured']:.1f}x   (goal >= 2x)")
+    print(f"    agreement with Van Loan: Phi {d['phi_rel']:.1e}, Q_k {d['qk_rel']:.1e} (max-abs rel)")
+
+    nav = bench_nav_step(args.imu, not args.skip_jsbsim)
+    print("[3] navigation step (F + Picard + factor + propagate + solution), warm:")
+    print(f"    SinsNavigation.update picard {nav['nav_step_picard_us']:.1f} us, "
+          f"vanloan {nav['nav_step_vanloan_us']:.1f} us")
+    if "jsbsim_12_steps_us" in nav:
+        print(f"    12 bare JSBSim 737 steps     {nav['jsbsim_12_steps_us']:.1f} us  -> nav step = "
+              f"{nav['nav_step_picard_us'] / nav['jsbsim_12_steps_us']:.2f} x one 10 Hz period "
+              "of bare JSBSim")
+
+    if not args.skip_jsbsim:
+        c = bench_closed_loop(args.sim_s, args.imu)
+        print(f"[4] closed loop, 737, {args.sim_s:g} s simulated, 120 Hz frames per wall second:")
+        print(f"    bare JSBSim {c['bare_fps']:.0f}, closed loop truth nav {c['closed_truth_fps']:.0f} "
+              f"({c['status_truth']}), closed loop SINS {c['closed_sins_fps']:.0f} "
+              f"({c['status_sins']})")
+        print(f"    ratio SINS closed loop / bare = {c['closed_sins_fps'] / c['bare_fps']:.2f} "
+              f"(goal >= 0.5); SINS / truth closed loop = "
+              f"{c['closed_sins_fps'] / c['closed_truth_fps']:.2f}")
+
+    m = bench_montecarlo(imu, args.n, args.mc_duration_s)
+    print(f"[2] Monte-Carlo {args.n} realisations x {args.mc_duration_s:g} s at 10 Hz "
+          f"({m['steps']} steps), one BLAS thread: {m['wall_s']:.1f} s (goal <= 30 s for 1000 x 1 h); "
+          f"95% horizontal error at the end {m['h95_end_m']:.0f} m")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
