@@ -9,7 +9,7 @@ of issue 3 are checked in :func:`check_goals`.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import pandas as pd
@@ -62,8 +62,12 @@ def pointmass_events(scn: Scenario) -> list[CommandEvent]:
 
 
 def ideal_response(scn: Scenario, params: CoupledLawParams) -> pd.DataFrame:
-    """The coupled law flown on the lag-free point-mass plant with the scenario's commands."""
+    """The coupled law flown on the lag-free point-mass plant with the scenario's commands.
+
+    The law's inner-loop model is lag-free too (``ny_model_tau_s = 0``), as the plant's loops are.
+    """
     pm = PointMassParams(nx_idle=-0.3, nx_max=0.5)
+    params = replace(params, ny_model_tau_s=0.0)
     return simulate(CoupledLaw(params=params), pm, scn.initial.altitude_m, initial_tas_mps(scn),
                     scn.duration_s, pointmass_events(scn))
 

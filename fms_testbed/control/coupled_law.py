@@ -62,6 +62,8 @@ class CoupledLawParams:
     use_measured_nx : use the measured n_xa in the damping term (n_xa - sin θ) = V'/g instead of
         the integrator's command; makes the law insensitive to n_x tracking error
     speed_protection : limit the flight path when the throttle is saturated
+    anti_windup : stop/back-calculate the n_xa integrator at throttle limits (off only to show
+        the wind-up it prevents)
     gamma_tau_s : time constant with which speed protection pulls θ to its limit, s
     ny_trim_tau_s : time constant of the n_y tracking-error integrator, s (0 = off). The
         altitude channel is static in n_y, so an inner-loop tracking error (lift change with speed,
@@ -85,6 +87,7 @@ class CoupledLawParams:
     form: str = "exact"
     use_measured_nx: bool = True
     speed_protection: bool = True
+    anti_windup: bool = True
     gamma_tau_s: float = 2.0
     ny_trim_tau_s: float = 2.0
     ny_model_tau_s: float = 0.5
@@ -132,7 +135,8 @@ class CoupledLawState:
     nxa_cmd: n_xa integrator (the tangential load-factor command), g
     engaged: whether :meth:`CoupledLaw.engage` has been called
     sat_hi, sat_lo: throttle at max / idle at the last update
-    protecting: speed protection limited n_ya at the last update
+    protect_mode: speed protection: +1 climb limited at max throttle, -1 descent limited at
+        idle, 0 off (latched until the altitude channel asks for less than the limit)
     dny: last Δn_ya = n_ya - 1 command, g
     ny_trim: n_y tracking-error integrator, g
     ny_model: the law's n_y command through the inner-loop model, g
@@ -142,7 +146,7 @@ class CoupledLawState:
     engaged: bool = False
     sat_hi: bool = False
     sat_lo: bool = False
-    protecting: bool = False
+    protect_mode: int = 0
     dny: float = 0.0
     ny_trim: float = 0.0
     ny_model: float = 1.0
@@ -236,36 +240,23 @@ def thrust_channel_rate(p: CoupledLawParams, dV_mps: float, tas_mps: float, gamm
     return cross - (2.0 * p.xi_V / p.T_V_s) * damp - dV_mps / (G_MPS2 * p.T_V_s ** 2)
 
 
-def speed_protection_ny(p: CoupledLawParams, ny: float, dV_mps: float, tas_mps: float,
-                        gamma_rad: float, nx_meas: float, sat_hi: bool, sat_lo: bool,
-                        g_ratio: float = 1.0) -> tuple[float, bool]:
-    """Limit n_ya so that the available thrust can hold the speed (throttle saturated).
+def speed_protection_limit(p: CoupledLawParams, side: int, dV_mps: float, tas_mps: float,
+                           gamma_rad: float, nx_meas: float, g_ratio: float = 1.0) -> float:
+    """n_ya limit (g) at which the available thrust still holds the speed (throttle at a limit).
 
     With the throttle at a limit, V' = g (n_x - sin θ) is set by θ alone. Demanding
     V' = -ΔV / τ with τ = T_V / (2 ξ_V) gives the flight-path limit
     ``sin θ_lim = n_x + ΔV / (g τ)``, bounded to θ_lim ≥ 0 at max throttle and θ_lim ≤ 0 at idle
-    (the protection gives up the climb or the descent, never trades altitude the other way);
-    n_ya is then limited to
-    ``cos θ + (V / g)(θ_lim - θ) / gamma_tau_s`` — a floor at idle (no overspeed in a descent),
-    a ceiling at max throttle (no speed decay in a climb).
-
-    Returns
-    -------
-    (n_ya, g; whether the limit was active)
+    (the protection gives up the climb or the descent, never trades altitude the other way).
+    The limit is ``cos θ + (V / g)(θ_lim - θ) / gamma_tau_s``: a ceiling at max throttle
+    (``side`` = +1, no speed decay in a climb), a floor at idle (``side`` = -1, no overspeed in
+    a descent).
     """
-    if not (p.speed_protection and (sat_hi or sat_lo)):
-        return ny, False
     tau = p.T_V_s / (2.0 * p.xi_V)
     s_lim = min(max((nx_meas + dV_mps / (G_MPS2 * tau)) / g_ratio, -0.5), 0.5)
-    # only give up the climb (max throttle) or the descent (idle): never dive for speed nor
-    # climb to shed it
-    s_lim = max(s_lim, 0.0) if sat_hi else min(s_lim, 0.0)
-    ny_lim = g_ratio * math.cos(gamma_rad) + (tas_mps / G_MPS2) * (math.asin(s_lim) - gamma_rad) / p.gamma_tau_s
-    if sat_lo and ny < ny_lim:
-        return ny_lim, True
-    if sat_hi and ny > ny_lim:
-        return ny_lim, True
-    return ny, False
+    s_lim = max(s_lim, 0.0) if side > 0 else min(s_lim, 0.0)
+    return g_ratio * math.cos(gamma_rad) + (tas_mps / G_MPS2) * (
+        math.asin(s_lim) - gamma_rad) / p.gamma_tau_s
 
 
 class CoupledLaw:
@@ -309,7 +300,7 @@ class CoupledLaw:
         """One outer-loop step: return ``(nx_cmd, ny_cmd)`` in g.
 
         Steps: saturation → altitude channel (eq. 7) → n_y limits → speed protection →
-        thrust channel (eq. 8) → anti-windup → integrate.
+        n_y tracking-error integrator → thrust channel (eq. 8) → anti-windup → integrate.
 
         Parameters
         ----------
@@ -333,8 +324,7 @@ class CoupledLaw:
 
         ny = altitude_channel_ny(p, dH_lim, V, gam, nxa, gr)
         ny = min(max(ny, p.ny_min), p.ny_max)
-        ny, st.protecting = speed_protection_ny(p, ny, dV, V, gam, nx_meas, st.sat_hi, st.sat_lo,
-                                                gr)
+        ny = self._protect(ny, dV, V, gam, nx_meas, gr)
         ny = min(max(ny, p.ny_min), p.ny_max)
 
         if p.ny_trim_tau_s > 0:
@@ -346,14 +336,48 @@ class CoupledLaw:
                 st.ny_trim += (st.ny_model - float(state.ny)) * dt_s / p.ny_trim_tau_s
                 st.ny_trim = min(max(st.ny_trim, -0.1), 0.1)
 
-        rate = thrust_channel_rate(p, dV, V, gam, nxa, ny, gr)
-        # anti-windup: no motion into an unachievable command; back-calculate to the measurement
-        if st.sat_hi:
-            rate = min(rate, 0.0)
-            st.nxa_cmd = min(st.nxa_cmd, nx_meas + 0.01)
-        if st.sat_lo:
-            rate = max(rate, 0.0)
-            st.nxa_cmd = max(st.nxa_cmd, nx_meas - 0.01)
-        st.nxa_cmd += rate * dt_s
+        if st.protect_mode:
+            # flight path holds the speed; keep the throttle at its limit
+            st.nxa_cmd = nx_meas + 0.02 * st.protect_mode
+        else:
+            rate = thrust_channel_rate(p, dV, V, gam, nxa, ny, gr)
+            # anti-windup: no motion into an unachievable command; back-calculate to the
+            # measurement
+            if st.sat_hi and p.anti_windup:
+                rate = min(rate, 0.0)
+                st.nxa_cmd = min(st.nxa_cmd, nx_meas + 0.01)
+            if st.sat_lo and p.anti_windup:
+                rate = max(rate, 0.0)
+                st.nxa_cmd = max(st.nxa_cmd, nx_meas - 0.01)
+            st.nxa_cmd += rate * dt_s
         st.dny = ny - 1.0
         return st.nxa_cmd, ny
+
+    def _protect(self, ny: float, dV: float, V: float, gam: float, nx_meas: float,
+                 gr: float) -> float:
+        """Speed protection with a latch (see :func:`speed_protection_limit`).
+
+        Enters when the throttle is at a limit, the speed is on the losing side (below target at
+        max throttle, above at idle) and the altitude channel asks for more climb (descent) than
+        the thrust can fly at constant speed (by 0.005 g); leaves when the altitude channel's
+        own demand falls back inside the limit by 0.005 g (e.g. the capture of the target
+        altitude) or the speed error changes sign.
+        """
+        p, st = self.params, self.state
+        if not p.speed_protection:
+            st.protect_mode = 0
+            return ny
+        if st.protect_mode == 0:
+            side = 1 if st.sat_hi else -1 if st.sat_lo else 0
+            if side:
+                lim = speed_protection_limit(p, side, dV, V, gam, nx_meas, gr)
+                if (ny - lim) * side > 0.005 and dV * side < 0:
+                    st.protect_mode = side
+        if st.protect_mode:
+            side = st.protect_mode
+            lim = speed_protection_limit(p, side, dV, V, gam, nx_meas, gr)
+            if (ny - lim) * side <= -0.005 or dV * side > 0:
+                st.protect_mode = 0
+            else:
+                ny = lim
+        return ny

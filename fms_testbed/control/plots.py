@@ -122,14 +122,22 @@ def plot_bode_coupling(omega_rps: np.ndarray, cases: dict[str, np.ndarray], path
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     panels = [((0, 0), "V / V_cmd, dB", 0, 0, 1.0), ((0, 1), "V / H_cmd, dB re (km/h)/m", 0, 1, 3.6),
               ((1, 0), "H / V_cmd, dB re m/(km/h)", 1, 0, 1 / 3.6), ((1, 1), "H / H_cmd, dB", 1, 1, 1.0)]
+    floor = 1e-16
+    notes: dict[tuple, list[str]] = {}
     for label, W in cases.items():
         for (r, c), _, i, j, scale in panels:
             mag = np.abs(W[i, j]) * scale
-            axes[r, c].semilogx(omega_rps, 20 * np.log10(np.maximum(mag, 1e-12)), label=label)
+            axes[r, c].semilogx(omega_rps, 20 * np.log10(np.maximum(mag, floor)), label=label)
+            if r != c and mag.max() < 1e-9:
+                notes.setdefault((r, c), []).append(
+                    f"{label}: max {mag.max():.1e} (numerically zero)")
     for (r, c), lab, *_ in panels:
         axes[r, c].set_ylabel(lab)
         axes[r, c].grid(alpha=0.4, which="both")
-        axes[r, c].set_ylim(-200 if c != r else -60, 10)
+        axes[r, c].set_ylim(-330 if c != r else -60, 10)
+    for (r, c), txt in notes.items():
+        axes[r, c].text(0.02, 0.04, "\n".join(txt), transform=axes[r, c].transAxes, fontsize=7,
+                        va="bottom")
     for c in (0, 1):
         axes[1, c].set_xlabel("frequency ω, rad/s")
     axes[0, 0].legend(fontsize=8)
@@ -153,6 +161,10 @@ def plot_linear_steps(t_s: np.ndarray, cases: dict[str, tuple[np.ndarray, np.nda
         axes[1, 0].plot(t_s, sv[1])
         axes[0, 1].plot(t_s, sh[0] * KMH)
         axes[1, 1].plot(t_s, sh[1])
+    if all(np.abs(sv[1]).max() < 1e-9 for sv, _ in cases.values()):
+        axes[1, 0].text(0.02, 0.9, "ΔH ≡ 0: at θ0 = 0 speed does not enter the linearised\n"
+                        "altitude dynamics; on JSBSim the n_y loop's tracking error does",
+                        transform=axes[1, 0].transAxes, fontsize=8, va="top")
     axes[0, 0].set_title(f"speed step {dV_mps * KMH:.0f} km/h")
     axes[0, 1].set_title(f"altitude step {dH_m:.0f} m")
     axes[0, 0].set_ylabel("ΔV, km/h")
