@@ -30,7 +30,8 @@ import math
 
 #: Properties written from Python (inputs of the system).
 INPUT_PROPERTIES = (
-    "fms/ap/master", "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
+    "fms/ap/master", "fms/ap/bank-trigger", "fms/ap/yaw-trigger", "fms/ap/ny-trigger",
+    "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
     "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle",
     "fms/trim/elevator", "fms/trim/aileron", "fms/trim/rudder", "fms/trim/throttle",
     "fms/gain/bank-kp", "fms/gain/bank-ki", "fms/gain/bank-kd",
@@ -42,11 +43,15 @@ INPUT_PROPERTIES = (
 )
 
 #: Properties the system computes and Python reads.
-OUTPUT_PROPERTIES = ("fms/meas/nx", "fms/meas/ny", "fms/throttle-sat", "fms/throttle-out")
+OUTPUT_PROPERTIES = ("fms/meas/nx", "fms/meas/ny", "fms/throttle-out")
 
 
-def _fn(name: str, body: str) -> str:
-    return f'  <fcs_function name="{name}"><function>{body}</function></fcs_function>\n'
+def _fn(name: str, body: str, clip: tuple[str, str] | None = None,
+        outputs: tuple[str, ...] = ()) -> str:
+    """An ``fcs_function`` component, optionally clipped and written to output properties."""
+    extra = f"<clipto><min>{clip[0]}</min><max>{clip[1]}</max></clipto>" if clip else ""
+    extra += "".join(f"<output>{o}</output>" for o in outputs)
+    return f'  <fcs_function name="{name}"><function>{body}</function>{extra}</fcs_function>\n'
 
 
 def _p(prop: str) -> str:
@@ -64,8 +69,25 @@ def _pid(name: str, error: str, gain: str, trigger: str) -> str:
             f"<trigger>{trigger}</trigger></pid>\n")
 
 
+def _sum(*terms: str) -> str:
+    return f"<sum>{''.join(terms)}</sum>"
+
+
+def _prod(*terms: str) -> str:
+    return f"<product>{''.join(terms)}</product>"
+
+
+def _diff(a: str, b: str) -> str:
+    return f"<difference>{a}{b}</difference>"
+
+
 def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float) -> str:
     """Return the ``<system>`` element (XML text) for an aircraft with ``n_engines`` engines.
+
+    16 components in all (each costs JSBSim time every frame). Integrator triggers of the bank,
+    yaw and n_y loops are written from Python on (dis)engagement (0 integrate, -1 reset); the n_x
+    trigger is computed here for anti-windup (+1 holds the integrator while the throttle sits at a
+    limit in the direction the error pushes).
 
     Parameters
     ----------
@@ -74,94 +96,68 @@ def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float) -> str:
     dt_s : frame time, s (documentation only; JSBSim supplies the frame time)
     """
     decl = "".join(f'  <property value="0">{p}</property>\n' for p in INPUT_PROPERTIES)
-    alpha = "aero/alpha-rad"
-    w = "inertia/weight-lbs"
+    P = _p
+    alpha, w = P("aero/alpha-rad"), P("inertia/weight-lbs")
+    fx, fz = P("forces/fbx-total-lbs"), P("forces/fbz-total-lbs")
+    qr = P("fms/sched/qbar-ratio")
+    tan_phi = f"<tan>{P('attitude/phi-rad')}</tan>"
     meas = (
         '<channel name="fms-measurements">\n'
-        + _fn("fms/meas/nx",
-              f"<quotient><sum><product>{_p('forces/fbx-total-lbs')}<cos>{_p(alpha)}</cos></product>"
-              f"<product>{_p('forces/fbz-total-lbs')}<sin>{_p(alpha)}</sin></product></sum>"
-              f"{_p(w)}</quotient>")
-        + _fn("fms/meas/ny",
-              f"<quotient><difference><product>{_p('forces/fbx-total-lbs')}<sin>{_p(alpha)}</sin>"
-              f"</product><product>{_p('forces/fbz-total-lbs')}<cos>{_p(alpha)}</cos></product>"
-              f"</difference>{_p(w)}</quotient>")
-        # gain schedule: surface loops scale with 1/qbar relative to the design point (the aircraft's default condition)
+        + _fn("fms/meas/nx", f"<quotient>{_sum(_prod(fx, f'<cos>{alpha}</cos>'), _prod(fz, f'<sin>{alpha}</sin>'))}{w}</quotient>")
+        + _fn("fms/meas/ny", f"<quotient>{_diff(_prod(fx, f'<sin>{alpha}</sin>'), _prod(fz, f'<cos>{alpha}</cos>'))}{w}</quotient>")
+        # gain schedule: surface loops scale with q̄_ref / q̄ about the design point
         + _fn("fms/sched/qbar-ratio",
-              f"<max><v>0.25</v><min><v>4</v><quotient>{_p('fms/sched/qbar-ref-psf')}"
-              f"<max>{_p('aero/qbar-psf')}<v>1</v></max></quotient></min></max>")
+              f"<quotient>{P('fms/sched/qbar-ref-psf')}<max>{P('aero/qbar-psf')}<v>1</v></max></quotient>",
+              clip=("0.25", "4"))
         + "</channel>\n")
-
-    def reset_trigger(loop: str) -> str:
-        # JSBSim pid trigger: 0 integrates, > 0 holds, < 0 resets the integrator.
-        return _fn(f"fms/{loop}-trigger", f"<difference>{_p(f'fms/ap/{loop}-engage')}<v>1</v></difference>")
-
     lateral = (
         '<channel name="fms-lateral">\n'
-        + reset_trigger("bank")
-        + _fn("fms/bank-err-rad", f"<product>{_p('fms/sched/qbar-ratio')}<difference>{_p('fms/cmd/bank-rad')}"
-              f"{_p('attitude/phi-rad')}</difference></product>")
-        + _pid("fms/bank-pid", "fms/bank-err-rad", "bank", "fms/bank-trigger")
-        + _fn("fms/aileron-out", _master("fcs/aileron-cmd-norm",
-              f"<sum>{_p('fms/trim/aileron')}<product>{_p('fms/ap/bank-engage')}<difference>"
-              f"{_p('fms/bank-pid')}<product>{_p('fms/sched/qbar-ratio')}{_p('fms/gain/bank-kd')}"
-              f"{_p('velocities/p-rad_sec')}</product>"
-              "</difference></product></sum>"))
-        + '  <pure_gain name="fms/aileron-clip"><input>fms/aileron-out</input><gain>1</gain>'
-          '<clipto><min>-1</min><max>1</max></clipto><output>fcs/aileron-cmd-norm</output></pure_gain>\n'
-        + reset_trigger("yaw")
-        + _fn("fms/yaw-rate-err-rps",
-              f"<difference>{_p('velocities/r-rad_sec')}<quotient><product><v>32.174</v>"
-              f"<tan>{_p('attitude/phi-rad')}</tan></product><max>{_p('velocities/vt-fps')}<v>50</v></max>"
-              "</quotient></difference>")
-        + _pid("fms/yaw-pid", "aero/beta-rad", "yaw", "fms/yaw-trigger")
-        + _fn("fms/rudder-out", _master("fcs/rudder-cmd-norm",
-              f"<sum>{_p('fms/trim/rudder')}<product>{_p('fms/ap/yaw-engage')}<difference>"
-              f"<product>{_p('fms/gain/yaw-kd')}{_p('fms/yaw-rate-err-rps')}</product>{_p('fms/yaw-pid')}"
-              "</difference></product></sum>"))
-        + '  <pure_gain name="fms/rudder-clip"><input>fms/rudder-out</input><gain>1</gain>'
-          '<clipto><min>-1</min><max>1</max></clipto><output>fcs/rudder-cmd-norm</output></pure_gain>\n'
+        + _fn("fms/bank-err-rad", _prod(qr, _diff(P("fms/cmd/bank-rad"), P("attitude/phi-rad"))))
+        + _pid("fms/bank-pid", "fms/bank-err-rad", "bank", "fms/ap/bank-trigger")
+        + _fn("fms/aileron-out", _master("fcs/aileron-cmd-norm", _sum(
+              P("fms/trim/aileron"), _prod(P("fms/ap/bank-engage"), _diff(
+                  P("fms/bank-pid"), _prod(qr, P("fms/gain/bank-kd"), P("velocities/p-rad_sec")))))),
+              clip=("-1", "1"), outputs=("fcs/aileron-cmd-norm",))
+        + _pid("fms/yaw-pid", "aero/beta-rad", "yaw", "fms/ap/yaw-trigger")
+        # yaw-rate error: r minus the coordinated-turn rate g tanφ / V (fps units)
+        + _fn("fms/rudder-out", _master("fcs/rudder-cmd-norm", _sum(
+              P("fms/trim/rudder"), _prod(P("fms/ap/yaw-engage"), _diff(
+                  _prod(P("fms/gain/yaw-kd"), _diff(
+                      P("velocities/r-rad_sec"),
+                      f"<quotient>{_prod('<v>32.174</v>', tan_phi)}"
+                      f"<max>{P('velocities/vt-fps')}<v>50</v></max></quotient>")),
+                  P("fms/yaw-pid"))))),
+              clip=("-1", "1"), outputs=("fcs/rudder-cmd-norm",))
         + "</channel>\n")
-
+    thr_out = P("fms/throttle-out")
     longitudinal = (
         '<channel name="fms-longitudinal">\n'
-        + reset_trigger("ny")
-        + _fn("fms/ny-err", f"<product>{_p('fms/sched/qbar-ratio')}<difference>{_p('fms/cmd/ny')}"
-              f"{_p('fms/meas/ny')}</difference></product>")
-        + _pid("fms/ny-pid", "fms/ny-err", "ny", "fms/ny-trigger")
-        + _fn("fms/elevator-out", _master("fcs/elevator-cmd-norm",
-              f"<sum>{_p('fms/trim/elevator')}<product>{_p('fms/ap/ny-engage')}<difference>"
-              f"<product>{_p('fms/sched/qbar-ratio')}{_p('fms/gain/ny-kd')}{_p('velocities/q-rad_sec')}"
-              f"</product>{_p('fms/ny-pid')}"
-              f"<product>{_p('fms/sched/qbar-ratio')}{_p('fms/gain/ny-kff')}<difference>{_p('fms/cmd/ny')}<v>1</v></difference>"
-              "</product>"
-              "</difference></product></sum>"))
+        + _fn("fms/ny-err", _prod(qr, _diff(P("fms/cmd/ny"), P("fms/meas/ny"))))
+        + _pid("fms/ny-pid", "fms/ny-err", "ny", "fms/ap/ny-trigger")
+        + _fn("fms/elevator-out", _master("fcs/elevator-cmd-norm", _sum(
+              P("fms/trim/elevator"), _prod(P("fms/ap/ny-engage"), _diff(
+                  _prod(qr, P("fms/gain/ny-kd"), P("velocities/q-rad_sec")),
+                  _sum(P("fms/ny-pid"), _prod(qr, P("fms/gain/ny-kff"),
+                                               _diff(P("fms/cmd/ny"), "<v>1</v>"))))))))
         + '  <actuator name="fms/elevator-act"><input>fms/elevator-out</input>'
           f"<rate_limit>{elevator_rate_max_ps:.6g}</rate_limit>"
-          '<clipto><min>-1</min><max>1</max></clipto><output>fcs/elevator-cmd-norm</output></actuator>\n'
-        # Throttle: anti-windup trigger = -1 (reset) when disengaged, +1 (hold) when the previous
-        # frame's unclipped command sat beyond a limit in the direction the error pushes.
-        + _fn("fms/nx-err", f"<difference>{_p('fms/cmd/nx')}{_p('fms/meas/nx')}</difference>")
+          "<clipto><min>-1</min><max>1</max></clipto><output>fcs/elevator-cmd-norm</output></actuator>\n"
+        + _fn("fms/nx-err", _diff(P("fms/cmd/nx"), P("fms/meas/nx")))
+        # anti-windup on the previous frame's (clipped) throttle
         + _fn("fms/nx-trigger",
-              f"<ifthen><lt>{_p('fms/ap/nx-engage')}<v>0.5</v></lt><v>-1</v>"
-              f"<ifthen><gt><product>{_p('fms/throttle-sat')}{_p('fms/nx-err')}</product><v>0</v></gt>"
-              "<v>1</v><v>0</v></ifthen></ifthen>")
+              f"<ifthen><lt>{P('fms/ap/nx-engage')}<v>0.5</v></lt><v>-1</v>"
+              f"<ifthen><or><and><ge>{thr_out}<difference>{P('fms/limit/throttle-max')}<v>1e-6</v></difference></ge>"
+              f"<gt>{P('fms/nx-err')}<v>0</v></gt></and>"
+              f"<and><le>{thr_out}<sum>{P('fms/limit/throttle-min')}<v>1e-6</v></sum></le>"
+              f"<lt>{P('fms/nx-err')}<v>0</v></lt></and></or><v>1</v><v>0</v></ifthen></ifthen>")
         + _pid("fms/nx-pid", "fms/nx-err", "nx", "fms/nx-trigger")
-        + _fn("fms/throttle-raw", _master(
+        + _fn("fms/throttle-out", _master(
               "fcs/throttle-cmd-norm[0]",
-              f"<ifthen><gt>{_p('fms/ap/nx-engage')}<v>0.5</v></gt>"
-              f"<sum>{_p('fms/trim/throttle')}{_p('fms/nx-pid')}<product>{_p('fms/gain/nx-kff')}"
-              f"{_p('fms/cmd/nx')}</product></sum>{_p('fms/cmd/throttle')}</ifthen>"))
-        + _fn("fms/throttle-sat",
-              f"<ifthen><ge>{_p('fms/throttle-raw')}{_p('fms/limit/throttle-max')}</ge><v>1</v>"
-              f"<ifthen><le>{_p('fms/throttle-raw')}{_p('fms/limit/throttle-min')}</le><v>-1</v><v>0</v>"
-              "</ifthen></ifthen>")
-        + _fn("fms/throttle-out",
-              f"<max><min>{_p('fms/throttle-raw')}{_p('fms/limit/throttle-max')}</min>"
-              f"{_p('fms/limit/throttle-min')}</max>")
-        + "".join(
-            f'  <pure_gain name="fms/throttle-eng{i}"><input>fms/throttle-out</input><gain>1</gain>'
-            f"<output>fcs/throttle-cmd-norm[{i}]</output></pure_gain>\n" for i in range(n_engines))
+              f"<ifthen><gt>{P('fms/ap/nx-engage')}<v>0.5</v></gt>"
+              + _sum(P("fms/trim/throttle"), P("fms/nx-pid"), _prod(P("fms/gain/nx-kff"), P("fms/cmd/nx")))
+              + f"{P('fms/cmd/throttle')}</ifthen>"),
+              clip=("fms/limit/throttle-min", "fms/limit/throttle-max"),
+              outputs=tuple(f"fcs/throttle-cmd-norm[{i}]" for i in range(n_engines)))
         + "</channel>\n")
     return (f'<system name="fms-inner-loops">\n<!-- generated by fms_testbed.inner_loops; '
             f"frame {dt_s:.6f} s ({1.0 / dt_s:.0f} Hz) -->\n{decl}{meas}{lateral}{longitudinal}</system>\n")

@@ -205,7 +205,6 @@ _READ = {  # state field -> (property, scale)
     "elevator": ("fcs/elevator-cmd-norm", 1.0),
     "aileron": ("fcs/aileron-cmd-norm", 1.0),
     "rudder": ("fcs/rudder-cmd-norm", 1.0),
-    "throttle_sat": ("fms/throttle-sat", 1.0),
     "wow": ("gear/wow", 1.0),
 }
 
@@ -250,6 +249,7 @@ class JSBSimAircraft:
         self._scaled = tuple((k, sc) for k, (_, sc) in _READ.items() if sc != 1.0)
         self._w = {name: pm.get_node(name, True) for name in (
             "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
+            "fms/ap/bank-trigger", "fms/ap/yaw-trigger", "fms/ap/ny-trigger",
             "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle")}
         self._write_gains()
 
@@ -307,6 +307,8 @@ class JSBSimAircraft:
         fdm["fms/ap/master"] = 0.0
         for name in ("fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage"):
             fdm[name] = 0.0
+        for name in ("fms/ap/bank-trigger", "fms/ap/yaw-trigger", "fms/ap/ny-trigger"):
+            fdm[name] = -1.0
         for prop, val in (("fcs/elevator-cmd-norm", 0.0), ("fcs/aileron-cmd-norm", 0.0),
                           ("fcs/rudder-cmd-norm", 0.0), ("fcs/pitch-trim-cmd-norm", 0.0)):
             fdm[prop] = val
@@ -358,9 +360,10 @@ class JSBSimAircraft:
     def engage(self, bank: bool = True, yaw: bool = True, ny: bool = True, nx: bool = True) -> None:
         """Engage (or release) the inner loops."""
         w = self._w
-        w["fms/ap/bank-engage"].set_double_value(float(bank))
-        w["fms/ap/yaw-engage"].set_double_value(float(yaw))
-        w["fms/ap/ny-engage"].set_double_value(float(ny))
+        for loop, on in (("bank", bank), ("yaw", yaw), ("ny", ny)):
+            w[f"fms/ap/{loop}-engage"].set_double_value(float(on))
+            # JSBSim pid trigger: 0 integrates, < 0 resets the integrator
+            w[f"fms/ap/{loop}-trigger"].set_double_value(0.0 if on else -1.0)
         w["fms/ap/nx-engage"].set_double_value(float(nx))
 
     def command(self, bank_rad: float | None = None, ny: float | None = None,

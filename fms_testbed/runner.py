@@ -242,10 +242,11 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     law_engaged = False
     cmd_nx = cmd_ny = float("nan")
     bar = None
-    if progress or (progress is None and scn.duration_s > 300):
+    if progress is not False:
         from tqdm import tqdm
-        bar = tqdm(total=int(scn.duration_s), unit="sim s", disable=None if progress is None else False,
-                   desc=scn.name or "run", leave=False)
+        # appears only after 2 s of wall time, and (unless forced) only on a terminal
+        bar = tqdm(total=int(scn.duration_s), unit="sim s", delay=2.0, leave=False,
+                   disable=None if progress is None else False, desc=scn.name or "run")
     raw = ac.read()
     for k in range(n_total + 1):
         s = ac.state(raw)
@@ -318,7 +319,7 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
             status, reason = "diverged", "JSBSim stopped"
             break
         raw = ac.read()
-        if bar is not None and k % 40 == 0:
+        if bar is not None and k % 200 == 0:
             bar.n = int(raw["t_s"])
             bar.refresh()
     if bar is not None:
