@@ -25,12 +25,14 @@ def test_stim300_units_convert_to_si():
     imu = load_imu("stim300")                                 # case-insensitive
     assert math.sqrt(imu.q_psd[6]) == pytest.approx(0.15 * math.pi / 180 / 60)   # rad/√s
     assert math.sqrt(imu.q_psd[3]) == pytest.approx(0.06 / 60)                   # m/s/√s
-    assert imu.decay_rps[0] == pytest.approx(1 / 3600)                           # accel bias GM
-    # gyro bias GM: stationary variance σ² and q = 2σ²/τ
+    # gyro bias (no turn-on): stationary Gauss-Markov, variance σ², q = 2σ²/τ, decay 1/τ
+    assert imu.decay_rps[3] == pytest.approx(1 / 3600)
     assert imu.p0_var[12] == pytest.approx((0.5 * DEG_H) ** 2)
     assert imu.q_psd[12] == pytest.approx(2 * (0.5 * DEG_H) ** 2 / 3600)
-    # accel bias: turn-on 750 µg plus in-run 50 µg
-    assert imu.p0_var[9] == pytest.approx((750e-6 * 9.80665) ** 2 + (50e-6 * 9.80665) ** 2)
+    # accel bias: turn-on 750 µg kept constant (no decay) + in-run 50 µg as a random walk
+    assert imu.decay_rps[0] == 0.0
+    assert imu.p0_var[9] == pytest.approx((750e-6 * 9.80665) ** 2)
+    assert imu.q_psd[9] == pytest.approx(2 * (50e-6 * 9.80665) ** 2 / 3600)
     assert imu.p0_var[18] == pytest.approx(500e-6 ** 2)                          # gyro SF
     assert imu.p0_var[27] == pytest.approx(1e-3 ** 2) and imu.q_psd[27] == 0     # constant
 

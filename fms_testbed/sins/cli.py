@@ -66,7 +66,7 @@ def _handler(args) -> int:
         t0 = time.perf_counter()
         mc = montecarlo_run(traj, imu, args.n, args.seed, opts)
         log.info("Monte-Carlo %d realisations: %.1f s", args.n, time.perf_counter() - t0)
-        results["Monte-Carlo"] = mc
+        results[f"Monte-Carlo (N = {args.n})"] = mc
         mc.to_frame().to_csv(out / "ins_montecarlo_sigma.csv", index=False)
     cov.to_frame().to_csv(out / "ins_covariance_sigma.csv", index=False)
     main = mc if mc is not None else cov

@@ -17,9 +17,9 @@ import numpy as np  # noqa: E402
 _ROWS = {
     "position": ((0, "east position error, m", 1.0), (1, "north position error, m", 1.0),
                  (2, "up position error, m", 1.0)),
-    "attitude": ((6, "attitude error about east, mrad", 1e3),
-                 (7, "attitude error about north, mrad", 1e3),
-                 (8, "attitude error about up (heading), mrad", 1e3)),
+    "attitude": ((6, "tilt about east ε_E, mrad", 1e3),
+                 (7, "tilt about north ε_N, mrad", 1e3),
+                 (8, "about up ε_U (heading), mrad", 1e3)),
 }
 
 
@@ -64,8 +64,9 @@ def plot_p95(results: dict, out: Path, title: str = "") -> Path:
     styles = {"covariance": "k-", "Monte-Carlo": "r--"}
     for name, res in results.items():
         t = (res.t_s - res.t_s[0]) / 60.0
-        ax1.plot(t, res.h95_m, styles.get(name, "-"), label=name)
-        ax2.plot(t, res.v95_m, styles.get(name, "-"), label=name)
+        style = styles.get(name.split(" ")[0], "-")
+        ax1.plot(t, res.h95_m, style, label=name)
+        ax2.plot(t, res.v95_m, style, label=name)
     ax1.set_ylabel("95 % horizontal error, m")
     ax2.set_ylabel("95 % vertical error, m")
     ax2.set_xlabel("time since start, min")

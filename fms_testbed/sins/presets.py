@@ -7,8 +7,13 @@ means adding one file. A scenario may also give the same mapping inline
 All values are 1σ. Noise densities (``arw_deg_per_sqrt_h``, ``vrw_mps_per_sqrt_h``,
 ``bias_rate_random_walk_*``) are **continuous-time** spectral densities; Gauss-Markov σ are
 stationary standard deviations with their correlation time (driving density q = 2σ²/τ, paper
-§5). A correlation time of ``null`` makes a bias a random walk (density
-``bias_rate_random_walk_*``) and a scale factor / misalignment a random constant.
+§5). A correlation time of ``null`` makes a scale factor / misalignment a random constant.
+
+Biases: with no turn-on value, the in-run bias (``bias_instability_*``, ``bias_correlation_time_s``)
+is a stationary Gauss-Markov state. With a turn-on (run-to-run) value the paper's model is used,
+b' = η with b(0) ~ N(0, σ_turn_on²): the constant does not decay, and the in-run instability
+becomes a random walk of density 2σ²/τ (the Gauss-Markov's initial growth; conservative beyond τ),
+plus ``bias_rate_random_walk_*`` if given.
 """
 
 from __future__ import annotations
@@ -117,10 +122,17 @@ def _triad_states(bias_sigma_turn_on, bias_sigma_inst, bias_tau, bias_rrw, sf, s
     def gm(sigma, tau):
         return (1.0 / tau, 2.0 * sigma * sigma / tau) if tau else (0.0, 0.0)
 
-    b_decay, b_q = gm(bias_sigma_inst, bias_tau)
-    if not bias_tau:
-        b_q = bias_rrw ** 2
-    b_p0 = bias_sigma_turn_on ** 2 + (bias_sigma_inst ** 2 if bias_tau else 0.0)
+    if bias_tau and bias_sigma_turn_on == 0.0:
+        # in-run bias alone: stationary first-order Gauss-Markov
+        b_decay, b_q = gm(bias_sigma_inst, bias_tau)
+        b_p0 = bias_sigma_inst ** 2
+    else:
+        # paper §5: b' = η, b(0) = d (run-to-run constant + random walk). A Gauss-Markov decay
+        # would wrongly erode the turn-on constant, so a given instability becomes a random walk
+        # with the same initial growth as the Gauss-Markov process (q = 2σ²/τ)
+        b_decay = 0.0
+        b_q = bias_rrw ** 2 + (2.0 * bias_sigma_inst ** 2 / bias_tau if bias_tau else 0.0)
+        b_p0 = bias_sigma_turn_on ** 2
     k_decay, k_q = gm(sf, sf_tau)
     m_decay, m_q = gm(mis, mis_tau)
     return ((b_decay, b_q, b_p0, 3), (k_decay, k_q, sf * sf, 3), (m_decay, m_q, mis * mis, 6))
