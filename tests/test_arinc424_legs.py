@@ -1,0 +1,255 @@
+"""One test per path terminator, on synthetic records (FD and CR included: absent from FAA data)."""
+
+import math
+
+import pytest
+
+from fms_testbed.arinc424.construct import _foot
+from fms_testbed.arinc424.legs import LEG_TYPES
+from fms_testbed.arinc424.legrecord import PATH_TERMINATORS
+from fms_testbed.arinc424.model import turn_radius_m
+from fms_testbed.arinc424.synth import leg_record as L
+from fms_testbed.arinc424.synth import offset, waypoint_record
+from fms_testbed.path import Arc, gravity_mps2, inverse
+from tests.arinc424_world import APT, PARAMS, PERF, build, world
+
+FT = 0.3048
+NM = 1852.0
+G = gravity_mps2(APT[0])
+R_PLAN = turn_radius_m(PERF.tas_plan_mps, PARAMS.bank_plan_deg, G)
+
+
+def sid(pt, seq, **kw):
+    return L("XTST", "TSID1", pt, seq, proc_type="D", transition="RW09", route_type="1", **kw)
+
+
+def app(pt, seq, **kw):
+    return L("XTST", "T09", pt, seq, proc_type="F", transition="", route_type="R", **kw)
+
+
+def end_of(path):
+    return path.segments[-1].geom.end
+
+
+def dist(a, b):
+    return inverse(a[0], a[1], b[0], b[1])[0]
+
+
+def arcs(path, role=None):
+    return [s for s in path.segments if isinstance(s.geom, Arc) and (role is None or s.role == role)]
+
+
+def test_table_has_all_23_path_terminators():
+    assert sorted(LEG_TYPES) == sorted(PATH_TERMINATORS) and len(LEG_TYPES) == 23
+
+
+def test_if_tf_ends_at_fix_with_geodesic_length(tmp_path):
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB")])
+    w = world()
+    assert p.status == "ok"
+    assert dist(end_of(p), w["WB"]) < 0.5
+    assert p.length_m() == pytest.approx(dist(w["WA"], w["WB"]), abs=1.0)
+    assert p.legs[1].termination.kind == "fix"
+
+
+def test_tf_fly_by_turn_uses_radius_and_lead_from_speed_and_bank(tmp_path):
+    w = world()
+    c = offset(*w["WB"], 150.0, 15.0)
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
+                         app("TF", 30, fix="WC")], extra=[waypoint_record("WC", *c)])
+    fb = arcs(p, "flyby")
+    assert len(fb) == 1
+    arc = fb[0].geom
+    assert arc.radius_m == pytest.approx(R_PLAN, rel=1e-6)
+    assert arc.sweep_deg == pytest.approx(60.0, abs=0.3)
+    lead = R_PLAN * math.tan(math.radians(abs(arc.sweep_deg)) / 2)
+    assert dist(arc.start, w["WB"]) == pytest.approx(lead, abs=1.0)
+    assert dist(arc.end, w["WB"]) == pytest.approx(lead, abs=1.0)
+    assert fb[0].bank_deg == pytest.approx(PARAMS.bank_plan_deg, abs=1e-6)
+
+
+def test_fly_over_fix_is_passed_then_rejoined(tmp_path):
+    w = world()
+    c = offset(*w["WB"], 150.0, 15.0)
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB", desc="EY  "),
+                         app("TF", 30, fix="WC")], extra=[waypoint_record("WC", *c)])
+    assert not arcs(p, "flyby")
+    assert min(dist(s.geom.end, w["WB"]) for s in p.segments) < 0.5   # over the fix
+    turn = arcs(p, "turn")[0]
+    assert dist(turn.geom.start, w["WB"]) < 0.5 and turn.geom.sweep_deg > 0
+    assert dist(end_of(p), c) < 0.5
+
+
+def test_cf_intercepts_the_course_and_ends_on_it(tmp_path):
+    w = world()
+    p = build(tmp_path, [app("IF", 10, fix="WN"), app("CF", 20, fix="WB", course_deg=90.0)])
+    assert dist(end_of(p), w["WB"]) < 0.5
+    assert p.segments[-1].geom.end_course_deg == pytest.approx(90.0 + 0.0, abs=0.5) or \
+        abs(((p.segments[-1].geom.end_course_deg - 90.0) + 180) % 360 - 180) < 0.5
+    # the last straight lies on the coded course line
+    mid = p.segments[-1].geom.point_at(p.segments[-1].geom.length_m() / 2)
+    assert abs(_foot(*w["WB"], 90.0, *mid)[1]) < 1.0
+
+
+def test_df_turns_the_coded_way_even_beyond_180(tmp_path):
+    p = build(tmp_path, [sid("CA", 10, course_deg=90.0, alt_desc="+", alt1_ft=1000),
+                         sid("DF", 20, fix="WS", turn="L")])
+    w = world()
+    turn = [s for s in arcs(p, "turn") if s.leg_index == 1][0].geom
+    assert turn.sweep_deg < -180.0   # WS bears ~153° right of the runway heading; coded left
+    assert dist(end_of(p), w["WS"]) < 0.5
+
+
+def test_fa_ends_where_the_climb_reaches_the_altitude(tmp_path):
+    p = build(tmp_path, [sid("IF", 10, fix="WB"),
+                         sid("FA", 20, fix="WB", course_deg=90.0, alt_desc="+", alt1_ft=3000)])
+    grad = PERF.climb_gradient_at(PERF.tas_plan_mps)
+    assert p.legs[1].termination.kind == "altitude"
+    assert p.length_m() == pytest.approx((3000 - 35) * FT / grad, abs=1.0)
+
+
+def test_fc_flies_the_coded_distance(tmp_path):
+    p = build(tmp_path, [app("IF", 10, fix="WB"), app("FC", 20, fix="WB", course_deg=90.0,
+                                                      distance_nm=7.0)])
+    assert p.length_m() == pytest.approx(7.0 * NM, abs=0.01)
+    assert p.legs[1].termination.kind == "distance"
+
+
+def test_fd_ends_at_the_dme_distance(tmp_path):
+    w = world()
+    p = build(tmp_path, [app("IF", 10, fix="WB"),
+                         app("FD", 20, fix="WB", course_deg=90.0, navaid="TVR",
+                             distance_nm=12.0)])
+    t = p.legs[1].termination
+    assert t.kind == "dme"
+    assert dist(end_of(p), w["TVR"]) == pytest.approx(12.0 * NM, abs=0.5)
+
+
+def test_fm_flies_the_manual_distance(tmp_path):
+    p = build(tmp_path, [app("IF", 10, fix="WB"), app("FM", 20, fix="WB", course_deg=45.0)])
+    assert p.length_m() == pytest.approx(PARAMS.manual_leg_m, abs=0.01)
+    assert p.legs[1].termination.kind == "manual"
+
+
+@pytest.mark.parametrize("pt", ["CA", "VA"])
+def test_course_or_heading_to_altitude_from_the_runway(tmp_path, pt):
+    p = build(tmp_path, [sid(pt, 10, course_deg=90.0, alt_desc="+", alt1_ft=2000)])
+    grad = PERF.climb_gradient_at(PERF.tas_plan_mps)
+    assert p.length_m() == pytest.approx((2000 - 35) * FT / grad, abs=1.0)
+    assert p.legs[0].termination.alt_m == pytest.approx(2000 * FT)
+
+
+@pytest.mark.parametrize("pt", ["CD", "VD"])
+def test_course_or_heading_to_dme(tmp_path, pt):
+    w = world()
+    p = build(tmp_path, [sid(pt, 10, course_deg=90.0, navaid="TVR", distance_nm=15.0)])
+    assert dist(end_of(p), w["TVR"]) == pytest.approx(15.0 * NM, abs=0.5)
+
+
+@pytest.mark.parametrize("pt", ["CR", "VR"])
+def test_course_or_heading_to_radial(tmp_path, pt):
+    w = world()
+    p = build(tmp_path, [sid(pt, 10, course_deg=90.0, navaid="TVR", theta_deg=120.0)])
+    _, az, _ = inverse(*w["TVR"], *end_of(p))
+    assert az % 360 == pytest.approx(120.0, abs=0.01)
+    assert p.legs[0].termination.kind == "radial"
+
+
+@pytest.mark.parametrize("pt", ["CI", "VI"])
+def test_intercept_ends_on_the_next_course(tmp_path, pt):
+    w = world()
+    p = build(tmp_path, [sid("CA", 10, course_deg=90.0, alt_desc="+", alt1_ft=1000),
+                         sid(pt, 20, course_deg=200.0, turn="R"),
+                         sid("CF", 30, fix="WS", course_deg=270.0)])
+    t = p.legs[1].termination
+    assert t.kind == "intercept" and t.next_leg == 2
+    assert abs(_foot(*w["WS"], 270.0, t.lat_deg, t.lon_deg)[1]) < 1.0
+    assert not [f for f in p.findings if f.category == "no-intercept"]
+    assert dist(end_of(p), w["WS"]) < 0.5
+
+
+def test_vm_flies_the_manual_distance(tmp_path):
+    p = build(tmp_path, [sid("VM", 10, course_deg=90.0)])
+    assert p.length_m() == pytest.approx(PARAMS.manual_leg_m, abs=0.01)
+
+
+def test_rf_follows_the_coded_centre_radius_and_direction_beyond_180(tmp_path):
+    w = world()
+    centre = offset(*w["WB"], 0.0, 2.0)   # WB is on a 2 NM circle about the centre
+    c = offset(*centre, 340.0, 2.0)       # 200 deg clockwise from radial 180 -> 20 (340 ccw)
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
+                         app("RF", 30, fix="WC", turn="R", arc_radius_nm=2.0, centre="CTR")],
+              extra=[waypoint_record("WC", *c), waypoint_record("CTR", *centre)])
+    rf = [s for s in p.segments if s.path_term == "RF"][0].geom
+    assert rf.radius_m == pytest.approx(2.0 * NM, abs=0.05 * NM)
+    assert rf.sweep_deg == pytest.approx(160.0, abs=0.1)   # clockwise from 180 to 340
+    assert dist(end_of(p), c) < 0.5
+
+
+def test_rf_coded_left_goes_the_long_way(tmp_path):
+    w = world()
+    centre = offset(*w["WB"], 0.0, 2.0)
+    c = offset(*centre, 200.0, 2.0)
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
+                         app("RF", 30, fix="WC", turn="L", arc_radius_nm=2.0, centre="CTR")],
+              extra=[waypoint_record("WC", *c), waypoint_record("CTR", *centre)])
+    rf = [s for s in p.segments if s.path_term == "RF"][0].geom
+    assert rf.sweep_deg == pytest.approx(-340.0, abs=0.1) and rf.turn == "L"
+
+
+def test_af_flies_the_dme_arc_the_coded_way(tmp_path):
+    w = world()
+    p = build(tmp_path, [app("IF", 10, fix="ARC1"),
+                         app("AF", 20, fix="ARC2", turn="L", navaid="TVR", theta_deg=100.0,
+                             rho_nm=10.0, course_deg=200.0)])
+    af = [s for s in p.segments if s.path_term == "AF"][0].geom
+    assert dist(af.centre, w["TVR"]) < 0.5
+    assert af.radius_m == pytest.approx(10.0 * NM, abs=1.0)
+    assert af.sweep_deg == pytest.approx(-100.0, abs=0.01)
+    assert dist(end_of(p), w["ARC2"]) < 0.5
+
+
+def _hold_arcs(p):
+    return [s.geom for s in p.segments if s.role == "hold"]
+
+
+def test_hf_flies_one_circuit_in_the_coded_direction_and_leaves_over_the_fix(tmp_path):
+    w = world()
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
+                         app("HF", 30, fix="WB", turn="L", course_deg=90.0, time_min=1.0)])
+    holds = _hold_arcs(p)
+    assert len(holds) == 2 and all(a.sweep_deg < 0 for a in holds)
+    assert sum(abs(a.sweep_deg) for a in holds) == pytest.approx(360.0, abs=1.0)
+    assert dist(end_of(p), w["WB"]) < 0.5
+    assert p.legs[2].termination.kind == "circuit"
+
+
+def test_hm_is_a_manual_termination_at_the_fix(tmp_path):
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
+                         app("HM", 30, fix="WB", turn="R", course_deg=90.0, distance_nm=4.0)])
+    assert p.legs[2].termination.kind == "manual"
+    assert all(a.sweep_deg > 0 for a in _hold_arcs(p))
+    straight = [s.geom.length_m() for s in p.segments if s.leg_index == 2 and s.role == "leg"]
+    assert max(straight) == pytest.approx(4.0 * NM, abs=1.0)   # outbound leg length
+
+
+def test_ha_holds_until_the_altitude_is_reached(tmp_path):
+    p = build(tmp_path, [sid("IF", 10, fix="WB"),
+                         sid("HA", 20, fix="WB", turn="R", course_deg=90.0, time_min=1.0,
+                             alt_desc="+", alt1_ft=25000)])
+    holds = _hold_arcs(p)
+    circuits = sum(abs(a.sweep_deg) for a in holds) / 360.0
+    grad = PERF.climb_gradient_at(PERF.tas_plan_mps)
+    assert circuits >= 2 - 1e-6
+    assert circuits * 0 + p.length_m() * grad >= (25000 - 35) * FT - 1.0
+    assert p.legs[1].termination.kind == "altitude"
+
+
+def test_pi_turns_45_the_coded_way_then_180_the_other(tmp_path):
+    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
+                         app("PI", 30, fix="WB", turn="R", course_deg=270.0, distance_nm=10.0),
+                         app("CF", 40, fix="WB", course_deg=90.0)])
+    sweeps = [round(s.geom.sweep_deg) for s in p.segments
+              if s.leg_index == 2 and isinstance(s.geom, Arc)]
+    assert 45 in sweeps and -180 in sweeps
+    assert dist(end_of(p), world()["WB"]) < 0.5
