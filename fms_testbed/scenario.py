@@ -69,14 +69,11 @@ Speed = Annotated[float, Field(gt=0, lt=1000)]
 Alt = Annotated[float, Field(ge=-400, le=25000)]
 
 
-class Initial(_Strict):
-    """Initial condition (trimmed straight and level)."""
+class _AltSpeed(_Strict):
+    """Altitude and speed keys in the user's unit (one of each at most)."""
 
-    lat_deg: Annotated[float, Field(ge=-89, le=89)] = 45.0
-    lon_deg: Annotated[float, Field(ge=-180, le=360)] = 0.0
     alt_m: Alt | None = None
     alt_ft: Annotated[float, Field(ge=-1300, le=82000)] | None = None
-    heading_deg: Annotated[float, Field(ge=0, le=360)] = 0.0
     tas_mps: Speed | None = None
     tas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = None
     tas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = None
@@ -84,22 +81,35 @@ class Initial(_Strict):
     cas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = None
     cas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = None
 
+    _required = False
+
+    @property
+    def altitude_m(self) -> float | None:
+        """Altitude, m (None if not given)."""
+        return _alt(self.__dict__, self._where(), self._required)
+
+    @property
+    def speed(self) -> tuple[str | None, float | None]:
+        """(``'tas'`` or ``'cas'``, speed in m/s), or (None, None) if not given."""
+        return _speed(self.__dict__, self._where(), self._required)
+
+    def _where(self) -> str:
+        return type(self).__name__.lower()
+
+
+class Initial(_AltSpeed):
+    """Initial condition (trimmed straight and level); altitude and speed required."""
+
+    lat_deg: Annotated[float, Field(ge=-89, le=89)] = 45.0
+    lon_deg: Annotated[float, Field(ge=-180, le=360)] = 0.0
+    heading_deg: Annotated[float, Field(ge=0, le=360)] = 0.0
+
+    _required = True
+
     @model_validator(mode="after")
     def _check(self):
-        d = self.__dict__
-        _alt(d, "initial", True)
-        _speed(d, "initial", True)
+        _ = self.altitude_m, self.speed
         return self
-
-    @property
-    def altitude_m(self) -> float:
-        """Initial altitude, m."""
-        return _alt(self.__dict__, "initial", True)
-
-    @property
-    def speed(self) -> tuple[str, float]:
-        """(``'tas'`` or ``'cas'``, speed in m/s)."""
-        return _speed(self.__dict__, "initial", True)
 
 
 class Wind(_Strict):
@@ -141,7 +151,7 @@ class When(_Strict):
         return self
 
 
-class Event(_Strict):
+class Event(_AltSpeed):
     """A target change at time ``t_s`` (or when ``when`` is met). Unset fields are unchanged."""
 
     t_s: Annotated[float, Field(ge=0)] | None = None
@@ -151,14 +161,6 @@ class Event(_Strict):
     nx: Annotated[float, Field(ge=-0.5, le=0.5)] | None = None
     ny: Annotated[float, Field(ge=-1.0, le=3.0)] | None = None
     throttle: Annotated[float, Field(ge=0, le=1)] | None = None
-    alt_m: Alt | None = None
-    alt_ft: Annotated[float, Field(ge=-1300, le=82000)] | None = None
-    tas_mps: Speed | None = None
-    tas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = None
-    tas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = None
-    cas_mps: Speed | None = None
-    cas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = None
-    cas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = None
 
     @model_validator(mode="after")
     def _check(self):
@@ -168,22 +170,11 @@ class Event(_Strict):
             raise ValueError("bank_deg and heading_deg in one event conflict")
         if self.nx is not None and self.throttle is not None:
             raise ValueError("nx and throttle in one event conflict")
-        _alt(self.__dict__, "event", False)
-        _speed(self.__dict__, "event", False)
+        _ = self.altitude_m, self.speed
         targets = [k for k, v in self.__dict__.items() if v is not None and k not in ("t_s", "when")]
         if not targets:
             raise ValueError("an event must set at least one target")
         return self
-
-    @property
-    def altitude_m(self) -> float | None:
-        """Altitude target, m, or None."""
-        return _alt(self.__dict__, "event", False)
-
-    @property
-    def speed(self) -> tuple[str | None, float | None]:
-        """(``'tas'``/``'cas'``, m/s) or (None, None)."""
-        return _speed(self.__dict__, "event", False)
 
 
 class Scenario(_Strict):
