@@ -11,7 +11,7 @@ from fms_testbed.arinc424.model import turn_radius_m
 from fms_testbed.arinc424.synth import leg_record as L
 from fms_testbed.arinc424.synth import offset, waypoint_record
 from fms_testbed.path import Arc, gravity_mps2, inverse
-from tests.arinc424_world import APT, PARAMS, PERF, build, world
+from tests.test_arinc424_world import APT, PARAMS, PERF, build, world
 
 FT = 0.3048
 NM = 1852.0
