@@ -162,4 +162,5 @@ def test_any_tuning_keeps_speed_during_an_unclipped_altitude_step(T_V, xi_V, T_H
     p = CoupledLawParams(T_V_s=T_V, xi_V=xi_V, T_H_s=T_H, xi_H=xi_H, ny_model_tau_s=0.0)
     df = simulate(CoupledLaw(params=p), WIDE, 3000.0, V0, 40.0, [CommandEvent(t_s=0, alt_m=3000 + dH)],
                   dt_s=0.05, substeps=2)
-    assert np.max(np.abs(df["tas_mps"] - V0)) * 3.6 < 0.05
+    # zero in continuous time; what is left is the 20 Hz discretisation (PI baseline: ~3 km/h)
+    assert np.max(np.abs(df["tas_mps"] - V0)) * 3.6 < 0.1
