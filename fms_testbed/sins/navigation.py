@@ -10,9 +10,13 @@ Scenario block (``navigation:``)::
     vertical: baro          # baro (damped, default) | free (unstable vertical channel)
     baro_tau_s: 60          # baro loop time constant, s
     tol: 1.0e-12            # adaptive Picard tolerance
+    matrices_dt_s: 0        # reuse Φ_k, S_k for this long (s) before rebuilding F; 0 = every step
 
 Each :meth:`SinsNavigation.update` builds F at the previous true state, discretises over the
 elapsed Δt, propagates x_k = Φ x_{k-1} + S N_k (paper eq. 6.11) and returns truth ⊕ errors.
+With ``matrices_dt_s > 0`` the last Φ_k, S_k are reused (same Δt) until that much time has
+passed: the propagation then costs two 33×33 products per step, at the price of holding F
+(attitude, specific force, rates) constant over that interval.
 """
 
 from __future__ import annotations
@@ -27,12 +31,12 @@ from ..state import AircraftState, NavSolution
 from .analysis import SinsOptions
 from .discretize import (PICARD_MAX_ORDER, PICARD_MAX_RATE_DT, DiscretisationError,
                          _picard_sins, discretize)
-from .euler import eps_to_euler_errors
 from .model import baro_gains, build_F, earth_radii
 from .presets import G0_MPS2, ImuModel, load_imu
 from .simulate import FACTOR_RTOL, IndefiniteCovarianceError, _psd_cholesky
 
-SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol"}
+SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol",
+             "matrices_dt_s"}
 RAD2DPH = 180.0 / math.pi * 3600.0
 
 
@@ -56,8 +60,8 @@ def _c_bn(roll, pitch, heading):
 
 @njit(cache=True)
 def _sins_step(x, noise, lat, alt, v, rpy, w_eb, f_b, decay, q_diag, k1, k2, dt, tol, rtol):
-    """Fused kernel: F at the true state → Picard (Φ, Q_k) → S → Φ x + S N. Status 0 ok,
-    1 Picard range, 2 no convergence, 3 indefinite Q_k."""
+    """Fused kernel: F at the true state → Picard (Φ, Q_k) → S → (Φ x + S N, Φ, S, status);
+    status 0 ok, 1 Picard range, 2 no convergence, 3 indefinite Q_k."""
     c = _c_bn(rpy[0], rpy[1], rpy[2])
     w_ie = np.array([0.0, 7.292115e-5 * math.cos(lat), 7.292115e-5 * math.sin(lat)])
     w_ib = w_eb + c.T @ w_ie
@@ -65,29 +69,33 @@ def _sins_step(x, noise, lat, alt, v, rpy, w_eb, f_b, decay, q_diag, k1, k2, dt,
     rate = 0.0
     for i in range(F.shape[0]):
         rate = max(rate, abs(F[i, i]))
+    empty = np.zeros((0, 0))
     if rate * dt > PICARD_MAX_RATE_DT:
-        return x, 1
+        return x, empty, empty, 1
     phi, qk, _, ok = _picard_sins(F, q_diag, dt, tol, PICARD_MAX_ORDER)
     if not ok:
-        return x, 2
+        return x, empty, empty, 2
     L, bad = _psd_cholesky(qk, rtol)
     if bad >= 0:
-        return x, 3
-    return phi @ x + L @ noise, 0
+        return x, empty, empty, 3
+    return phi @ x + L @ noise, phi, L, 0
 
 
 class SinsNavigation:
     """Navigation source with SINS errors; see the module docstring for the scenario keys."""
 
     def __init__(self, imu: ImuModel, seed: int = 0, opts: SinsOptions = SinsOptions(),
-                 dt_s: float = 0.1):
+                 dt_s: float = 0.1, matrices_dt_s: float = 0.0):
         self.imu = imu
         self.opts = opts
         self.dt_s = float(dt_s)
+        self.matrices_dt_s = float(matrices_dt_s)
         self.seed = int(seed)
         self.rng = np.random.default_rng(self.seed)
         self.x = np.sqrt(imu.p0_var) * self.rng.standard_normal(imu.p0_var.size)
         self._prev: AircraftState | None = None
+        self._gains: tuple[float, float] | None = None       # baro gains, set at the first step
+        self._held = None                                    # (t_built_s, dt_s, Φ, S)
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "SinsNavigation":
@@ -112,42 +120,57 @@ class SinsNavigation:
                                vertical=str(spec.get("vertical", "baro")),
                                baro_tau_s=float(spec.get("baro_tau_s", 60.0)))
             dt_s = float(spec.get("dt_s", 0.1))
+            matrices_dt_s = float(spec.get("matrices_dt_s", 0.0))
             sd = spec.get("seed", seed)
             sd = 0 if sd is None else int(sd)
         except (TypeError, ValueError) as exc:
             raise ConfigError(f"navigation: bad value: {exc}") from None
         if not dt_s > 0:
             raise ConfigError(f"navigation.dt_s: must be > 0 s, got {dt_s}")
-        return cls(imu, seed=sd, opts=opts, dt_s=dt_s)
+        if matrices_dt_s < 0:
+            raise ConfigError(f"navigation.matrices_dt_s: must be >= 0 s, got {matrices_dt_s}")
+        return cls(imu, seed=sd, opts=opts, dt_s=dt_s, matrices_dt_s=matrices_dt_s)
 
     def _propagate(self, prev: AircraftState, dt: float) -> None:
         noise = self.rng.standard_normal(self.x.size)
+        held = self._held
+        if (held is not None and held[1] == dt
+                and prev.t_s - held[0] < self.matrices_dt_s - 1e-9):
+            self.x = held[2] @ self.x + held[3] @ noise
+            return
         o = self.opts
-        k1, k2 = baro_gains(o.baro_tau_s if o.vertical == "baro" else None, prev.lat_rad)
+        if self._gains is None:
+            self._gains = baro_gains(o.baro_tau_s if o.vertical == "baro" else None,
+                                     prev.lat_rad)
+        k1, k2 = self._gains
         rpy = np.array([prev.roll_rad, prev.pitch_rad, prev.heading_rad])
         w_eb = np.array([prev.p_rps, prev.q_rps, prev.r_rps])
         v = np.asarray(prev.v_enu_mps, float)
         f_b = np.asarray(prev.f_body_mps2, float)
         if o.method == "picard":
-            x, status = _sins_step(self.x, noise, prev.lat_rad, prev.alt_m, v, rpy, w_eb, f_b,
-                                   self.imu.decay_rps, self.imu.q_psd, k1, k2, dt, o.tol,
-                                   FACTOR_RTOL)
+            x, phi, L, status = _sins_step(self.x, noise, prev.lat_rad, prev.alt_m, v, rpy, w_eb,
+                                           f_b, self.imu.decay_rps, self.imu.q_psd, k1, k2, dt,
+                                           o.tol, FACTOR_RTOL)
             if status == 1 or status == 2:
                 raise DiscretisationError(
                     f"navigation: Picard series unsuitable at dt = {dt:g} s (Δt/τ > "
                     f"{PICARD_MAX_RATE_DT} or no convergence); set navigation.method: vanloan")
             if status == 3:
                 raise IndefiniteCovarianceError(f"navigation: Q_k indefinite at t = {prev.t_s} s")
-            self.x = x
-            return
-        from .analysis import system_matrix
-        F = system_matrix(prev.lat_rad, prev.alt_m, v, rpy, w_eb, f_b, self.imu, o)
-        phi, qk = discretize(F, np.diag(self.imu.q_psd), dt, method=o.method)
-        L, bad = _psd_cholesky(np.ascontiguousarray(qk), FACTOR_RTOL)
-        if bad >= 0:
-            raise IndefiniteCovarianceError(f"navigation: Q_k indefinite at t = {prev.t_s} s "
-                                            f"(method {o.method})")
-        self.x = phi @ self.x + L @ noise
+        else:
+            from ._blas import single_thread_blas
+            from .analysis import system_matrix
+            F = system_matrix(prev.lat_rad, prev.alt_m, v, rpy, w_eb, f_b, self.imu, o)
+            with single_thread_blas():
+                phi, qk = discretize(F, np.diag(self.imu.q_psd), dt, method=o.method)
+            L, bad = _psd_cholesky(np.ascontiguousarray(qk), FACTOR_RTOL)
+            if bad >= 0:
+                raise IndefiniteCovarianceError(f"navigation: Q_k indefinite at t = {prev.t_s} s "
+                                                f"(method {o.method})")
+            x = phi @ self.x + L @ noise
+        self.x = x
+        if self.matrices_dt_s > 0:
+            self._held = (prev.t_s, dt, phi, L)
 
     def update(self, truth: AircraftState) -> NavSolution:
         """Advance the error state to ``truth.t_s`` and return truth ⊕ errors."""
@@ -167,8 +190,12 @@ class SinsNavigation:
         rm, rn, _, _ = earth_radii(truth.lat_rad)
         lat = truth.lat_rad + x[1] / (rm + truth.alt_m)
         lon = truth.lon_rad + x[0] / ((rn + truth.alt_m) * math.cos(truth.lat_rad))
-        d_roll, d_pitch, d_head = eps_to_euler_errors(x[6], x[7], x[8], truth.pitch_rad,
-                                                      truth.heading_rad)
+        # paper eq. 6.10 (scalar form of euler.eps_to_euler_errors, kept in math for speed)
+        sp, cp = math.sin(truth.heading_rad), math.cos(truth.heading_rad)
+        a = float(x[6]) * sp + float(x[7]) * cp
+        d_roll = -a / math.cos(truth.pitch_rad)
+        d_pitch = -float(x[6]) * cp + float(x[7]) * sp
+        d_head = float(x[8]) - math.tan(truth.pitch_rad) * a
         errors = {
             "nse_east_m": float(x[0]), "nse_north_m": float(x[1]), "nse_up_m": float(x[2]),
             "ve_err_mps": float(x[3]), "vn_err_mps": float(x[4]), "vu_err_mps": float(x[5]),
