@@ -136,6 +136,15 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
             if lo_at[k] is not None:
                 h = max(h, lo_at[k])
             alt[k] = h if k > 0 else min(h, max(start_alt_m, alt[1]))
+        # forward pass: no steeper than the planned angle where the windows allow staying high
+        for k in range(1, last + 1):
+            ang = descent_angle_deg
+            vpa = path.legs[k - 1].record.vpa_deg
+            if vpa:
+                ang = abs(vpa)
+            floor = alt[k - 1] - math.tan(math.radians(ang)) * (along[k] - along[k - 1])
+            if floor > alt[k]:
+                alt[k] = floor if hi_at[k] is None else min(floor, max(hi_at[k], alt[k]))
     # climb: forward pass, capped by every 'at or below' ahead
     cap = np.full(n + 1, np.inf)
     run = np.inf

@@ -289,8 +289,9 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
                             "R" if omega > 0 else "L", r)
     out = []
     if ok and arc is not None:
-        out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "turn",
-                               seg.speed_mps, 0.0))
+        out.append(PathSegment(arc, seg.leg_index, seg.path_term, seg.fix_ident, "turn",
+                               seg.speed_mps, math.degrees(math.atan(
+                                   seg.speed_mps ** 2 / (r * b.g)))))
         start = arc.end
     else:
         start = (lat, lon)
