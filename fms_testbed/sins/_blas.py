@@ -11,15 +11,18 @@ from __future__ import annotations
 import ctypes
 import re
 from contextlib import contextmanager
+from functools import lru_cache
 
 _SUFFIXES = ("64_", "", "_64")
 
 
+@lru_cache(maxsize=1)
 def _handles():
+    """(get, set) pairs of the loaded OpenBLAS libraries (scanned once; scipy is loaded by then)."""
     try:
         maps = open("/proc/self/maps").read()
     except OSError:
-        return []
+        return ()
     out = []
     for path in sorted(set(re.findall(r"(/\S*openblas\S*\.so\S*)", maps))):
         try:
@@ -36,7 +39,7 @@ def _handles():
             else:
                 continue
             break
-    return out
+    return tuple(out)
 
 
 @contextmanager
