@@ -1,0 +1,138 @@
+"""Fly a real ARINC-424 procedure in JSBSim: build it, start the aircraft on it, fly the closed
+loop with :class:`~fms_testbed.guidance.fms.ProcedureGuidance`, then measure the flight errors.
+
+Start condition (stated plainly, it is a simplification): JSBSim cannot take off here in a
+useful way, so a SID starts **airborne over the departure end of the runway (DER)** at the
+builder's planned start altitude (35 ft above the runway), trimmed straight and level at the
+aircraft's planned climb TAS on the runway heading; the profile then climbs it. STARs and
+approaches start over their first fix at the first coded altitude, on the first segment's
+course. An approach ends at the runway/MAP (the missed approach is not flown). JSBSim's terrain
+is at mean sea level, so height above ground is altitude above MSL.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from .aircraft import load_aircraft
+from .errors import ConfigError
+from .guidance.fms import ProcedureGuidance
+from .guidance.vertical import procedure_law
+from .guidance.procedure import FlyablePath, ProcedureSpec, build_procedure, load_db, \
+    parse_procedure
+from .scenario import Scenario, parse_scenario
+
+MPS_KT = 3600.0 / 1852.0
+
+
+def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
+    """The scenario ``initial`` block for the start of a built path (module docstring)."""
+    seg0 = fp.path.segments[0].geom
+    lat, lon = seg0.start
+    alt = fp.path.legs[0].start.alt_m
+    return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,
+            "tas_mps": cfg.limits.climb_tas_mps, "heading_deg": seg0.start_course_deg % 360.0}
+
+
+def prepare(raw: dict, source: str = "<scenario>", db=None
+            ) -> tuple[Scenario, ProcedureSpec, FlyablePath, Any]:
+    """Validate a scenario mapping that has a ``procedure:`` block and build the procedure.
+
+    ``initial`` defaults to the start of the built path (:func:`initial_from_path`) and
+    ``duration_s`` to 1.6 × the path length at the planned speed + 120 s (guidance ends the
+    flight at the end of the procedure anyway).
+
+    Returns
+    -------
+    (scenario, procedure spec, built procedure, database)
+    """
+    raw = dict(raw)
+    if "procedure" not in raw:
+        raise ConfigError(f"{source}: a procedure flight needs a 'procedure:' block")
+    spec = parse_procedure(raw["procedure"], source)
+    if "aircraft" not in raw:
+        raise ConfigError(f"{source}: field 'aircraft': missing")
+    cfg = load_aircraft(raw["aircraft"])
+    if db is None:
+        base = Path(source).parent if source and not source.startswith("<") else None
+        db = load_db(spec.db, base)
+    fp = build_procedure(db, spec, cfg)
+    raw.setdefault("initial", initial_from_path(fp, cfg))
+    raw.setdefault("duration_s", min(6 * 3600.0, 1.6 * fp.path.length_m()
+                                     / cfg.limits.climb_tas_mps + 120.0))
+    raw.setdefault("name", f"{spec.airport}-{spec.procedure}".lower())
+    raw["procedure"] = spec.model_dump(exclude_none=True)
+    return parse_scenario(raw, source), spec, fp, db
+
+
+def load_procedure_scenario(path: str | Path):
+    """Read a procedure scenario YAML file and :func:`prepare` it."""
+    path = Path(path)
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except FileNotFoundError:
+        raise ConfigError(f"{path}: no such scenario file") from None
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f" line {mark.line + 1}:" if mark else ""
+        raise ConfigError(f"{path}:{where} invalid YAML: {getattr(exc, 'problem', exc)}") from None
+    if not isinstance(raw, dict):
+        raise ConfigError(f"{path}: expected a mapping at the top level")
+    raw.setdefault("name", path.stem)
+    return prepare(raw, str(path))
+
+
+def fly_procedure(scn: Scenario, spec: ProcedureSpec, fp: FlyablePath, db,
+                  out_dir: str | Path | None = None, seed: int | None = None,
+                  plots: bool = True, csv: bool = False, progress: bool | None = None):
+    """Fly a prepared procedure scenario; return :class:`~fms_testbed.runner.RunResult`.
+
+    The summary gains ``procedure`` (what was flown, monitor status, findings), ``errors``
+    (FTE/NSE/PDE/TSE overall and per leg, RNP containment), ``constraints`` (compliance at each
+    constrained fix), ``sequencing`` (legs entered in order, none skipped or repeated) and
+    ``guidance_events``. A flight that leaves the procedure ends with status ``diverged``.
+    """
+    from .flight_errors import flight_errors
+    from .runner import RunResult, fly, write_outputs
+
+    cfg = load_aircraft(scn.aircraft)
+    g = ProcedureGuidance(fp, cfg, db=db, spec=spec)
+    law = procedure_law(cfg) if scn.vertical_law == "coupled" and cfg.coupled_law else None
+    df, summary = fly(scn, cfg=cfg, seed=seed, guidance=g, progress=progress, vertical_law=law)
+    if g.abort_reason:
+        summary["status"], summary["reason"] = "diverged", g.abort_reason
+    elif summary["status"] == "ok" and not g.done:
+        summary["status"] = "incomplete"
+        summary["reason"] = (f"duration {scn.duration_s:.0f} s ended on leg {g.leg + 1} of "
+                             f"{len(fp.seq.legs)}")
+    p = fp.path
+    summary["procedure"] = {
+        "name": p.name, "airport": p.airport, "type": {"D": "SID", "E": "STAR",
+                                                        "F": "APPROACH"}.get(p.proc_type),
+        "procedure": p.proc_id, "transition": p.transition, "start": p.start_kind,
+        "legs": p.leg_types(), "length_nm": round(p.length_m() / 1852.0, 2),
+        "monitor_status": p.status, "navigation": (scn.navigation or {}).get("source", "truth"),
+        "findings": [f"leg {f.leg_index + 1}: {f.category}: {f.message}" for f in p.findings],
+    }
+    summary.update(flight_errors(df, fp, g))
+    summary["guidance_events"] = g.events
+    out = Path(out_dir) if out_dir is not None else None
+    if out is not None:
+        write_outputs(df, summary, out, csv=csv, plots=plots)
+        if plots:
+            from .plots_procedure import plot_procedure
+            summary["plots"] = summary.get("plots", []) + [
+                q.name for q in plot_procedure(df, summary, fp, out, g.rebuilt)]
+        (out / "summary.json").write_text(json.dumps(summary, indent=2, default=_json) + "\n")
+    return RunResult(df=df, summary=summary, out_dir=out)
+
+
+def _json(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return float(x)

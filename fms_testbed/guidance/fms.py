@@ -1,0 +1,391 @@
+"""``ProcedureGuidance``: flies a built ARINC-424 procedure through the runner's Guidance hook.
+
+Every outer step (20 Hz by default) it
+
+1. projects the *navigation* position on the active path piece (local tangent plane, see
+   :mod:`.geometry`) — guidance flies on the navigation solution, so NSE shows in the true track;
+2. sequences pieces/segments/legs when the aircraft passes abeam a piece's end (fly-by arcs are
+   part of the path, so the transition points are the planned ones);
+3. ends a conditional leg (altitude, DME distance, radial) when the condition is actually met —
+   earlier than planned: the rest of the procedure is rebuilt from the aircraft's state
+   (:func:`.procedure.rebuild_from`); later: the leg's last line is flown on beyond its planned
+   end until the condition is met;
+4. commands bank from :func:`.lateral.bank_command_rad` with the curvature of the piece ahead
+   once inside the roll anticipation distance, and altitude/TAS targets from :mod:`.vertical`;
+5. logs ``xtk_m`` (true cross-track, TSE), ``nav_xtk_m`` (FTE), ``leg_index``, ``leg_code`` and
+   the other per-step quantities :mod:`fms_testbed.flight_errors` needs.
+
+Truth is used only for logging, never for control.
+"""
+
+from __future__ import annotations
+
+import bisect
+import logging
+import math
+from dataclasses import dataclass, field
+
+from ..path.geodesy import inverse
+from ..path.segments import Arc, Line, project
+from ..runner import GuidanceOutput
+from .geometry import LocalPiece, local_pieces, radii_m
+from .lateral import LateralGains, anticipation_m, bank_command_rad, feedforward_bank_rad
+from .procedure import FlyablePath, rebuild_from
+from .vertical import altitude_lead_s, cas_band, leg_speed_limits, tas_target_mps
+
+log = logging.getLogger(__name__)
+
+CONDITIONAL = frozenset({"CA", "FA", "VA", "CD", "FD", "VD", "CR", "VR"})
+"""Legs whose end is a condition checked in flight (HA is flown as built)."""
+OVERRUN_MAX_M = 20 * 1852.0
+"""A conditional leg flown this far past its planned end without the condition: give up, m."""
+XTK_ABORT_M = 5 * 1852.0
+"""Cross-track beyond which the flight is declared off the procedure, m."""
+STRAIGHT_MARGIN_M = 2000.0
+
+
+@dataclass
+class _Active:
+    """The path being flown (the whole procedure, or its rest after an in-flight rebuild)."""
+
+    fp: FlyablePath
+    pieces: list[LocalPiece]
+    seg_cum_m: list[float]
+    pde_m: list[float]
+    flat_m: list[tuple[float, float]]
+    prof_s: list[float]
+    prof_h: list[float]
+    climb_tgt: list[float | None]
+    s_base_m: float
+    last_piece_of_leg: dict[int, int] = field(default_factory=dict)
+
+
+def _pde(db, fp: FlyablePath, seg, prev_leg) -> float:
+    """Path definition error of one built segment: largest distance of 5 points of it from the
+    ideal coded path (TF: geodesic between the fixes; CF: the coded course line through the fix;
+    RF: the coded centre and radius), m; NaN where not defined (other legs, transitions)."""
+    if seg.role != "leg":
+        return float("nan")
+    lg = fp.path.legs[seg.leg_index]
+    t = lg.termination
+    g = seg.geom
+    pts = [g.point_at(g.length_m() * k / 4.0) for k in range(5)]
+    if lg.path_term == "TF" and prev_leg is not None and prev_leg.termination.kind == "fix" \
+            and isinstance(g, Line):
+        pt = prev_leg.termination
+        ideal = Line(pt.lat_deg, pt.lon_deg, t.lat_deg, t.lon_deg)
+        return max(abs(project(ideal, *p)[1]) for p in pts)
+    if lg.path_term == "RF" and isinstance(g, Arc) and lg.record.arc_radius_m and db is not None:
+        c = db.find_fix(lg.record.centre, fp.seq.airport)
+        if c is None:
+            return float("nan")
+        return max(abs(inverse(c.lat_deg, c.lon_deg, *p)[0] - lg.record.arc_radius_m)
+                   for p in pts)
+    if lg.path_term == "CF" and isinstance(g, Line) and lg.record.course_deg is not None:
+        from ..path.geodesy import direct
+        crs = g.end_course_deg  # the built course; compare with the coded course line
+        coded = (lg.record.course_deg if lg.record.course_true else
+                 lg.record.course_deg + _magvar(db, fp, lg))
+        back = direct(t.lat_deg, t.lon_deg, coded + 180.0, max(g.length_m(), 1000.0))
+        ideal = Line(back[0], back[1], t.lat_deg, t.lon_deg)
+        del crs
+        return max(abs(project(ideal, *p)[1]) for p in pts)
+    return float("nan")
+
+
+def _magvar(db, fp, lg) -> float:
+    nav = db.find_fix(lg.record.navaid, fp.seq.airport) if db is not None else None
+    if nav is not None and nav.section in ("D ", "PI"):
+        return nav.magvar_deg
+    apt = db.airports.get(fp.seq.airport) if db is not None else None
+    return apt.magvar_deg if apt else 0.0
+
+
+def climb_targets(prof) -> list[float | None]:
+    """Per profile node j: in a climb phase (``prof.climb[j]``), the altitude to climb to at
+    the law's level-change rate while flying toward node j — the highest planned altitude of the
+    rest of that climb phase, capped by every 'at or below'/'at' constraint ahead in it, m
+    (None outside climb phases, where the planned profile itself is flown)."""
+    n = len(prof.along_m)
+    hi = [None] * n
+    for w in prof.windows:
+        if w.hi_m is not None and w.leg_index + 1 < n:
+            hi[w.leg_index + 1] = w.hi_m
+    out: list[float | None] = [None] * n
+    run_max, run_cap = -math.inf, math.inf
+    for j in range(n - 1, -1, -1):
+        if not bool(prof.climb[j]):
+            run_max, run_cap = -math.inf, math.inf
+            continue
+        run_max = max(run_max, float(prof.alt_m[j]))
+        if hi[j] is not None:
+            run_cap = min(run_cap, hi[j])
+        out[j] = min(run_max, run_cap)
+    return out
+
+
+def _activate(fp: FlyablePath, db, s_base_m: float) -> _Active:
+    segs = fp.path.segments
+    geoms = [s.geom for s in segs]
+    pieces = local_pieces(geoms)
+    cum, s = [], 0.0
+    for g in geoms:
+        cum.append(s)
+        s += g.length_m()
+    pde = []
+    for k, sg in enumerate(segs):
+        prev = fp.path.legs[sg.leg_index - 1] if sg.leg_index > 0 else None
+        try:
+            pde.append(_pde(db, fp, sg, prev))
+        except Exception:  # noqa: BLE001 - a PDE that cannot be evaluated is undefined, not fatal
+            pde.append(float("nan"))
+    # straight-flight distance from the previous and to the next curvature change, per segment
+    is_line = [isinstance(g, Line) for g in geoms]
+    before, after = [0.0] * len(segs), [0.0] * len(segs)
+    run = 0.0
+    for k in range(len(segs)):
+        run = run if (k > 0 and is_line[k - 1]) else 0.0
+        before[k] = run if is_line[k] else 0.0
+        run = run + geoms[k].length_m() if is_line[k] else 0.0
+    run = 0.0
+    for k in range(len(segs) - 1, -1, -1):
+        run = run if (k < len(segs) - 1 and is_line[k + 1]) else 0.0
+        after[k] = run if is_line[k] else 0.0
+        run = run + geoms[k].length_m() if is_line[k] else 0.0
+    prof = fp.path.profile
+    climb_tgt = climb_targets(prof)
+    last = {}
+    for i, p in enumerate(pieces):
+        last[segs[p.seg_index].leg_index] = i
+    return _Active(fp, pieces, cum, pde, list(zip(before, after)),
+                   [float(x) for x in prof.along_m], [float(x) for x in prof.alt_m], climb_tgt,
+                   s_base_m, last)
+
+
+class ProcedureGuidance:
+    """Guidance that flies a :class:`~.procedure.FlyablePath` (implements the runner's
+    ``Guidance`` protocol: ``update(dt_s, nav, truth) -> GuidanceOutput``).
+
+    Parameters
+    ----------
+    fp : the built procedure
+    cfg : aircraft configuration (bank limit, roll rate, minimum speed, coupled-law timing)
+    db : the database it came from (in-flight rebuilds, PDE); spec : its ProcedureSpec
+    gains : lateral tuning (default: :meth:`LateralGains.for_aircraft`)
+
+    Attributes
+    ----------
+    events : list of dicts (t_s, kind 'leg' | 'rebuild' | 'condition' | 'abort', leg, detail)
+    legs_sequenced : global leg indices in the order they became active
+    abort_reason : why guidance stopped early ('' when it did not)
+    rebuilt : the paths rebuilt in flight (rest of the procedure), in order
+    """
+
+    def __init__(self, fp: FlyablePath, cfg, db=None, spec=None, gains: LateralGains | None = None):
+        self.whole = fp
+        self.cfg, self.db, self.spec = cfg, db, spec
+        self.gains = gains or LateralGains.for_aircraft(cfg)
+        self.act = _activate(fp, db, 0.0)
+        self.i = 0
+        self.leg = -1
+        self.events: list[dict] = []
+        self.legs_sequenced: list[int] = []
+        self.abort_reason = ""
+        self.lead_s = altitude_lead_s(cfg)
+        self.limits = leg_speed_limits(fp.seq.legs)
+        self.carry_max_cas: float | None = None
+        self.descent = fp.path.proc_type in ("E", "F")
+        self.tas_cmd = cfg.limits.climb_tas_mps
+        self.next_speed_t = -1.0
+        self.cond_start: tuple | None = None
+        self.done = False
+        self.rebuilt: list[FlyablePath] = []
+
+    # ------------------------------------------------------------------ helpers
+    def _global_leg(self, piece_i: int) -> int:
+        a = self.act
+        return a.fp.leg_offset + a.fp.path.segments[a.pieces[piece_i].seg_index].leg_index
+
+    def _enter_leg(self, t_s: float, g: int) -> None:
+        if g == self.leg:
+            return
+        for k in range(self.leg + 1, g + 1):  # every leg entered once, in order
+            self.legs_sequenced.append(k)
+            self.events.append({"t_s": t_s, "kind": "leg", "leg": k,
+                                "code": self.whole.seq.legs[k].path_term})
+            lim = self.limits[k] if k < len(self.limits) else None
+            if self.descent and lim is not None and lim.desc in ("", "@", "-"):
+                c = lim.cas_mps
+                self.carry_max_cas = c if self.carry_max_cas is None else min(self.carry_max_cas, c)
+        self.leg = g
+        self.cond_start = None
+        self.next_speed_t = -1.0
+
+    def _condition(self, bl, lat: float, lon: float, alt_m: float) -> bool:
+        t = bl.termination
+        if t.kind == "altitude":
+            return alt_m >= t.alt_m
+        if t.navaid_lat_deg is None:
+            return False
+        la0, lo0 = math.radians(t.navaid_lat_deg), math.radians(t.navaid_lon_deg)
+        m0, n0 = radii_m(la0)
+        x = (lon - lo0) * n0 * math.cos(0.5 * (lat + la0))
+        y = (lat - la0) * m0
+        if t.kind == "dme":
+            d = math.hypot(x, y) - t.dme_m
+        elif t.kind == "radial":
+            d = ((math.degrees(math.atan2(x, y)) - t.radial_deg + 180.0) % 360.0) - 180.0
+        else:
+            return False
+        if self.cond_start is None:
+            self.cond_start = (d,)
+            return False
+        return d * self.cond_start[0] <= 0.0
+
+    def _df_fix_passed(self, k: int, lat: float, lon: float, trk: float) -> bool:
+        """True when leg ``k`` is a DF whose fix is behind or abeam the aircraft within a turn
+        diameter, or within 0.3 NM: a direct-to would loop back; the fix counts as passed."""
+        legs = self.whole.path.legs
+        if k >= len(legs) or legs[k].path_term != "DF" or legs[k].termination.lat_deg is None:
+            return False
+        t = legs[k].termination
+        la0, lo0 = math.radians(t.lat_deg), math.radians(t.lon_deg)
+        m0, n0 = radii_m(la0)
+        x = (lo0 - lon) * n0 * math.cos(0.5 * (lat + la0))
+        y = (la0 - lat) * m0
+        d = math.hypot(x, y)
+        rel = abs((math.atan2(x, y) - trk + math.pi) % (2 * math.pi) - math.pi)
+        v = self.cfg.limits.climb_tas_mps
+        r = v * v / (9.80665 * math.tan(math.radians(20.0)))
+        return d < 0.3 * 1852.0 or (rel > math.radians(60.0) and d < 2.0 * r)
+
+    def _rebuild(self, t_s: float, g_leg: int, lat: float, lon: float, trk: float, alt: float,
+                 s_now: float) -> bool:
+        nxt = g_leg + 1
+        while nxt < len(self.whole.seq.legs) and self._df_fix_passed(nxt, lat, lon, trk):
+            self.events.append({"t_s": t_s, "kind": "condition", "leg": nxt,
+                                "detail": "DF fix already passed when the previous leg ended"})
+            self._enter_leg(t_s, nxt)
+            nxt += 1
+        if nxt >= len(self.whole.seq.legs):
+            return False
+        fp = None
+        if self.db is not None and self.spec is not None:
+            fp = rebuild_from(self.db, self.whole, self.spec, self.cfg, nxt, math.degrees(lat),
+                              math.degrees(lon), math.degrees(trk) % 360.0, alt)
+        if fp is None:
+            return False
+        self.act = _activate(fp, self.db, s_now)
+        self.rebuilt.append(fp)
+        self.i = 0
+        self.events.append({"t_s": t_s, "kind": "rebuild", "leg": nxt,
+                            "detail": f"rest of the procedure rebuilt from the aircraft state "
+                                      f"({len(fp.path.segments)} segments)"})
+        return True
+
+    def _abort(self, t_s: float, why: str) -> GuidanceOutput:
+        self.abort_reason = why
+        self.events.append({"t_s": t_s, "kind": "abort", "leg": self.leg, "detail": why})
+        self.done = True
+        return GuidanceOutput(done=True)
+
+    # ------------------------------------------------------------------ the step
+    def update(self, dt_s: float, nav, truth) -> GuidanceOutput:
+        """One guidance step: bank command, altitude and TAS targets, done flag, log (module
+        docstring)."""
+        if self.done:
+            return GuidanceOutput(done=True)
+        a = self.act
+        lat, lon = nav.lat_rad, nav.lon_rad
+        v = nav.v_enu_mps
+        ve, vn = float(v[0]), float(v[1])
+        gs = math.hypot(ve, vn)
+        trk = math.atan2(ve, vn)
+        p = a.pieces[self.i]
+        along, xtk, dtrk = p.project(lat, lon)
+        g_leg = self._global_leg(self.i)
+        self._enter_leg(nav.t_s, g_leg)
+        # conditional leg: ended in flight when the condition is met
+        seg = a.fp.path.segments[p.seg_index]
+        bl = a.fp.path.legs[seg.leg_index]
+        if bl.path_term in CONDITIONAL:
+            if self._condition(bl, lat, lon, nav.alt_m):
+                self.events.append({"t_s": nav.t_s, "kind": "condition", "leg": g_leg,
+                                    "detail": f"{bl.termination.kind} condition met"})
+                s_now = a.s_base_m + a.seg_cum_m[p.seg_index] + p.s0_m + along
+                if self._rebuild(nav.t_s, g_leg, lat, lon, trk, nav.alt_m, s_now):
+                    return self.update(dt_s, nav, truth)
+                nxt = a.last_piece_of_leg[seg.leg_index] + 1
+                if nxt >= len(a.pieces):
+                    self.done = True
+                    return GuidanceOutput(done=True)
+                self.i = nxt
+                return self.update(dt_s, nav, truth)
+            hold = self.i == a.last_piece_of_leg[seg.leg_index]
+            if hold and along > p.length_m + OVERRUN_MAX_M:
+                self.events.append({"t_s": nav.t_s, "kind": "condition", "leg": g_leg,
+                                    "detail": f"{bl.termination.kind} condition not met "
+                                              f"{OVERRUN_MAX_M / 1852:.0f} NM past the plan"})
+                hold = False
+        else:
+            hold = False
+        # sequencing: abeam the end of the piece
+        if along >= p.length_m and not hold:
+            if self.i + 1 >= len(a.pieces):
+                self.done = True
+                return GuidanceOutput(done=True, log=self._log(p, along, xtk, xtk, seg, nav,
+                                                               truth, g_leg, float("nan")))
+            self.i += 1
+            return self.update(dt_s, nav, truth)
+        if abs(xtk) > XTK_ABORT_M:
+            return self._abort(nav.t_s, f"off the procedure: cross-track {xtk / 1852:.1f} NM "
+                               f"on leg {g_leg + 1} ({bl.path_term})")
+        # lateral
+        kappa = p.curvature_1pm
+        if self.i + 1 < len(a.pieces) and not hold:
+            k2 = a.pieces[self.i + 1].curvature_1pm
+            if k2 != kappa:
+                dphi = feedforward_bank_rad(gs, k2) - feedforward_bank_rad(gs, kappa)
+                if p.length_m - along < anticipation_m(gs, dphi, self.gains):
+                    kappa = k2
+        terr = (trk - dtrk + math.pi) % (2 * math.pi) - math.pi
+        bank = bank_command_rad(xtk, terr, gs, kappa, self.gains)
+        # vertical
+        s_path = a.seg_cum_m[p.seg_index] + p.s0_m + along
+        s_ahead = s_path + gs * self.lead_s
+        ps, ph = a.prof_s, a.prof_h
+        j = bisect.bisect_right(ps, s_ahead)
+        if j <= 0:
+            alt_cmd = ph[0]
+        elif j >= len(ps):
+            alt_cmd = ph[-1]
+        else:
+            f = (s_ahead - ps[j - 1]) / max(ps[j] - ps[j - 1], 1e-9)
+            alt_cmd = ph[j - 1] + f * (ph[j] - ph[j - 1])
+        jn = bisect.bisect_right(ps, s_path)
+        if 0 < jn < len(ps) and a.climb_tgt[jn] is not None:  # climb: at the law's rate
+            alt_cmd = max(alt_cmd, a.climb_tgt[jn])
+        if nav.t_s >= self.next_speed_t:
+            lim = self.limits[g_leg] if g_leg < len(self.limits) else None
+            lo, hi = cas_band(lim, self.carry_max_cas if self.descent else None)
+            self.tas_cmd = tas_target_mps(self.cfg.limits.climb_tas_mps, nav.alt_m, lo, hi,
+                                          self.cfg.limits.cas_min_mps)
+            self.next_speed_t = nav.t_s + 1.0
+        return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=self.tas_cmd,
+                              log=self._log(p, along, xtk, None, seg, nav, truth, g_leg, s_path))
+
+    def _log(self, p: LocalPiece, along: float, nav_xtk: float, true_xtk, seg, nav, truth,
+             g_leg: int, s_path: float) -> dict:
+        a = self.act
+        if true_xtk is None:
+            _, true_xtk, _ = p.project(truth.lat_rad, truth.lon_rad)
+        s_seg = p.s0_m + along
+        b, f = a.flat_m[p.seg_index]
+        flat = 0.0 if p.is_arc else min(
+            b + s_seg, f + a.fp.path.segments[p.seg_index].geom.length_m() - s_seg)
+        return {"xtk_m": true_xtk, "nav_xtk_m": nav_xtk, "leg_index": g_leg,
+                "leg_code": seg.path_term, "seg_role": seg.role,
+                "along_m": a.s_base_m + (s_path if s_path == s_path else 0.0),
+                "curvature_1pm": p.curvature_1pm, "straight_m": flat,
+                "pde_m": a.pde_m[p.seg_index], "rnp_m": a.fp.rnp_m[seg.leg_index]
+                if seg.leg_index < len(a.fp.rnp_m) else float("nan")}
