@@ -74,6 +74,8 @@ def cmd_compare(args) -> int:
     bad = [x for x in laws if x not in VERTICAL_LAWS]
     if bad:
         raise UserError(f"--laws: unknown law(s) {', '.join(bad)}; known: {', '.join(VERTICAL_LAWS)}")
+    if args.envelope:
+        return _compare_envelope(args, laws)
     names = args.scenarios or list(DEFAULT_SCENARIOS)
     overrides = {"aircraft": args.aircraft} if args.aircraft else None
     scns = [load_scenario(_scenario_path(n), overrides) for n in names]
@@ -116,6 +118,28 @@ def cmd_compare(args) -> int:
         print("\nGoals:\n" + gl)
     print(f"\nwritten to {out}/ (comparison.csv, comparison.md, *.png, *.parquet)")
     return 0 if all(g.ok for g in goals) else 1
+
+
+def _compare_envelope(args, laws) -> int:
+    """``compare --envelope``: +100 m and +10 % steps at every envelope point of each aircraft."""
+    from .aircraft import list_aircraft
+    from .control.compare import envelope_rows
+
+    if args.scenarios:
+        raise UserError("compare --envelope takes no scenarios (it builds its own steps)")
+    names = [args.aircraft] if args.aircraft else list_aircraft()
+    rows = []
+    for name in names:
+        rows.extend(envelope_rows(load_aircraft(name), laws, seed=args.seed))
+    table = pd.DataFrame(rows)
+    out = _out_dir(args.out, "envelope")
+    out.mkdir(parents=True, exist_ok=True)
+    table.to_csv(out / "envelope.csv", index=False)
+    md = markdown_table(table)
+    (out / "envelope.md").write_text(f"# Coupled law across the envelope\n\n{md}\n")
+    print(md)
+    print(f"\nwritten to {out}/ (envelope.csv, envelope.md)")
+    return 0
 
 
 # --- analyse -----------------------------------------------------------------------------------
@@ -254,6 +278,9 @@ def register(subparsers) -> None:
     p.add_argument("--laws", default="coupled,pi,tecs", help="comma-separated laws")
     p.add_argument("--paper-plot", action="store_true",
                    help="also draw every scenario in the paper's Fig. 2 layout")
+    p.add_argument("--envelope", action="store_true",
+                   help="instead: +100 m and +10 %% speed steps at every envelope point of every "
+                        "aircraft (or --aircraft)")
     p.add_argument("--no-small-step", dest="small_step", action="store_false",
                    help="skip the extra 100 m (unclipped) altitude step")
     p.add_argument("--seed", type=int, default=0)

@@ -107,3 +107,12 @@ def test_writing_gains_replaces_a_block_style_section(tmp_path):
     write_gains_to_config(f, CoupledLawParams(T_V_s=8.0, xi_V=1.0, T_H_s=9.0, xi_H=1.0))
     d = yaml.safe_load(f.read_text())
     assert d["coupled_law"]["T_V_s"] == 8.0 and d["other"] == 1 and d["name"] == "x"
+
+
+def test_compare_envelope_covers_every_envelope_point(tmp_path):
+    out = tmp_path / "env"
+    assert main(["compare", "--envelope", "--aircraft", "c172p", "--laws", "coupled",
+                 "--out", str(out)]) == 0
+    table = pd.read_csv(out / "envelope.csv")
+    assert len(table) == len(load_aircraft_file(aircraft_dir() / "c172p.yaml").envelope)
+    assert (table["speed_step_max_dH_m"] <= 1.5).all()

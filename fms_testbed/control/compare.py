@@ -199,3 +199,52 @@ def check_goals(table: pd.DataFrame, params: CoupledLawParams) -> list[Goal]:
                 goals.append(Goal(f"{c['scenario']} ({c['step']}): settling vs pure 2nd order "
                                   f"({ref:.1f} s)", d2, 20.0, "%", d2 <= 20.0))
     return goals
+
+
+def envelope_scenario(cfg: AircraftConfig, alt_m: float, tas_mps: float, kind: str,
+                      duration_s: float = 100.0) -> Scenario:
+    """An unclipped step at an envelope point: +100 m (``kind="alt"``) or +10 % TAS."""
+    from ..scenario import parse_scenario
+
+    ev = ({"t_s": 5.0, "alt_m": alt_m + 100.0} if kind == "alt"
+          else {"t_s": 5.0, "tas_mps": 1.1 * tas_mps})
+    return parse_scenario({
+        "name": f"{cfg.name}-{alt_m:.0f}m-{tas_mps * 3.6:.0f}kmh-{kind}",
+        "aircraft": cfg.source_file or cfg.name, "duration_s": duration_s, "hold": True,
+        "initial": {"alt_m": alt_m, "tas_mps": tas_mps, "lat_deg": 47.0, "heading_deg": 90.0},
+        "events": [ev]}, f"<envelope {cfg.name}>")
+
+
+def envelope_rows(cfg: AircraftConfig, laws: tuple[str, ...] = ("coupled", "pi"),
+                  seed: int | None = None) -> list[dict]:
+    """Fly +100 m and +10 % speed steps at every envelope point of ``cfg`` with each law.
+
+    Returns one row per (point, law) with settling (s), overshoot (%), the cross deviation
+    (km/h in the altitude step, m in the speed step) and the throttle-saturation share (%).
+    """
+    from ..runner import fly
+
+    params = params_from_config(cfg)
+    lo, hi = cfg.inner_loops.throttle_min, cfg.inner_loops.throttle_max
+    rows = []
+    for pt in cfg.envelope:
+        for law in laws:
+            row = {"aircraft": cfg.name, "alt_m": pt.alt_m, "tas_kmh": pt.tas_mps * 3.6,
+                   "law": law}
+            for kind in ("alt", "speed"):
+                scn = envelope_scenario(cfg, pt.alt_m, pt.tas_mps, kind)
+                df, summary = fly(scn, cfg=cfg, seed=seed,
+                                  vertical_law=VERTICAL_LAWS[law](params=params), progress=False)
+                if summary["status"] != "ok":
+                    row[f"{kind}_status"] = summary["reason"]
+                    continue
+                m = step_metrics(df, kind, throttle_min=lo, throttle_max=hi)
+                row[f"{kind}_settling_s"] = m.settling_s
+                row[f"{kind}_overshoot_pct"] = m.overshoot_pct
+                row[f"{kind}_sat_pct"] = 100.0 * m.throttle_sat_frac
+                if kind == "alt":
+                    row["alt_step_max_dV_kmh"] = m.max_cross_dev * KMH_PER_MPS
+                else:
+                    row["speed_step_max_dH_m"] = m.max_cross_dev
+            rows.append(row)
+    return rows
