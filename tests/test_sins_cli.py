@@ -99,3 +99,10 @@ def test_covariance_and_monte_carlo_agree_along_a_flight():
     z = (mc.sigma[-1][live] / cov.sigma[-1][live] - 1) / math.sqrt(1 / (2 * 2000))
     assert np.all(np.abs(z) < 4), z
     assert mc.h95_m[-1] == pytest.approx(cov.h95_m[-1], rel=0.06)
+
+
+def test_non_finite_values_are_reported_with_row_and_column():
+    df = pd.DataFrame({c: [0.0, 1.0, 2.0] for c in REQUIRED_COLUMNS})
+    df.loc[2, "fz_mps2"] = float("nan")
+    with pytest.raises(UserError, match="row 2: column fz_mps2"):
+        from_dataframe(df)

@@ -135,3 +135,27 @@ def test_bad_arguments_raise_user_errors():
         discretize(np.zeros((1, 1)), np.zeros((1, 1)), 0.1, method="euler")
     with pytest.raises(DiscretisationError, match="dt"):
         discretize(np.zeros((1, 1)), np.zeros((1, 1)), 0.0)
+
+
+def test_discretize_is_exported_as_a_package_function():
+    import fms_testbed.sins as sins
+    phi, qk = sins.discretize(np.zeros((1, 1)), np.eye(1), 0.1)
+    assert phi[0, 0] == 1.0 and qk[0, 0] == pytest.approx(0.1)
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=40, deadline=None)
+@given(st.integers(0, 10_000), st.integers(2, 8), st.floats(0.001, 0.1))
+def test_picard_matches_van_loan_for_random_models(seed, n, dt):
+    rng = np.random.default_rng(seed)
+    F = rng.normal(size=(n, n)) * 0.5
+    F -= np.diag(np.diag(F))                                 # keep Δt·|F_ii| inside the range
+    F += np.diag(-rng.uniform(0, 0.9, n))
+    G = rng.normal(size=(n, n))
+    Q = G @ G.T
+    phi, qk = discretize(F, Q, dt)
+    phi_v, qk_v = discretize(F, Q, dt, method="vanloan")
+    assert rel(phi, phi_v) <= 1e-12 and rel(qk, qk_v) <= 1e-12

@@ -75,6 +75,11 @@ def from_dataframe(df, where: str = "timeseries") -> Trajectory:
         raise UserError(f"{where}: missing column(s) {', '.join(missing)} needed by the SINS model")
     if len(df) < 2:
         raise UserError(f"{where}: needs at least 2 rows, has {len(df)}")
+    for c in REQUIRED_COLUMNS:
+        bad_rows = np.flatnonzero(~np.isfinite(df[c].to_numpy(float)))
+        if bad_rows.size:
+            raise UserError(f"{where}: row {bad_rows[0]}: column {c} is not a finite number "
+                            f"({bad_rows.size} such rows)")
     t = df["t_s"].to_numpy(float)
     bad = np.flatnonzero(np.diff(t) <= 0)
     if bad.size:
