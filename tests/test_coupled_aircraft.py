@@ -79,3 +79,28 @@ def test_holding_flight_east_has_no_steady_altitude_offset():
     tail = df[df["t_s"] > 80.0]
     assert abs((tail["alt_m"] - tail["cmd_alt_m"]).mean()) < 0.25
     assert abs((tail["tas_mps"] - tail["cmd_tas_mps"]).mean()) * 3.6 < 0.1
+
+
+def _steep_descent(protect: bool):
+    from dataclasses import replace
+
+    from fms_testbed.control import CoupledLaw
+
+    # dH limit 400 m: the law asks for V_y = 400 / (2 ξ_H T_H) ≈ 25 m/s, more than idle allows
+    p = replace(params_from_config(load_aircraft("737")), dH_limit_m=400.0,
+                speed_protection=protect)
+    scn = {"name": "steep-descent", "aircraft": "737", "duration_s": 200.0, "hold": True,
+           "initial": {"alt_m": 5000.0, "tas_kmh": 450.0, "lat_deg": 47.0, "heading_deg": 90.0},
+           "events": [{"t_s": 5, "alt_m": 3000.0}]}
+    r = run_scenario(scn, plots=False, overrides={"vertical_law_instance": CoupledLaw(params=p)})
+    assert r.summary["status"] == "ok", r.summary["reason"]
+    return r.df
+
+
+def test_no_overspeed_in_an_idle_descent_on_jsbsim():
+    prot, raw = _steep_descent(True), _steep_descent(False)
+    dv = (prot["tas_mps"] - prot["cmd_tas_mps"]) * 3.6
+    assert (prot["throttle"] <= 0.005).mean() > 0.5            # the descent is flown at idle
+    assert dv.max() < 2.0 and dv.min() > -3.0                   # km/h
+    assert ((raw["tas_mps"] - raw["cmd_tas_mps"]) * 3.6).max() > 50.0
+    assert prot["vs_mps"].min() > raw["vs_mps"].min() + 5.0     # it gave up descent rate instead
