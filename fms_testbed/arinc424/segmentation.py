@@ -254,9 +254,10 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         # end the arc exactly where the next line resumes
         fixed = _retarget_arc(arc, t2)
         out[-1] = replace(out[-1], geom=fixed)
-        out.append(replace(seg, geom=Line(*fixed.end, seg.geom.end_lat_deg,
-                                          seg.geom.end_lon_deg)))
-        trim_prev = 0.0
+        rest = Line(*fixed.end, seg.geom.end_lat_deg, seg.geom.end_lon_deg)
+        if rest.length_m() >= 0.01:
+            out.append(replace(seg, geom=rest))
+        trim_prev = 0.0  # out[-1] is already the trimmed line
     return out
 
 
