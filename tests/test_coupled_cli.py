@@ -116,3 +116,18 @@ def test_compare_envelope_covers_every_envelope_point(tmp_path):
     table = pd.read_csv(out / "envelope.csv")
     assert len(table) == len(load_aircraft_file(aircraft_dir() / "c172p.yaml").envelope)
     assert (table["speed_step_max_dH_m"] <= 1.5).all()
+
+
+def test_tune_quick_on_jsbsim_does_not_worsen_the_cost_and_writes_the_file(tmp_path):
+    cfg_file = tmp_path / "737.yaml"
+    shutil.copy(aircraft_dir() / "737.yaml", cfg_file)
+    out = tmp_path / "tune"
+    assert main(["tune", "--aircraft", str(cfg_file), "--quick", "--write", "--out", str(out)]) == 0
+    hist = pd.read_csv(out / "history.csv")
+    assert len(hist) <= 8
+    assert hist["cost"].min() <= hist["cost"].iloc[0]
+    best = hist.loc[hist["cost"].idxmin()]
+    written = load_aircraft_file(cfg_file).coupled_law
+    assert written.T_V_s == pytest.approx(best["T_V_s"], abs=0.006)
+    assert written.xi_H == pytest.approx(best["xi_H"], abs=0.006)
+    assert "identified inner-loop lags" in (out / "report.md").read_text().lower()
