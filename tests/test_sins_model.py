@@ -178,3 +178,30 @@ def test_white_noise_growth_matches_short_time_formulas():
     assert P[3, 3] == pytest.approx(n_a ** 2 * t + g ** 2 * n_g ** 2 * t ** 3 / 3, rel=0.01)
     assert P[0, 0] == pytest.approx(n_a ** 2 * t ** 3 / 3 + g ** 2 * n_g ** 2 * t ** 5 / 20,
                                     rel=0.01)
+
+
+def test_stationary_alignment_nulls_level_and_gyrocompass_rates():
+    from fms_testbed.sins.model import alignment_map, earth_rate_enu
+    from fms_testbed.sins.presets import load_imu
+
+    imu = load_imu("STIM300")
+    lat, c = 0.8, dcm_body_to_enu(0.02, 0.05, 1.2)
+    g = -gravity_up(lat, 0.0)[0]
+    F = build_F(lat, 0.0, np.zeros(3), c.T @ np.array([0, 0, g]), c.T @ earth_rate_enu(lat), c,
+                imu.decay_rps, 0.0, 0.0)
+    z = np.sqrt(imu.p0_var) * np.random.default_rng(0).standard_normal(33)
+    x0 = alignment_map(lat, c, imu.decay_rps) @ z
+    rate = F @ x0
+    assert np.abs(rate[3:5]).max() < 1e-15                    # levelled: no horizontal δV'
+    assert abs(rate[6]) < 1e-18                               # gyrocompassed: no east ε'
+    assert np.abs((F @ z)[3:5]).max() > 1e-3                  # unaligned: biases drive δV
+
+
+def test_aligned_stationary_ins_has_no_bias_schuler_bowl():
+    from fms_testbed.sins.model import alignment_map
+    F, c, g = _stationary_F()
+    x0 = np.zeros(33)
+    x0[9] = 9.80665e-3                                        # 1 mg east accelerometer bias
+    x0 = alignment_map(math.radians(45.0), c, DECAY) @ x0
+    _, x = _propagate(F, x0, 3600.0)
+    assert np.abs(x[:, 0]).max() < 1.0                        # vs 12.7 km unaligned

@@ -17,13 +17,15 @@ from scipy.optimize import brentq
 
 from ..errors import UserError
 from .discretize import METHODS, discretize, discretize_sins
-from .model import N_STATES, baro_gains, build_F, dcm_body_to_enu, earth_rate_enu
+from .model import (N_STATES, alignment_map, baro_gains, build_F, dcm_body_to_enu,
+                    earth_rate_enu)
 from .presets import ImuModel
 from ._blas import single_thread_blas
 from .simulate import factor_psd
 from .trajectory import Trajectory
 
 VERTICAL_MODES = ("baro", "free")
+ALIGNMENT_MODES = ("stationary", "none")
 
 
 @dataclass(frozen=True)
@@ -34,12 +36,15 @@ class SinsOptions:
     tol: relative tolerance of the adaptive Picard order
     vertical: ``baro`` (vertical channel damped by a critically damped baro loop of time constant
         ``baro_tau_s``, s; the baro error itself is not modelled) or ``free`` (unstable, physics)
+    alignment: ``stationary`` (initial attitude errors from a self-alignment at the start attitude
+        and latitude, :func:`~.model.alignment_map`) or ``none`` (all initial errors independent)
     """
 
     method: str = "picard"
     tol: float = 1e-12
     vertical: str = "baro"
     baro_tau_s: float = 60.0
+    alignment: str = "stationary"
 
     def __post_init__(self):
         if self.method not in METHODS:
@@ -47,6 +52,9 @@ class SinsOptions:
         if self.vertical not in VERTICAL_MODES:
             raise UserError(f"navigation.vertical: {self.vertical!r} is not one of "
                             f"{', '.join(VERTICAL_MODES)}")
+        if self.alignment not in ALIGNMENT_MODES:
+            raise UserError(f"navigation.alignment: {self.alignment!r} is not one of "
+                            f"{', '.join(ALIGNMENT_MODES)}")
         if not self.baro_tau_s > 0:
             raise UserError(f"navigation.baro_tau_s: must be > 0 s, got {self.baro_tau_s!r}")
 
@@ -66,6 +74,13 @@ def step_discrete(F: np.ndarray, imu: ImuModel, dt_s: float, opts: SinsOptions):
     if opts.method == "picard":
         return discretize_sins(F, imu.q_psd, dt_s, tol=opts.tol)
     return discretize(F, np.diag(imu.q_psd), dt_s, method=opts.method)
+
+
+def initial_map(lat_rad: float, rpy_rad, imu: ImuModel, opts: SinsOptions) -> np.ndarray:
+    """A with x0 = A z, z ~ N(0, diag(imu.p0_var)): identity, or the stationary alignment map."""
+    if opts.alignment == "none":
+        return np.eye(N_STATES)
+    return alignment_map(float(lat_rad), dcm_body_to_enu(*rpy_rad), imu.decay_rps)
 
 
 def _discrete_steps(traj: Trajectory, imu: ImuModel, opts: SinsOptions):
@@ -125,8 +140,10 @@ class CovarianceResult:
 
 def covariance_run(traj: Trajectory, imu: ImuModel, opts: SinsOptions = SinsOptions(),
                    store_every_s: float = 1.0) -> CovarianceResult:
-    """Propagate P along ``traj`` from P0 = diag(imu.p0_var); store every ``store_every_s`` s."""
-    P = np.diag(imu.p0_var).astype(float)
+    """Propagate P along ``traj`` from P0 = A diag(imu.p0_var) Aᵀ (A: :func:`initial_map`);
+    store every ``store_every_s`` s."""
+    A = initial_map(traj.lat_rad[0], traj.rpy_rad[0], imu, opts)
+    P = A @ np.diag(imu.p0_var) @ A.T
     t, sig, h95, v95 = [], [], [], []
     next_store = traj.t_s[0]
 
@@ -184,12 +201,14 @@ def montecarlo_run(traj: Trajectory, imu: ImuModel, n_real: int = 1000, seed: in
                    n_keep: int = 20) -> MonteCarloResult:
     """Vectorised Monte-Carlo of ``n_real`` realisations along ``traj`` (reproducible from ``seed``).
 
-    x_0 ~ N(0, diag(imu.p0_var)); each step X ← Φ X + S N, S Sᵀ = Q_k (:func:`factor_psd`).
+    x_0 = A z, z ~ N(0, diag(imu.p0_var)) (A: :func:`initial_map`); each step X ← Φ X + S N,
+    S Sᵀ = Q_k (:func:`factor_psd`).
     """
     if n_real < 2:
         raise UserError(f"Monte-Carlo needs at least 2 realisations, got {n_real}")
     rng = np.random.default_rng(seed)
-    X = np.sqrt(imu.p0_var)[:, None] * rng.standard_normal((N_STATES, n_real))
+    X = initial_map(traj.lat_rad[0], traj.rpy_rad[0], imu, opts) @ (
+        np.sqrt(imu.p0_var)[:, None] * rng.standard_normal((N_STATES, n_real)))
     n_keep = min(n_keep, n_real)
     t, sig, h95, v95, keep = [], [], [], [], []
     next_store = traj.t_s[0]

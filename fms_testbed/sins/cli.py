@@ -52,7 +52,8 @@ def _handler(args) -> int:
     if not args.dt_s > 0:
         raise UserError(f"--dt-s: must be > 0, got {args.dt_s}")
     imu = load_imu(args.imu)
-    opts = SinsOptions(method=args.method, vertical=args.vertical, baro_tau_s=args.baro_tau_s)
+    opts = SinsOptions(method=args.method, vertical=args.vertical, baro_tau_s=args.baro_tau_s,
+                       alignment=args.alignment)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     traj = _trajectory(args).resample(args.dt_s)
@@ -76,7 +77,7 @@ def _handler(args) -> int:
         table["h95_cov_m"], table["v95_cov_m"] = ct["h95_m"].to_numpy(), ct["v95_m"].to_numpy()
     table.to_csv(out / "ins_p95_table.csv", index=False)
     title = (f"{imu.name} along {traj.label} — {args.mode}, vertical {args.vertical}, "
-             f"{args.method}")
+             f"alignment {args.alignment}, {args.method}")
     plots = [plot_envelopes(cov, mc, out, "position", title),
              plot_envelopes(cov, mc, out, "attitude", title), plot_p95(results, out, title)]
     print(f"{imu.summary()}; covariance {t_cov:.1f} s")
@@ -99,6 +100,9 @@ def register(subparsers) -> None:
     p.add_argument("--method", choices=("picard", "vanloan", "trapezoid"), default="picard")
     p.add_argument("--vertical", choices=("baro", "free"), default="baro",
                    help="baro-damped (default) or free (unstable) vertical channel")
+    p.add_argument("--alignment", choices=("stationary", "none"), default="stationary",
+                   help="initial attitude errors from a stationary self-alignment (default) or "
+                        "independent of the sensor errors")
     p.add_argument("--baro-tau-s", type=float, default=60.0, help="baro loop time constant, s")
     p.add_argument("--dt-s", type=float, default=0.1, help="navigation step, s (default 0.1)")
     p.add_argument("--duration-s", type=float, default=3600.0,

@@ -268,3 +268,32 @@ def baro_gains(tau_s: float | None, lat_rad: float = 0.0) -> tuple[float, float]
     w = 1.0 / tau_s
     g = -gravity_up(lat_rad, 0.0)[0]
     return 2.0 * w, w * w + 2.0 * g / A_M
+
+
+def alignment_map(lat_rad: float, c_bn: np.ndarray, decay_rps: np.ndarray) -> np.ndarray:
+    """A (33×33): initial state x0 = A z after a stationary self-alignment at attitude C_B^N.
+
+    z holds independent initial errors (sensor states, and any extra position/velocity/attitude
+    errors). Levelling nulls the horizontal velocity-error rate and gyrocompassing the east
+    attitude-error rate at rest (f^N = (0, 0, g), ω_IB = Earth rate), so the attitude errors take
+    up the sensor errors seen at alignment (s = sensor states, F_vs, F_εs the sensor columns of F):
+
+        ε_N += (F_vs s)_E / g,   ε_E += -(F_vs s)_N / g,   ε_U += tan φ ε_N + (F_εs s)_E / (Ω cos φ)
+
+    Parameters
+    ----------
+    lat_rad : latitude of the alignment, rad.
+    c_bn : (3, 3) C_B^N at alignment (body FRD → ENU).
+    decay_rps : (24,) sensor decay rates (they do not enter the result, F is built with them).
+    """
+    g = -gravity_up(lat_rad, 0.0)[0]
+    w_ie = earth_rate_enu(lat_rad)
+    f_b = c_bn.T @ np.array([0.0, 0.0, g])
+    F = build_F(float(lat_rad), 0.0, np.zeros(3), f_b, c_bn.T @ w_ie, np.ascontiguousarray(c_bn),
+                np.asarray(decay_rps, float), 0.0, 0.0)
+    A = np.eye(N_STATES)
+    fvs, fes = F[3:6, 9:], F[6:9, 9:]
+    A[7, 9:] += fvs[0] / g                          # ε_N from the east accelerometer error
+    A[6, 9:] += -fvs[1] / g                         # ε_E from the north accelerometer error
+    A[8, 9:] += math.tan(lat_rad) * A[7, 9:] + fes[0] / (OMEGA_IE_RPS * math.cos(lat_rad))
+    return A

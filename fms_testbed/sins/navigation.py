@@ -10,6 +10,7 @@ Scenario block (``navigation:``)::
     vertical: baro          # baro (damped, default) | free (unstable vertical channel)
     baro_tau_s: 60          # baro loop time constant, s
     tol: 1.0e-12            # adaptive Picard tolerance
+    alignment: stationary   # stationary (self-alignment at the start attitude) | none
     matrices_dt_s: 0        # reuse Φ_k, S_k for this long (s) before rebuilding F; 0 = every step
 
 Each :meth:`SinsNavigation.update` builds F at the previous true state, discretises over the
@@ -36,7 +37,7 @@ from .presets import G0_MPS2, ImuModel, load_imu
 from .simulate import FACTOR_RTOL, IndefiniteCovarianceError, _psd_cholesky
 
 SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol",
-             "matrices_dt_s"}
+             "matrices_dt_s", "alignment"}
 RAD2DPH = 180.0 / math.pi * 3600.0
 
 
@@ -92,7 +93,8 @@ class SinsNavigation:
         self.matrices_dt_s = float(matrices_dt_s)
         self.seed = int(seed)
         self.rng = np.random.default_rng(self.seed)
-        self.x = np.sqrt(imu.p0_var) * self.rng.standard_normal(imu.p0_var.size)
+        self._z0 = np.sqrt(imu.p0_var) * self.rng.standard_normal(imu.p0_var.size)
+        self.x = self._z0.copy()          # mapped through the alignment at the first update
         self._prev: AircraftState | None = None
         self._gains: tuple[float, float] | None = None       # baro gains, set at the first step
         self._held = None                                    # (t_built_s, dt_s, Φ, S)
@@ -118,7 +120,8 @@ class SinsNavigation:
             opts = SinsOptions(method=str(spec.get("method", "picard")),
                                tol=float(spec.get("tol", 1e-12)),
                                vertical=str(spec.get("vertical", "baro")),
-                               baro_tau_s=float(spec.get("baro_tau_s", 60.0)))
+                               baro_tau_s=float(spec.get("baro_tau_s", 60.0)),
+                               alignment=str(spec.get("alignment", "stationary")))
             dt_s = float(spec.get("dt_s", 0.1))
             matrices_dt_s = float(spec.get("matrices_dt_s", 0.0))
             sd = spec.get("seed", seed)
@@ -175,7 +178,11 @@ class SinsNavigation:
     def update(self, truth: AircraftState) -> NavSolution:
         """Advance the error state to ``truth.t_s`` and return truth ⊕ errors."""
         prev = self._prev
-        if prev is not None:
+        if prev is None:
+            from .analysis import initial_map
+            rpy = (truth.roll_rad, truth.pitch_rad, truth.heading_rad)
+            self.x = initial_map(truth.lat_rad, rpy, self.imu, self.opts) @ self._z0
+        else:
             dt = truth.t_s - prev.t_s
             if dt < 0:
                 raise UserError(f"navigation: time went backwards ({prev.t_s} -> {truth.t_s} s)")
