@@ -205,3 +205,13 @@ def test_aligned_stationary_ins_has_no_bias_schuler_bowl():
     x0 = alignment_map(math.radians(45.0), c, DECAY) @ x0
     _, x = _propagate(F, x0, 3600.0)
     assert np.abs(x[:, 0]).max() < 1.0                        # vs 12.7 km unaligned
+
+
+def test_noise_mapped_through_G_gives_the_constant_diagonal_Q_of_eq_6_9():
+    from fms_testbed.sins.model import noise_input_matrix
+    from fms_testbed.sins.presets import load_imu
+
+    q1 = load_imu("STIM300").q_psd                             # densities of η (eq. 6.9 order)
+    G = noise_input_matrix(C)
+    Q = G @ np.diag(q1) @ G.T
+    assert np.allclose(Q, np.diag(q1), rtol=0, atol=1e-12 * q1.max())
