@@ -56,3 +56,15 @@ def test_simulation_is_reproducible_from_its_seed():
     b = simulate_lti(F, np.diag(q), 0.1, 20, imu.p0_var, 5, seed=3)
     c = simulate_lti(F, np.diag(q), 0.1, 20, imu.p0_var, 5, seed=4)
     assert np.array_equal(a, b) and not np.allclose(a, c)
+
+
+def test_step_applies_the_discrete_input_matrix():
+    from fms_testbed.sins.simulate import step
+
+    F = np.array([[0.0, 1.0], [0.0, 0.0]])
+    phi, qk, bk = discretize(F, np.zeros((2, 2)), 0.5, B=np.array([[0.0], [1.0]]))
+    rng = np.random.default_rng(0)
+    x = np.zeros(2)
+    for _ in range(4):                                        # constant unit acceleration, 2 s
+        x = step(x, phi, np.zeros((2, 0)), rng, bk=bk, u=np.array([1.0]))
+    assert np.allclose(x, [0.5 * 2.0 ** 2, 2.0], rtol=1e-14)
