@@ -17,12 +17,23 @@ are the cross-couplings that make the closed-loop transfer matrix from (V_cmd, H
 diagonal. ``ΔH_lim = clip(ΔH, ±dH_limit_m)`` turns a large step into a constant-V_y level change
 followed by a second-order capture. ``form="paper"`` uses the small-angle law of eq. 19 instead.
 
+Realisation on a 6-DoF aircraft (each addition measured on JSBSim, see docs/readme/coupled-law.md):
+
+* the damping term uses the measured n_xa (``(n_xa - sin θ) = V'/g``), so n_x tracking error of
+  the inner loop does not turn into ΔV;
+* g is the apparent gravity (:func:`gravity_ratio`: normal gravity at latitude and height minus
+  the Eötvös and curvature terms) — load factors are forces over m·g0, and level flight east at
+  47° N reads n_y = 0.9978;
+* an n_y tracking-error integrator (``ny_trim_tau_s``) compensates the slow n_y disturbance
+  (lift growing with speed) that the static altitude channel would otherwise pass into ΔH.
+
 Limits. n_ya is clipped to the aircraft's ``[ny_min, ny_max]``; the thrust-channel cross term uses
 the clipped value. When the throttle sits at a limit the n_xa integrator stops moving in the
 unachievable direction and is pulled back to the measured n_xa (back-calculation), so there is no
-wind-up at the top of a climb. With the throttle saturated, speed protection limits the flight-path
-angle to what the available thrust can fly without losing (max throttle) or gaining (idle) speed:
-no overspeed in an idle descent and no speed decay in a thrust-limited climb.
+wind-up at the top of a climb. With the throttle saturated and the speed on the losing side, a
+latched speed protection limits the flight path to what the available thrust can fly at constant
+speed (:func:`speed_protection_limit`) and keeps the throttle at the limit: no overspeed in an idle
+descent and no speed decay in a thrust-limited climb.
 
 Tuning (:class:`CoupledLawParams`, frozen) is apart from state (:class:`CoupledLawState`).
 """
