@@ -6,7 +6,7 @@ useful way, so a SID starts **airborne over the departure end of the runway (DER
 builder's planned start altitude (35 ft above the runway), trimmed straight and level at the
 aircraft's planned climb TAS on the runway heading; the profile then climbs it. STARs and
 approaches start over their first fix at the first coded altitude, on the first segment's
-course. An approach ends at the runway/MAP (the missed approach is not flown). JSBSim's terrain
+course, at the planned TAS moved into the first leg's coded speed limit. An approach ends at the runway/MAP (the missed approach is not flown). JSBSim's terrain
 is at mean sea level, so height above ground is altitude above MSL.
 """
 
@@ -32,11 +32,15 @@ MPS_KT = 3600.0 / 1852.0
 
 def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     """The scenario ``initial`` block for the start of a built path (module docstring)."""
+    from .guidance.vertical import cas_band, leg_speed_limits, tas_target_mps
+
     seg0 = fp.path.segments[0].geom
     lat, lon = seg0.start
     alt = fp.path.legs[0].start.alt_m
+    lo, hi = cas_band(leg_speed_limits(fp.seq.legs[:1])[0], None)
+    tas = tas_target_mps(cfg.limits.climb_tas_mps, alt, lo, hi, cfg.limits.cas_min_mps)
     return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,
-            "tas_mps": cfg.limits.climb_tas_mps, "heading_deg": seg0.start_course_deg % 360.0}
+            "tas_mps": round(tas, 3), "heading_deg": seg0.start_course_deg % 360.0}
 
 
 def prepare(raw: dict, source: str = "<scenario>", db=None

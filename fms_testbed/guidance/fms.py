@@ -49,6 +49,7 @@ class _Active:
     """The path being flown (the whole procedure, or its rest after an in-flight rebuild)."""
 
     fp: FlyablePath
+    segs: list
     pieces: list[LocalPiece]
     seg_cum_m: list[float]
     pde_m: list[float]
@@ -101,6 +102,59 @@ def _magvar(db, fp, lg) -> float:
     return apt.magvar_deg if apt else 0.0
 
 
+BLEND_S = 6.0
+"""Each slope change of the planned profile is blended over ±BLEND_S seconds of flight."""
+
+
+def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
+                    extend: bool) -> tuple[float, float, float]:
+    """Planned altitude at path distance ``s_m`` with every slope change blended by a parabola
+    over ±``w_m`` (constant vertical acceleration), and its first and second derivatives along
+    the path: (h m, dh/ds, d²h/ds² 1/m). The blend lies on the outside of each corner (above a
+    descent-to-level knee). ``extend``: the last slope continues past the last node (the final
+    approach path goes on to the runway); otherwise the profile is flat beyond its ends.
+
+    Guidance commands ``H_cmd = h + 2 ξ_H T_H V dh/ds + T_H² V² d²h/ds²``, the inverse of the
+    coupled law's altitude dynamics ``T_H² Ḧ + 2 ξ_H T_H Ḣ + H = H_cmd`` along the smooth profile,
+    so the aircraft flies the profile itself without lag."""
+    n = len(ps)
+    if n == 1:
+        return ph[0], 0.0, 0.0
+
+    def slope(k: int) -> float:  # slope of piece k (between nodes k-1 and k); 0 off the ends
+        if k <= 0:
+            return 0.0
+        if k >= n:
+            return slope(n - 1) if extend else 0.0
+        d = ps[k] - ps[k - 1]
+        return (ph[k] - ph[k - 1]) / d if d > 1e-6 else 0.0
+
+    j = bisect.bisect_right(ps, s_m)
+    m = slope(j)
+    if j <= 0:
+        h = ph[0]
+    elif j >= n:
+        h = ph[-1] + m * (s_m - ps[-1])
+    else:
+        h = ph[j - 1] + m * (s_m - ps[j - 1])
+    dh, ddh = m, 0.0
+    if w_m <= 0:
+        return h, dh, ddh
+    for k in range(max(j - 2, 0), min(j + 2, n)):
+        sk = ps[k]
+        if abs(s_m - sk) >= w_m:
+            continue
+        delta = slope(k + 1) - slope(k)
+        if delta == 0.0:
+            continue
+        u = s_m - sk + w_m
+        after = 1.0 if s_m > sk else 0.0
+        h += delta * u * u / (4.0 * w_m) - delta * (s_m - sk) * after
+        dh += delta * u / (2.0 * w_m) - delta * after
+        ddh += delta / (2.0 * w_m)
+    return h, dh, ddh
+
+
 def climb_targets(prof) -> list[float | None]:
     """Per profile node j: in a climb phase (``prof.climb[j]``), the altitude to climb to at
     the law's level-change rate while flying toward node j — the highest planned altitude of the
@@ -124,8 +178,36 @@ def climb_targets(prof) -> list[float | None]:
     return out
 
 
-def _activate(fp: FlyablePath, db, s_base_m: float) -> _Active:
-    segs = fp.path.segments
+def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
+    """The path as flown: a 'connector' line the builder put across a discontinuity (e.g.
+    after vectors, VM/FM) that starts with a track change is flown as a direct-to — a turn at
+    the planned radius from the previous segment's end, then a line to the connector's end —
+    as an FMS does after a discontinuity is cleared; other segments unchanged."""
+    from dataclasses import replace as _replace
+
+    from ..arinc424.construct import direct_to_arc
+    from ..path.geodesy import wrap180
+
+    r = tas_mps * tas_mps / (9.80665 * math.tan(math.radians(bank_deg)))
+    out = []
+    for k, sg in enumerate(segs):
+        if sg.role == "connector" and out and isinstance(sg.geom, Line):
+            prev = out[-1].geom
+            trk = prev.end_course_deg
+            if abs(wrap180(sg.geom.start_course_deg - trk)) > 2.0:
+                lat, lon = sg.geom.start
+                tlat, tlon = sg.geom.end
+                arc, ok = direct_to_arc(lat, lon, trk, tlat, tlon, None, r)
+                if ok and arc is not None:
+                    out.append(_replace(sg, geom=arc, role="turn"))
+                    out.append(_replace(sg, geom=Line(*arc.end, tlat, tlon)))
+                    continue
+        out.append(sg)
+    return out
+
+
+def _activate(fp: FlyablePath, db, s_base_m: float, tas_mps: float = 118.0) -> _Active:
+    segs = smooth_connectors(list(fp.path.segments), tas_mps)
     geoms = [s.geom for s in segs]
     pieces = local_pieces(geoms)
     cum, s = [], 0.0
@@ -157,7 +239,7 @@ def _activate(fp: FlyablePath, db, s_base_m: float) -> _Active:
     last = {}
     for i, p in enumerate(pieces):
         last[segs[p.seg_index].leg_index] = i
-    return _Active(fp, pieces, cum, pde, list(zip(before, after)),
+    return _Active(fp, segs, pieces, cum, pde, list(zip(before, after)),
                    [float(x) for x in prof.along_m], [float(x) for x in prof.alt_m], climb_tgt,
                    s_base_m, last)
 
@@ -185,16 +267,18 @@ class ProcedureGuidance:
         self.whole = fp
         self.cfg, self.db, self.spec = cfg, db, spec
         self.gains = gains or LateralGains.for_aircraft(cfg)
-        self.act = _activate(fp, db, 0.0)
+        self.act = _activate(fp, db, 0.0, cfg.limits.climb_tas_mps)
         self.i = 0
         self.leg = -1
         self.events: list[dict] = []
         self.legs_sequenced: list[int] = []
         self.abort_reason = ""
         self.lead_s = altitude_lead_s(cfg)
+        self.t2_s2 = cfg.coupled_law.T_H_s ** 2 if cfg.coupled_law is not None else 0.0
         self.limits = leg_speed_limits(fp.seq.legs)
         self.carry_max_cas: float | None = None
         self.descent = fp.path.proc_type in ("E", "F")
+        self.approach = fp.path.proc_type == "F"
         self.tas_cmd = cfg.limits.climb_tas_mps
         self.next_speed_t = -1.0
         self.cond_start: tuple | None = None
@@ -204,7 +288,7 @@ class ProcedureGuidance:
     # ------------------------------------------------------------------ helpers
     def _global_leg(self, piece_i: int) -> int:
         a = self.act
-        return a.fp.leg_offset + a.fp.path.segments[a.pieces[piece_i].seg_index].leg_index
+        return a.fp.leg_offset + a.segs[a.pieces[piece_i].seg_index].leg_index
 
     def _enter_leg(self, t_s: float, g: int) -> None:
         if g == self.leg:
@@ -275,7 +359,7 @@ class ProcedureGuidance:
                               math.degrees(lon), math.degrees(trk) % 360.0, alt)
         if fp is None:
             return False
-        self.act = _activate(fp, self.db, s_now)
+        self.act = _activate(fp, self.db, s_now, self.cfg.limits.climb_tas_mps)
         self.rebuilt.append(fp)
         self.i = 0
         self.events.append({"t_s": t_s, "kind": "rebuild", "leg": nxt,
@@ -306,7 +390,7 @@ class ProcedureGuidance:
         g_leg = self._global_leg(self.i)
         self._enter_leg(nav.t_s, g_leg)
         # conditional leg: ended in flight when the condition is met
-        seg = a.fp.path.segments[p.seg_index]
+        seg = a.segs[p.seg_index]
         bl = a.fp.path.legs[seg.leg_index]
         if bl.path_term in CONDITIONAL:
             if self._condition(bl, lat, lon, nav.alt_m):
@@ -352,16 +436,9 @@ class ProcedureGuidance:
         bank = bank_command_rad(xtk, terr, gs, kappa, self.gains)
         # vertical
         s_path = a.seg_cum_m[p.seg_index] + p.s0_m + along
-        s_ahead = s_path + gs * self.lead_s
-        ps, ph = a.prof_s, a.prof_h
-        j = bisect.bisect_right(ps, s_ahead)
-        if j <= 0:
-            alt_cmd = ph[0]
-        elif j >= len(ps):
-            alt_cmd = ph[-1]
-        else:
-            f = (s_ahead - ps[j - 1]) / max(ps[j] - ps[j - 1], 1e-9)
-            alt_cmd = ph[j - 1] + f * (ph[j] - ph[j - 1])
+        ps = a.prof_s
+        h, dh, ddh = blended_profile(ps, a.prof_h, s_path, gs * BLEND_S, self.approach)
+        alt_cmd = h + self.lead_s * gs * dh + self.t2_s2 * gs * gs * ddh
         jn = bisect.bisect_right(ps, s_path)
         if 0 < jn < len(ps) and a.climb_tgt[jn] is not None:  # climb: at the law's rate
             alt_cmd = max(alt_cmd, a.climb_tgt[jn])
@@ -382,7 +459,7 @@ class ProcedureGuidance:
         s_seg = p.s0_m + along
         b, f = a.flat_m[p.seg_index]
         flat = 0.0 if p.is_arc else min(
-            b + s_seg, f + a.fp.path.segments[p.seg_index].geom.length_m() - s_seg)
+            b + s_seg, f + a.segs[p.seg_index].geom.length_m() - s_seg)
         return {"xtk_m": true_xtk, "nav_xtk_m": nav_xtk, "leg_index": g_leg,
                 "leg_code": seg.path_term, "seg_role": seg.role,
                 "along_m": a.s_base_m + (s_path if s_path == s_path else 0.0),

@@ -16,7 +16,7 @@ above' constraints are met as early as the aircraft can. Speed: the aircraft's p
 the leg being flown (coded as IAS/CAS, converted at the present altitude, aimed
 :data:`SPEED_MARGIN_MPS` inside the limit) or raised to an 'at or above' one; in descent
 (STAR/approach) a limit, once applied, holds for the rest of the procedure. Never below
-1.05 × the aircraft's minimum CAS.
+MIN_CAS_FACTOR × the aircraft's minimum CAS.
 """
 
 from __future__ import annotations
@@ -26,6 +26,10 @@ from dataclasses import dataclass
 from ..atmosphere import cas_to_tas
 
 KT_MPS = 1852.0 / 3600.0
+MIN_CAS_FACTOR = 1.15
+"""The TAS target never gives a CAS below this multiple of the aircraft's minimum clean CAS
+(the planned TAS is constant, so high in a SID or STAR the CAS would otherwise fall toward the
+stall)."""
 SPEED_MARGIN_MPS = 2.0 * KT_MPS
 """Aim inside an 'at or below' / 'at or above' speed limit by this much, m/s."""
 
@@ -62,13 +66,13 @@ def cas_band(limit: SpeedLimit | None, carried_max_cas_mps: float | None
 def tas_target_mps(tas_plan_mps: float, alt_m: float, lo_cas_mps: float | None,
                    hi_cas_mps: float | None, cas_min_mps: float) -> float:
     """TAS target, m/s: the planned TAS moved into the allowed CAS band at altitude ``alt_m``
-    (ISA conversion), never below 1.05 × ``cas_min_mps``."""
+    (ISA conversion), never below MIN_CAS_FACTOR × ``cas_min_mps``."""
     v = tas_plan_mps
     if hi_cas_mps is not None:
         v = min(v, float(cas_to_tas(hi_cas_mps, alt_m)))
     if lo_cas_mps is not None:
         v = max(v, float(cas_to_tas(lo_cas_mps, alt_m)))
-    return max(v, float(cas_to_tas(1.05 * cas_min_mps, alt_m)))
+    return max(v, float(cas_to_tas(MIN_CAS_FACTOR * cas_min_mps, alt_m)))
 
 
 def altitude_lead_s(cfg) -> float:
