@@ -36,14 +36,16 @@ class ScenarioComparison:
 
 
 def initial_tas_mps(scn: Scenario) -> float:
-    """The scenario's initial true airspeed, m/s (CAS converted at the initial altitude)."""
+    """Initial true airspeed of scenario ``scn``, m/s (CAS converted at the initial altitude)."""
     kind, spd = scn.initial.speed
     return float(cas_to_tas(spd, scn.initial.altitude_m)) if kind == "cas" else spd
 
 
 def pointmass_events(scn: Scenario) -> list[CommandEvent]:
-    """The scenario's altitude/speed events as point-mass command events (CAS → TAS at the
-    event altitude, or at the initial altitude for conditional events)."""
+    """Altitude/speed events of scenario ``scn`` as point-mass command events.
+
+    CAS is converted to TAS at the event's altitude target, or the last one before it.
+    """
     out = []
     alt = scn.initial.altitude_m
     for ev in scn.events:
@@ -65,6 +67,10 @@ def ideal_response(scn: Scenario, params: CoupledLawParams) -> pd.DataFrame:
     """The coupled law flown on the lag-free point-mass plant with the scenario's commands.
 
     The law's inner-loop model is lag-free too (``ny_model_tau_s = 0``), as the plant's loops are.
+
+    Parameters
+    ----------
+    scn : validated scenario;  params : coupled-law tuning
     """
     pm = PointMassParams(nx_idle=-0.3, nx_max=0.5)
     params = replace(params, ny_model_tau_s=0.0)
@@ -100,7 +106,7 @@ def run_comparison(scn: Scenario, cfg: AircraftConfig | None = None,
 
 
 def stepped_channels(df: pd.DataFrame) -> list[str]:
-    """Channels whose command changes during the run (``"alt"``, ``"speed"``)."""
+    """Channels whose command changes during the run ``df`` (``"alt"``, ``"speed"``)."""
     out = []
     if find_steps(df, "cmd_alt_m"):
         out.append("alt")
@@ -110,13 +116,15 @@ def stepped_channels(df: pd.DataFrame) -> list[str]:
 
 
 def pure_second_order_settling_s(T_s: float, xi: float, band_frac: float = 0.02) -> float:
-    """2 % settling time of 1/(T² p² + 2 ξ T p + 1) for a unit step, s."""
+    """Settling time (s) of 1/(T² p² + 2 ξ T p + 1) for a unit step, time constant ``T_s`` (s),
+    damping ``xi``, band ``band_frac`` of the step (default 2 %)."""
     t = np.linspace(0.0, 40.0 * T_s, 40001)
     return settling_time(t, second_order_step(t, T_s, xi), 1.0, band_frac)
 
 
 def comparison_rows(cmp: ScenarioComparison, cfg: AircraftConfig) -> list[dict]:
-    """One table row per (law, stepped channel): metrics plus the ideal response's settling."""
+    """One table row per (law, stepped channel) of comparison ``cmp``: metrics plus the ideal
+    response's settling; ``cfg`` gives the throttle limits."""
     rows = []
     lo, hi = cfg.inner_loops.throttle_min, cfg.inner_loops.throttle_max
     ideal_m = {ch: step_metrics(cmp.ideal, ch) for ch in stepped_channels(cmp.ideal)}
@@ -167,6 +175,11 @@ def check_goals(table: pd.DataFrame, params: CoupledLawParams) -> list[Goal]:
     Goals: coupled max|ΔV| ≤ 1 km/h in the altitude step and ≥ 5× smaller than baseline (a);
     max|ΔH| ≤ 1.5 m in the speed step; settling within 10 % of the ideal point-mass response;
     for unclipped altitude steps (≤ dH_limit) settling within 20 % of the pure second order.
+
+    Parameters
+    ----------
+    table : rows from :func:`comparison_rows`
+    params : the coupled law's tuning (T_H, ξ_H for the pure second order; dH_limit)
     """
     goals = []
     t = table[table["status"] == "ok"]
@@ -203,7 +216,8 @@ def check_goals(table: pd.DataFrame, params: CoupledLawParams) -> list[Goal]:
 
 def envelope_scenario(cfg: AircraftConfig, alt_m: float, tas_mps: float, kind: str,
                       duration_s: float = 100.0) -> Scenario:
-    """An unclipped step at an envelope point: +100 m (``kind="alt"``) or +10 % TAS."""
+    """An unclipped step of ``cfg`` at ``alt_m`` (m), ``tas_mps`` (m/s): +100 m
+    (``kind="alt"``) or +10 % TAS, flown for ``duration_s`` (s)."""
     from ..scenario import parse_scenario
 
     ev = ({"t_s": 5.0, "alt_m": alt_m + 100.0} if kind == "alt"
@@ -219,8 +233,14 @@ def envelope_rows(cfg: AircraftConfig, laws: tuple[str, ...] = ("coupled", "pi")
                   seed: int | None = None) -> list[dict]:
     """Fly +100 m and +10 % speed steps at every envelope point of ``cfg`` with each law.
 
-    Returns one row per (point, law) with settling (s), overshoot (%), the cross deviation
-    (km/h in the altitude step, m in the speed step) and the throttle-saturation share (%).
+    Parameters
+    ----------
+    cfg : aircraft;  laws : law names;  seed : run seed
+
+    Returns
+    -------
+    one row per (point, law) with settling (s), overshoot (%), the cross deviation (km/h in the
+    altitude step, m in the speed step) and the throttle-saturation share (%)
     """
     from ..runner import fly
 

@@ -193,7 +193,13 @@ def gravity_ratio(lat_rad: float, alt_m: float, ve_mps: float = 0.0, vn_mps: flo
 
 
 def clip_altitude_error(dH_m: float, limit_m: float) -> float:
-    """``ΔH_lim = clip(ΔH, -limit, +limit)`` (level-change mode, eq. 19), m."""
+    """``ΔH_lim = clip(ΔH, -limit, +limit)`` (level-change mode, eq. 19), m.
+
+    Parameters
+    ----------
+    dH_m : altitude error H - H_cmd, m
+    limit_m : the limit (``dH_limit_m``), m
+    """
     return min(max(dH_m, -limit_m), limit_m)
 
 
@@ -262,6 +268,13 @@ def speed_protection_limit(p: CoupledLawParams, side: int, dV_mps: float, tas_mp
     The limit is ``cos θ + (V / g)(θ_lim - θ) / gamma_tau_s``: a ceiling at max throttle
     (``side`` = +1, no speed decay in a climb), a floor at idle (``side`` = -1, no overspeed in
     a descent).
+
+    Parameters
+    ----------
+    p : law tuning;  side : +1 max throttle (ceiling), -1 idle (floor)
+    dV_mps : speed error V - V_cmd, m/s;  tas_mps : airspeed, m/s
+    gamma_rad : flight-path angle, rad;  nx_meas : measured tangential load factor, g
+    g_ratio : apparent gravity over g0 (:func:`gravity_ratio`)
     """
     tau = p.T_V_s / (2.0 * p.xi_V)
     s_lim = min(max((nx_meas + dV_mps / (G_MPS2 * tau)) / g_ratio, -0.5), 0.5)

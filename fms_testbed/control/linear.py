@@ -150,7 +150,17 @@ class DecouplingReport:
 
 
 def frequency_response(sys: ct.StateSpace, omega_rps: np.ndarray) -> np.ndarray:
-    """Complex W(jω), shape (outputs, inputs, len(ω)); ω in rad/s."""
+    """Complex frequency response W(jω) = C (jωI - A)⁻¹ B + D.
+
+    Parameters
+    ----------
+    sys : state-space system (e.g. :func:`closed_loop`)
+    omega_rps : frequencies ω, rad/s
+
+    Returns
+    -------
+    array of shape (outputs, inputs, len(ω))
+    """
     A, B, C, D = (np.asarray(m) for m in (sys.A, sys.B, sys.C, sys.D))
     n = A.shape[0]
     out = np.empty((C.shape[0], B.shape[1], len(omega_rps)), dtype=complex)
@@ -188,7 +198,8 @@ def decoupling_report(sys: ct.StateSpace, p: CoupledLawParams,
 
 
 def step_responses(sys: ct.StateSpace, t_s: np.ndarray, dV_mps: float, dH_m: float):
-    """Responses to a speed step ``dV_mps`` and, separately, an altitude step ``dH_m``.
+    """Responses of ``sys`` to a speed step ``dV_mps`` (m/s) and, separately, an altitude step
+    ``dH_m`` (m) at times ``t_s`` (s).
 
     Returns
     -------
@@ -201,7 +212,13 @@ def step_responses(sys: ct.StateSpace, t_s: np.ndarray, dV_mps: float, dH_m: flo
 
 
 def siso_tf(sys: ct.StateSpace, output: str, inp: str) -> ct.TransferFunction:
-    """One entry of W(p) as a minimal transfer function (e.g. ``siso_tf(sys, "V", "H_cmd")``)."""
+    """One entry of W(p) as a minimal transfer function, e.g. ``siso_tf(sys, "V", "H_cmd")``.
+
+    Parameters
+    ----------
+    sys : closed loop from :func:`closed_loop`
+    output : one of :data:`OUTPUTS`;  inp : one of :data:`INPUTS`
+    """
     i, j = OUTPUTS.index(output), INPUTS.index(inp)
     sub = ct.ss(sys.A, sys.B[:, [j]], sys.C[[i], :], sys.D[[i]][:, [j]])
     return ct.minreal(ct.ss2tf(sub), verbose=False)

@@ -51,7 +51,7 @@ class StepMetrics:
 
 
 def find_steps(df: pd.DataFrame, col: str, tol: float = 1e-6) -> list[int]:
-    """Row indices where the command column ``col`` changes."""
+    """Row indices of ``df`` where the command column ``col`` changes by more than ``tol``."""
     c = df[col].to_numpy()
     return [int(i) + 1 for i in np.flatnonzero(np.abs(np.diff(c)) > tol)]
 
@@ -68,7 +68,10 @@ def settling_time(t_s: np.ndarray, y: np.ndarray, target: float, band: float) ->
 
 
 def rise_time(t_s: np.ndarray, y: np.ndarray, y0: float, target: float) -> float:
-    """10 → 90 % rise time, s (``nan`` if 90 % is never reached)."""
+    """10 → 90 % rise time of ``y`` from ``y0`` to ``target`` over times ``t_s`` (s), s.
+
+    ``nan`` if 90 % is never reached.
+    """
     frac = (y - y0) / (target - y0)
     i10 = np.flatnonzero(frac >= 0.1)
     i90 = np.flatnonzero(frac >= 0.9)

@@ -82,6 +82,7 @@ def plot_paper_fig2(runs: dict[str, pd.DataFrame], title: str, path: Path) -> Pa
     ----------
     runs : law name → timeseries; the coupled law on JSBSim and its ideal point-mass response
         are expected, baselines optional
+    title : figure title;  path : output PNG
     """
     fig, axes = plt.subplots(5, 1, figsize=(9, 12), sharex=True)
     for name, df in runs.items():
@@ -118,6 +119,7 @@ def plot_bode_coupling(omega_rps: np.ndarray, cases: dict[str, np.ndarray], path
     omega_rps : frequencies, rad/s
     cases : label → complex W(jω) of shape (4, 2, len(ω)) (outputs V, H, θ, n_xa; inputs
         V_cmd, H_cmd)
+    path : output PNG;  title : figure title
     """
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     panels = [((0, 0), "V / V_cmd, dB", 0, 0, 1.0), ((0, 1), "V / H_cmd, dB re (km/h)/m", 0, 1, 3.6),
@@ -152,8 +154,12 @@ def plot_linear_steps(t_s: np.ndarray, cases: dict[str, tuple[np.ndarray, np.nda
                       dV_mps: float, dH_m: float, path: Path, title: str) -> Path:
     """Linear step responses: V and H for a speed step and for an altitude step, per lag case.
 
+    Parameters
+    ----------
+    t_s : times, s
     cases : label → (speed-step outputs, altitude-step outputs), each (4, len(t)) as returned by
         :func:`fms_testbed.control.linear.step_responses`
+    dV_mps, dH_m : the step sizes, m/s and m;  path : output PNG;  title : figure title
     """
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     for label, (sv, sh) in cases.items():
@@ -187,8 +193,11 @@ def plot_tuning_overlay(jsb: dict[str, pd.DataFrame], lin: dict[str, pd.DataFram
                         title: str) -> Path:
     """JSBSim responses of the tuned law with the linear prediction overlaid.
 
+    Parameters
+    ----------
     jsb, lin : ``"alt"`` / ``"speed"`` → DataFrame with t_s, alt_m, tas_mps, cmd_alt_m,
         cmd_tas_mps (the linear one as deviations added to the same trim)
+    path : output PNG;  title : figure title
     """
     fig, axes = plt.subplots(2, 2, figsize=(11, 7), sharex=True)
     for c, key in enumerate(("alt", "speed")):

@@ -66,7 +66,13 @@ class CommandEvent:
 
 def make_state(t_s: float, tas_mps: float, gamma_rad: float, alt_m: float, nx: float, ny: float,
                throttle: float) -> AircraftState:
-    """An :class:`AircraftState` carrying the point-mass quantities (others zero), SI units."""
+    """An :class:`AircraftState` carrying the point-mass quantities (others zero).
+
+    Parameters
+    ----------
+    t_s : time, s;  tas_mps : airspeed, m/s;  gamma_rad : flight-path angle, rad
+    alt_m : altitude, m;  nx, ny : realised load factors, g;  throttle : pseudo-throttle, 0..1
+    """
     vs = tas_mps * math.sin(gamma_rad)
     return AircraftState(
         t_s=t_s, lat_rad=0.0, lon_rad=0.0, alt_m=alt_m, tas_mps=tas_mps, cas_mps=tas_mps,
@@ -150,7 +156,13 @@ def simulate(law, pm: PointMassParams, alt0_m: float, tas0_mps: float, duration_
 
 
 def second_order_step(t_s: np.ndarray, T_s: float, xi: float) -> np.ndarray:
-    """Unit-step response of ``1 / (T² p² + 2 ξ T p + 1)`` at times ``t_s`` (s), dimensionless."""
+    """Unit-step response of ``1 / (T² p² + 2 ξ T p + 1)`` (the desired dynamics of eq. 2/5).
+
+    Parameters
+    ----------
+    t_s : times after the step, s
+    T_s : time constant T, s;  xi : damping ratio ξ
+    """
     t = np.asarray(t_s, dtype=float)
     w = 1.0 / T_s
     if abs(xi - 1.0) < 1e-9:

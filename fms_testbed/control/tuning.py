@@ -94,7 +94,17 @@ def _step_scenario(cfg: AircraftConfig, op: OperatingPoint, kind: str, duration_
 
 def fly_steps(cfg: AircraftConfig, params: CoupledLawParams, op: OperatingPoint,
               duration_s: float = 100.0, plant: str = "jsbsim") -> tuple[dict, str]:
-    """Fly the altitude and the speed step with ``params``; return ({kind: df}, status)."""
+    """Fly the altitude and the speed step with ``params``.
+
+    Parameters
+    ----------
+    cfg : aircraft configuration;  params : law tuning;  op : operating point and steps
+    duration_s : length of each run, s;  plant : ``"jsbsim"`` or ``"pointmass"``
+
+    Returns
+    -------
+    ({"alt": df, "speed": df}, status) — status ``"ok"`` or the divergence reason
+    """
     runs, status = {}, "ok"
     for kind in ("alt", "speed"):
         if plant == "pointmass":
@@ -115,7 +125,16 @@ def fly_steps(cfg: AircraftConfig, params: CoupledLawParams, op: OperatingPoint,
 
 
 def cost(alt: StepMetrics, speed: StepMetrics, cfg: AircraftConfig) -> tuple[float, str]:
-    """Score a candidate (lower is better); see the module docstring. Returns (cost, note)."""
+    """Score a candidate (lower is better); see the module docstring.
+
+    Parameters
+    ----------
+    alt, speed : metrics of the altitude and the speed step;  cfg : aircraft (its n_y limits)
+
+    Returns
+    -------
+    (cost, dimensionless; note naming any violated limit)
+    """
     ref_h = 5.834 * BOUNDS["T_H_s"][0]      # 2 % settling of a critically damped 2nd order
     ref_v = 5.834 * BOUNDS["T_V_s"][0]
     note = []
@@ -142,7 +161,12 @@ def cost(alt: StepMetrics, speed: StepMetrics, cfg: AircraftConfig) -> tuple[flo
 
 def evaluate(cfg: AircraftConfig, params: CoupledLawParams, op: OperatingPoint,
              duration_s: float = 100.0, plant: str = "jsbsim") -> Evaluation:
-    """Fly both steps with ``params`` and score them."""
+    """Fly both steps with ``params`` and score them with :func:`cost`.
+
+    Parameters
+    ----------
+    cfg, params, op, duration_s, plant : as in :func:`fly_steps` (duration in s)
+    """
     runs, status = fly_steps(cfg, params, op, duration_s, plant)
     if status != "ok":
         return Evaluation(params, 1e3, None, None, runs, status)
@@ -157,6 +181,14 @@ def identify_lags(cfg: AircraftConfig, op: OperatingPoint) -> tuple[float, float
     """Equivalent first-order lags of the n_x and n_y inner loops, s (63 % rise time on JSBSim).
 
     Two short runs with direct inner-loop targets: n_x 0 → 0.03 and n_y 1 → 1.05 at t = 2 s.
+
+    Parameters
+    ----------
+    cfg : aircraft configuration;  op : operating point (altitude, TAS)
+
+    Returns
+    -------
+    (tau_nx_s, tau_ny_s), s
     """
     from ..runner import run_scenario
 
@@ -177,7 +209,13 @@ def identify_lags(cfg: AircraftConfig, op: OperatingPoint) -> tuple[float, float
 
 def linear_prediction(params: CoupledLawParams, op: OperatingPoint, tau_nx_s: float,
                       tau_ny_s: float, t_end_s: float) -> dict[str, pd.DataFrame]:
-    """Linear closed-loop responses to the tuning steps, in the runner's columns."""
+    """Linear closed-loop responses (:mod:`.linear`) to the tuning steps, in the runner's columns.
+
+    Parameters
+    ----------
+    params : law tuning;  op : operating point and steps
+    tau_nx_s, tau_ny_s : inner-loop lags, s;  t_end_s : end time, s (steps at 5 s)
+    """
     t = np.linspace(0.0, t_end_s - _T_STEP_S, int((t_end_s - _T_STEP_S) * 20) + 1)
     sys = closed_loop(params, op.tas_mps, tau_nx_s, tau_ny_s)
     sv, sh = step_responses(sys, t, op.speed_step_mps, op.dH_m)
@@ -267,6 +305,10 @@ def write_gains_to_config(path: str | Path, p: CoupledLawParams) -> None:
 
     Handles the one-line flow style (``coupled_law: {...}``) and an indented block; appends the
     block when there is none.
+
+    Parameters
+    ----------
+    path : aircraft YAML file;  p : tuning whose T_V_s, xi_V, T_H_s, xi_H, dH_limit_m are written
     """
     path = Path(path)
     lines = path.read_text().splitlines(keepends=True)
