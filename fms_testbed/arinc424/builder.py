@@ -199,6 +199,10 @@ class LegBuilder:
         along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
                                  state.lon_deg)
         trk = state.track_deg
+        if along < 0 and math.degrees(math.atan2(abs(xtk), -along)) < 3.0:
+            # within 3° of the course line seen from the fix (variation rounding in the
+            # data): fly straight to the fix
+            return self.direct_to(state, fix, direction, flyby_end)
         aligned = trk is None or abs(wrap180(trk - fcrs)) < 2.0
         if abs(xtk) < 30.0 and aligned and along < 0:
             if trk is not None and abs(wrap180(fcrs - trk)) >= 0.5:

@@ -215,7 +215,7 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         avail_c = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
         l_avail = max(min(avail_a, avail_c), 0.0)
         bank = bank_deg
-        fix = a.fix_ident or seg.fix_ident
+        fix = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
         if r * t > l_avail:
             r_geom = l_avail / t
             b.i = a.leg_index
@@ -281,7 +281,8 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
              ) -> list[PathSegment]:
     """Branch V,γ,φ,λ: the turn cannot be cut inside the fixes; fly over the corner, turn at
     the lowest speed and maximum bank, then go direct to the end of the next line."""
-    b.finding("correction", f"fly-by at {a.fix_ident or seg.fix_ident} (turn {omega:+.0f}°) "
+    at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
+    b.finding("correction", f"fly-by at {at} (turn {omega:+.0f}°) "
               f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
               "V,γ,φ,λ")
     lat, lon = a.geom.end
