@@ -24,8 +24,9 @@ def test_direct_and_inverse_agree_with_geographiclib(lat1, lon1, az, s):
     assert _angdiff(az2, r["azi2"]) < 1e-7
     d, a1, a2 = inverse(lat1, lon1, r["lat2"], r["lon2"])
     assert d == pytest.approx(s, abs=1e-3)
-    if s > 1.0:
-        assert _angdiff(a1, az) < 1e-6 and _angdiff(a2, r["azi2"]) < 1e-6
+    if s > 1.0:  # azimuth error x distance below a micrometre
+        tol = max(1e-6, 1e-4 / s)
+        assert _angdiff(a1, az) < tol and _angdiff(a2, r["azi2"]) < tol
 
 
 def test_nearly_antipodal_points_fall_back_to_geographiclib():
