@@ -32,13 +32,15 @@ from ..state import AircraftState, NavSolution
 from .analysis import SinsOptions
 from .discretize import (PICARD_MAX_ORDER, PICARD_MAX_RATE_DT, DiscretisationError,
                          _picard_sins, discretize)
-from .model import baro_gains, build_F, earth_radii
+from .model import A_M, E2, baro_gains, build_F
 from .presets import G0_MPS2, ImuModel, load_imu
 from .simulate import FACTOR_RTOL, IndefiniteCovarianceError, _psd_cholesky
 
 SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol",
              "matrices_dt_s", "alignment"}
 RAD2DPH = 180.0 / math.pi * 3600.0
+RAD2DEG = 180.0 / math.pi
+MPS2_TO_UG = 1e6 / G0_MPS2
 
 
 @njit(cache=True)
@@ -194,25 +196,30 @@ class SinsNavigation:
     def solution(self, truth: AircraftState) -> NavSolution:
         """Truth ⊕ the current error state (position, velocity, attitude; errors dict for logs)."""
         x = self.x
-        rm, rn, _, _ = earth_radii(truth.lat_rad)
-        lat = truth.lat_rad + x[1] / (rm + truth.alt_m)
-        lon = truth.lon_rad + x[0] / ((rn + truth.alt_m) * math.cos(truth.lat_rad))
+        e, n, u, ve, vn, vu, eps_e, eps_n, eps_u = x[:9].tolist()
+        lat0, h0 = truth.lat_rad, truth.alt_m
+        s2 = math.sin(lat0) ** 2
+        w = 1.0 - E2 * s2                                   # WGS-84 radii (model.earth_radii)
+        rn = A_M / math.sqrt(w)
+        rm = A_M * (1.0 - E2) / (w * math.sqrt(w))
         # paper eq. 6.10 (scalar form of euler.eps_to_euler_errors, kept in math for speed)
         sp, cp = math.sin(truth.heading_rad), math.cos(truth.heading_rad)
-        a = float(x[6]) * sp + float(x[7]) * cp
+        a = eps_e * sp + eps_n * cp
         d_roll = -a / math.cos(truth.pitch_rad)
-        d_pitch = -float(x[6]) * cp + float(x[7]) * sp
-        d_head = float(x[8]) - math.tan(truth.pitch_rad) * a
+        d_pitch = -eps_e * cp + eps_n * sp
+        d_head = eps_u - math.tan(truth.pitch_rad) * a
         errors = {
-            "nse_east_m": float(x[0]), "nse_north_m": float(x[1]), "nse_up_m": float(x[2]),
-            "ve_err_mps": float(x[3]), "vn_err_mps": float(x[4]), "vu_err_mps": float(x[5]),
-            "att_err_roll_deg": math.degrees(d_roll), "att_err_pitch_deg": math.degrees(d_pitch),
-            "att_err_heading_deg": math.degrees(d_head),
-            "bias_accel_x_ug": float(x[9]) / G0_MPS2 * 1e6,
+            "nse_east_m": e, "nse_north_m": n, "nse_up_m": u,
+            "ve_err_mps": ve, "vn_err_mps": vn, "vu_err_mps": vu,
+            "att_err_roll_deg": d_roll * RAD2DEG, "att_err_pitch_deg": d_pitch * RAD2DEG,
+            "att_err_heading_deg": d_head * RAD2DEG,
+            "bias_accel_x_ug": float(x[9]) * MPS2_TO_UG,
             "bias_gyro_x_dph": float(x[12]) * RAD2DPH, "bias_gyro_z_dph": float(x[14]) * RAD2DPH,
         }
+        v = truth.v_enu_mps
         return NavSolution(
-            t_s=truth.t_s, lat_rad=lat, lon_rad=lon, alt_m=truth.alt_m + float(x[2]),
-            v_enu_mps=np.asarray(truth.v_enu_mps, float) + x[3:6],
+            t_s=truth.t_s, lat_rad=lat0 + n / (rm + h0),
+            lon_rad=truth.lon_rad + e / ((rn + h0) * math.cos(lat0)), alt_m=h0 + u,
+            v_enu_mps=np.array([v[0] + ve, v[1] + vn, v[2] + vu]),
             roll_rad=truth.roll_rad + d_roll, pitch_rad=truth.pitch_rad + d_pitch,
             heading_rad=(truth.heading_rad + d_head) % (2 * math.pi), errors=errors)
