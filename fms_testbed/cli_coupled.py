@@ -103,7 +103,7 @@ def cmd_compare(args) -> int:
         for law, df in cmp.runs.items():
             df.to_parquet(out / f"{scn.name}-{law}.parquet", index=False)
     table = pd.DataFrame(rows)
-    goals = check_goals(table, params) if "coupled" in laws else []
+    goals = check_goals(table) if "coupled" in laws else []
     table.to_csv(out / "comparison.csv", index=False)
     show = table.drop(columns=[c for c in ("status",) if c in table and (table[c] == "ok").all()])
     md = markdown_table(show)
