@@ -139,7 +139,7 @@ class SinsNavigation:
     def _propagate(self, prev: AircraftState, dt: float) -> None:
         noise = self.rng.standard_normal(self.x.size)
         held = self._held
-        if (held is not None and held[1] == dt
+        if (held is not None and abs(held[1] - dt) <= 1e-6 * dt
                 and prev.t_s - held[0] < self.matrices_dt_s - 1e-9):
             self.x = held[2] @ self.x + held[3] @ noise
             return
