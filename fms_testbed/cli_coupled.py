@@ -76,7 +76,15 @@ def cmd_compare(args) -> int:
     if args.envelope:
         return _compare_envelope(args, laws)
     names = args.scenarios or list(DEFAULT_SCENARIOS)
-    overrides = {"aircraft": args.aircraft} if args.aircraft else None
+    overrides = {"aircraft": args.aircraft} if args.aircraft else {}
+    if args.turbulence:
+        overrides["turbulence"] = {"severity": args.turbulence}
+    if args.wind:
+        try:
+            frm, spd = (float(x) for x in args.wind.split("/"))
+        except ValueError:
+            raise UserError(f"--wind {args.wind!r}: expected FROM_DEG/SPEED_MPS, e.g. 270/15") from None
+        overrides["wind"] = {"from_deg": frm, "speed_mps": spd}
     scns = [load_scenario(_scenario_path(n), overrides) for n in names]
     if args.small_step and not args.scenarios:
         s0 = scns[0]
@@ -282,6 +290,9 @@ def register(subparsers) -> None:
                         "aircraft (or --aircraft)")
     p.add_argument("--no-small-step", dest="small_step", action="store_false",
                    help="skip the extra 100 m (unclipped) altitude step")
+    p.add_argument("--turbulence", choices=("light", "moderate", "severe"),
+                   help="fly the scenarios in turbulence (seeded by --seed)")
+    p.add_argument("--wind", metavar="FROM_DEG/SPEED_MPS", help="steady wind, e.g. 270/15")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", help="output folder (default results/compare-<time>)")
     p.set_defaults(func=cmd_compare)

@@ -131,3 +131,8 @@ def test_tune_quick_on_jsbsim_does_not_worsen_the_cost_and_writes_the_file(tmp_p
     assert written.T_V_s == pytest.approx(best["T_V_s"], abs=0.006)
     assert written.xi_H == pytest.approx(best["xi_H"], abs=0.006)
     assert "identified inner-loop lags" in (out / "report.md").read_text().lower()
+
+
+def test_compare_rejects_a_malformed_wind(capsys):
+    assert main(["compare", "--wind", "270"]) == 2
+    assert "FROM_DEG/SPEED_MPS" in capsys.readouterr().err
