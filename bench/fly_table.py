@@ -3,9 +3,9 @@
 Selection (reproducible, no hand-picking of results): for each airport in ``AIRPORTS`` in order,
 the first SID that has a runway transition (flown from its first runway transition through the
 common route), the first STAR that has a runway transition (common route + first runway
-transition; no en-route transition), and the first RNAV approach (ident starting with 'R')
-whose final contains an RF leg, else the first RNAV approach (first approach transition + final,
-to the MAP). Narrow-body jet (737), calm air, navigation = truth, seed 0.
+transition; no en-route transition), and the first RNAV approach ('R…', or RNAV (RNP) 'H…')
+with an RF leg in its final or in an approach transition (that transition + final, to the MAP),
+else the first RNAV approach with its first transition. Narrow-body jet (737), calm air, navigation = truth, seed 0.
 
     python bench/fly_table.py [--db FILE] [--aircraft 737] [--max N] [--out results/fly_table]
 
@@ -39,19 +39,38 @@ def pick(db, airport: str) -> list[dict]:
             if s.proc_type == kind and s.transition.startswith("RW"):
                 out.append({"airport": airport, "procedure": s.proc_id, "runway": s.transition})
                 break
-    finals = [s for s in seqs if s.proc_type == "F" and s.proc_id.startswith("R")
-              and s.route_type != "A"]
-    rf = [s for s in finals if any(lg.path_term == "RF" for lg in s.legs
-                                   if not lg.missed_approach_start)]
-    chosen = (rf or finals)[:1]
-    for s in chosen:
-        trans = [t for t in seqs if t.proc_type == "F" and t.proc_id == s.proc_id
-                 and t.route_type == "A"]
-        spec = {"airport": airport, "procedure": s.proc_id}
-        if trans:
-            spec["transition"] = trans[0].transition
-        out.append(spec)
+    out.extend(pick_approach(seqs, airport))
     return out
+
+
+def _has_rf(seq) -> bool:
+    return any(lg.path_term == "RF" for lg in seq.legs if not lg.missed_approach_start)
+
+
+def pick_approach(seqs, airport: str) -> list[dict]:
+    """The first RNAV approach (ident 'R…' or RNAV(RNP) 'H…', file order) with an RF leg in its
+    final or in one of its approach transitions (that transition is flown), else the first
+    RNAV approach with its first transition."""
+    ids = list(dict.fromkeys(s.proc_id for s in seqs if s.proc_type == "F"
+                             and s.proc_id[:1] in ("R", "H")))
+    fallback = None
+    for pid in ids:
+        parts = [s for s in seqs if s.proc_type == "F" and s.proc_id == pid]
+        finals = [s for s in parts if s.route_type != "A"]
+        trans = [s for s in parts if s.route_type == "A"]
+        if not finals:
+            continue
+        rf_trans = [t for t in trans if _has_rf(t)]
+        spec = {"airport": airport, "procedure": pid}
+        if rf_trans or _has_rf(finals[0]):
+            if rf_trans or trans:
+                spec["transition"] = (rf_trans or trans)[0].transition
+            return [spec]
+        if fallback is None:
+            if trans:
+                spec["transition"] = trans[0].transition
+            fallback = spec
+    return [fallback] if fallback else []
 
 
 def worst_misses(cons: list[dict]) -> tuple[float, float]:

@@ -274,6 +274,10 @@ class ProcedureGuidance:
         self.legs_sequenced: list[int] = []
         self.abort_reason = ""
         self.lead_s = altitude_lead_s(cfg)
+        top = spec.climb_top_ft * 0.3048 if spec is not None else 4572.0
+        los = [w.lo_m for w in (fp.path.profile.windows if fp.path.profile else ())
+               if w.lo_m is not None]
+        self.top_m = max([top] + los)
         self.t2_s2 = cfg.coupled_law.T_H_s ** 2 if cfg.coupled_law is not None else 0.0
         self.limits = leg_speed_limits(fp.seq.legs)
         self.carry_max_cas: float | None = None
@@ -441,7 +445,7 @@ class ProcedureGuidance:
         alt_cmd = h + self.lead_s * gs * dh + self.t2_s2 * gs * gs * ddh
         jn = bisect.bisect_right(ps, s_path)
         if 0 < jn < len(ps) and a.climb_tgt[jn] is not None:  # climb: at the law's rate
-            alt_cmd = max(alt_cmd, a.climb_tgt[jn])
+            alt_cmd = min(max(alt_cmd, a.climb_tgt[jn]), self.top_m)
         if nav.t_s >= self.next_speed_t:
             lim = self.limits[g_leg] if g_leg < len(self.limits) else None
             lo, hi = cas_band(lim, self.carry_max_cas if self.descent else None)

@@ -49,6 +49,9 @@ class ProcedureSpec(BaseModel):
         5.0, description="distance flown on FM/VM/HM legs (vectors), NM")
     climb_gradient: Annotated[float, Field(gt=0.02, lt=0.3)] | None = Field(
         None, description="planned climb gradient (default: the aircraft's capability)")
+    climb_top_ft: Annotated[float, Field(ge=1000, le=45000)] = Field(
+        15000.0, description="SID/missed-approach climbs stop here (raised to the highest "
+                             "'at or above' constraint when that is higher), ft")
     start_alt_ft: Annotated[float, Field(ge=-1000, le=45000)] | None = Field(
         None, description="start altitude, ft (default: the build's planned start)")
 
