@@ -68,3 +68,21 @@ def test_step_applies_the_discrete_input_matrix():
     for _ in range(4):                                        # constant unit acceleration, 2 s
         x = step(x, phi, np.zeros((2, 0)), rng, bk=bk, u=np.array([1.0]))
     assert np.allclose(x, [0.5 * 2.0 ** 2, 2.0], rtol=1e-14)
+
+
+from hypothesis import given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(0, 10_000), st.integers(1, 12), st.integers(0, 12))
+def test_factor_recovers_rank_and_matrix_of_random_psd(seed, n, r):
+    rng = np.random.default_rng(seed)
+    r = min(r, n)
+    B = rng.normal(size=(n, r)) * 10.0 ** rng.uniform(-6, 3, size=(n, 1))   # mixed state scales
+    Q = B @ B.T
+    S = factor_psd(Q)
+    assert S.shape[1] == r
+    d = np.sqrt(np.diag(Q))
+    d[d == 0] = 1.0
+    assert np.abs((S @ S.T - Q) / np.outer(d, d)).max() <= 1e-8
