@@ -128,3 +128,25 @@ def test_held_matrices_match_per_step_matrices_on_steady_flight():
     assert b.errors["nse_east_m"] == pytest.approx(a.errors["nse_east_m"], rel=1e-3)
     assert b.errors["att_err_heading_deg"] == pytest.approx(a.errors["att_err_heading_deg"],
                                                              rel=1e-3)
+
+
+def test_navigation_realisations_have_the_covariance_of_the_analysis():
+    from fms_testbed.sins.analysis import SinsOptions, covariance_run
+    from fms_testbed.sins.presets import load_imu
+
+    duration, n_seeds = 10.0, 300
+    states = _states(duration)
+    tr = straight_level(duration, 0.1, lat_deg=47.0, speed_mps=200.0, heading_deg=30.0)
+    cov = covariance_run(tr, load_imu("STIM300"), SinsOptions())
+    finals = []
+    for seed in range(n_seeds):
+        nav = SinsNavigation.from_spec({"source": "sins", "imu": "STIM300", "seed": seed})
+        for s in states:
+            nav.update(s)
+        finals.append(nav.x.copy())
+    X = np.array(finals)
+    var = X.var(axis=0, ddof=1)
+    sig2 = cov.sigma[-1] ** 2
+    live = sig2 > 0
+    z = (var[live] / sig2[live] - 1) / np.sqrt(2 / n_seeds)
+    assert np.all(np.abs(z) < 4), z
