@@ -97,7 +97,7 @@ def cmd_compare(args) -> int:
     rows = []
     for scn in scns:
         cfg = load_aircraft(scn.aircraft)
-        params = params_from_config(cfg)
+        params = _with_settings(params_from_config(cfg), args.set or [])
         cmp = run_comparison(scn, cfg, laws, params, seed=args.seed)
         rows.extend(comparison_rows(cmp, cfg))
         runs = dict(cmp.runs)
@@ -125,6 +125,35 @@ def cmd_compare(args) -> int:
         print("\nGoals:\n" + gl)
     print(f"\nwritten to {out}/ (comparison.csv, comparison.md, *.png, *.parquet)")
     return 0 if all(g.ok for g in goals) else 1
+
+
+def _with_settings(params, settings: list[str]):
+    """Apply ``--set KEY=VALUE`` overrides to :class:`CoupledLawParams` (type from the field)."""
+    from dataclasses import fields, replace
+
+    types = {f.name: f.type for f in fields(params)}
+    kw = {}
+    for item in settings:
+        key, sep, val = item.partition("=")
+        if not sep or key not in types:
+            raise UserError(f"--set {item!r}: expected KEY=VALUE with KEY one of "
+                            f"{', '.join(types)}")
+        t = types[key]
+        try:
+            if t in (bool, "bool"):
+                if val.lower() not in ("true", "false", "1", "0", "yes", "no"):
+                    raise ValueError(val)
+                kw[key] = val.lower() in ("true", "1", "yes")
+            elif t in (float, "float"):
+                kw[key] = float(val)
+            else:
+                kw[key] = val
+        except ValueError:
+            raise UserError(f"--set {item!r}: {val!r} is not a valid {t}") from None
+    try:
+        return replace(params, **kw)
+    except ValueError as exc:
+        raise UserError(f"--set: {exc}") from None
 
 
 def _compare_envelope(args, laws) -> int:
@@ -290,6 +319,9 @@ def register(subparsers) -> None:
                         "aircraft (or --aircraft)")
     p.add_argument("--no-small-step", dest="small_step", action="store_false",
                    help="skip the extra 100 m (unclipped) altitude step")
+    p.add_argument("--set", action="append", metavar="KEY=VALUE",
+                   help="override a coupled-law parameter for this comparison (repeatable), "
+                        "e.g. form=paper, use_measured_nx=false, ny_trim_tau_s=0, T_V_s=8")
     p.add_argument("--turbulence", choices=("light", "moderate", "severe"),
                    help="fly the scenarios in turbulence (seeded by --seed)")
     p.add_argument("--wind", metavar="FROM_DEG/SPEED_MPS", help="steady wind, e.g. 270/15")

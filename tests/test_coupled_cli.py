@@ -136,3 +136,14 @@ def test_tune_quick_on_jsbsim_does_not_worsen_the_cost_and_writes_the_file(tmp_p
 def test_compare_rejects_a_malformed_wind(capsys):
     assert main(["compare", "--wind", "270"]) == 2
     assert "FROM_DEG/SPEED_MPS" in capsys.readouterr().err
+
+
+def test_compare_set_overrides_a_law_parameter_and_rejects_unknown_keys(tmp_path, capsys):
+    out = tmp_path / "abl"
+    assert main(["compare", "coupled-speed-step", "--laws", "coupled", "--set", "ny_trim_tau_s=0",
+                 "--out", str(out)]) == 1                  # without the integrator ΔH > 1.5 m
+    row = pd.read_csv(out / "comparison.csv").iloc[0]
+    assert row["max_dH_m"] > 1.5
+    capsys.readouterr()
+    assert main(["compare", "--set", "T_V=6"]) == 2
+    assert "T_V_s" in capsys.readouterr().err
