@@ -24,8 +24,8 @@ def world() -> dict[str, tuple[float, float]]:
         "WN": offset(*offset(*APT, 270.0, 20.0), 0.0, 2.0),
         "WS": offset(*offset(*APT, 180.0, 10.0), 270.0, 20.0),
         "WE": offset(*APT, 90.0, 15.0),
-        "ARC1": offset(*pts["TVR"], 180.0, 10.0) if False else offset(*offset(*APT, 0.0, 10.0), 200.0, 10.0),
-        "ARC2": offset(*offset(*APT, 0.0, 10.0), 100.0, 10.0),
+        "ARC1": offset(*pts["TVR"], 200.0, 10.0),   # on the 10 NM DME arc of TVR
+        "ARC2": offset(*pts["TVR"], 100.0, 10.0),
     })
     return pts
 

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from .records import FT_M, KT_MPS, NM_M, RecordError, _f, _int, parse_alt_ft
+from .records import FT_M, KT_MPS, NM_M, RecordError, _int, parse_alt_ft
 
 #: The 23 ARINC-424 path terminators.
 PATH_TERMINATORS = ("IF", "TF", "CF", "DF", "FA", "FC", "FD", "FM", "CA", "CD", "CI", "CR",

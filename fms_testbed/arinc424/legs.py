@@ -10,7 +10,6 @@ leg's path, manual terminations after ``BuildParams.manual_leg_m``.
 
 from __future__ import annotations
 
-import math
 from dataclasses import replace
 
 from ..path.geodesy import direct, inverse, wrap180, wrap360
@@ -544,4 +543,3 @@ class PI(Leg):
 LEG_TYPES: dict[str, type[Leg]] = {cls.code: cls for cls in (
     IF, TF, CF, DF, FA, FC, FD, FM, CA, CD, CI, CR, RF, AF, VA, VD, VI, VM, VR, HA, HF, HM, PI)}
 
-_unused = (math, wrap180)

@@ -65,9 +65,10 @@ class Performance:
                    descent_rate_max_mps=lim.descent_rate_max_mps, bank_max_deg=lim.bank_max_deg)
 
     def climb_gradient_at(self, tas_mps: float) -> float:
-        """Climb gradient capability at a TAS (constant climb rate: scales as 1/V), rise/run."""
-        return min(self.climb_gradient_max * self.tas_plan_mps / tas_mps,
-                   self.climb_rate_max_mps / tas_mps * 1.5)
+        """Climb gradient capability at a TAS, rise over run: the climb rate is taken as
+        constant, so the gradient scales as 1/V from ``climb_gradient_max`` at the planned TAS,
+        and never exceeds ``climb_rate_max_mps / V``."""
+        return min(self.climb_gradient_max * self.tas_plan_mps, self.climb_rate_max_mps) / tas_mps
 
 
 @dataclass(frozen=True, slots=True)

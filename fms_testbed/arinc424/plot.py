@@ -32,7 +32,13 @@ def plot_path(path: ProcedurePath, out_file: str | Path) -> Path:
         raise ValueError(f"{path.name}: nothing to plot (no segments)")
     lat0, lon0 = path.segments[0].geom.start
     fr = LocalFrame(lat0, lon0)
-    fig, ax = plt.subplots(figsize=(9, 8))
+    prof = path.profile
+    if prof is not None and len(prof.along_m) > 1:
+        fig, (ax, axv) = plt.subplots(2, 1, figsize=(9, 10.5),
+                                      gridspec_kw={"height_ratios": [3.2, 1]})
+    else:
+        fig, ax = plt.subplots(figsize=(9, 8))
+        axv = None
     used = set()
     for seg in path.segments:
         g = seg.geom
@@ -86,9 +92,38 @@ def plot_path(path: ProcedurePath, out_file: str | Path) -> Path:
     ax.set_title(f"{path.name} — {path.status}\n"
                  + " ".join(f"{lg.path_term}" for lg in path.legs), fontsize=10)
     ax.legend(loc="best", fontsize=8)
+    if axv is not None:
+        _profile_panel(axv, path)
     out = Path(out_file)
     out.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
     fig.savefig(out, dpi=110)
     plt.close(fig)
     return out
+
+
+def _profile_panel(ax, path: ProcedurePath) -> None:
+    """Planned altitude along the path with the coded altitude windows."""
+    prof = path.profile
+    ax.plot(prof.along_m / NM_M, prof.alt_m / 0.3048, "-", color="tab:blue",
+            label="planned altitude")
+    for name, sel, marker in (("at or above", lambda w: w.lo_m is not None and w.hi_m is None,
+                               "^"),
+                              ("at or below", lambda w: w.hi_m is not None and w.lo_m is None,
+                               "v"),
+                              ("at / window", lambda w: w.lo_m is not None
+                               and w.hi_m is not None, "s")):
+        ws = [w for w in prof.windows if sel(w)]
+        if not ws:
+            continue
+        xs = [w.along_m / NM_M for w in ws]
+        ys = [(w.lo_m if w.lo_m is not None else w.hi_m) / 0.3048 for w in ws]
+        ax.plot(xs, ys, marker, color="k", mfc="none", ls="none", label=name)
+        for w, x, y in zip(ws, xs, ys):
+            if w.fix_ident:
+                ax.annotate(w.fix_ident, (x, y), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+    ax.set_xlabel("distance along the path [NM]")
+    ax.set_ylabel("altitude [ft]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)

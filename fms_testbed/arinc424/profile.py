@@ -1,8 +1,9 @@
 """Planned vertical profile from the coded altitude constraints and climb/descent gradients.
 
 Nodes are the path start and every leg end (distance along the built path, m). Climb phases
-(SIDs, missed approaches) climb at the aircraft's gradient and level off below every 'at or
-below' constraint ahead; descent phases are planned backwards from the last constrained fix at
+(SIDs, missed approaches) climb at the aircraft's gradient, level off below every 'at or
+below' constraint ahead and at the highest climb constraint still ahead (with none: the coded
+transition altitude, else 18,000 ft); descent phases are planned backwards from the last constrained fix at
 the coded vertical angle (else 3°), clamped into each fix's altitude window. One geometry feeds
 both: the distances come from the same segments the map and guidance use.
 """
@@ -145,13 +146,21 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
             floor = alt[k - 1] - math.tan(math.radians(ang)) * (along[k] - along[k - 1])
             if floor > alt[k]:
                 alt[k] = floor if hi_at[k] is None else min(floor, max(hi_at[k], alt[k]))
-    # climb: forward pass, capped by every 'at or below' ahead
+    # climb: forward pass, capped by every 'at or below' ahead and levelling off at the
+    # highest climb constraint still ahead (else the coded transition altitude, else 18,000 ft)
     cap = np.full(n + 1, np.inf)
     run = np.inf
+    top = -np.inf
+    trans = next((lg.record.trans_alt_m for lg in path.legs if lg.record.trans_alt_m), None)
     for k in range(n, -1, -1):
-        if hi_at[k] is not None and climb[k]:
-            run = min(run, hi_at[k])
-        cap[k] = run
+        if climb[k]:
+            if hi_at[k] is not None:
+                run = min(run, hi_at[k])
+                top = max(top, hi_at[k])
+            elif lo_at[k] is not None:
+                top = max(top, lo_at[k])
+        level = top if np.isfinite(top) else (trans if trans else 18000 * 0.3048)
+        cap[k] = min(run, level)
     for k in range(1, n + 1):
         if climb[k]:
             base = alt[k - 1]

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..path.geodesy import direct, gravity_mps2, wrap180, wrap360
+from ..path.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
 from ..path.segments import Arc, Line
 from .builder import LegBuilder, ResolvedLeg
 from .construct import direct_to_arc, turn_arc
@@ -262,7 +262,7 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
 
 
 def _retarget_arc(arc: Arc, pt: tuple[float, float]) -> Arc:
-    from ..path.geodesy import inverse
+    """The same arc ending on the radial through ``pt`` (small correction only)."""
     _, az, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, pt[0], pt[1])
     if arc.sweep_deg >= 0:
         sweep = wrap360(az - arc.start_radial_deg)
