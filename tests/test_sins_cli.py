@@ -51,6 +51,8 @@ def test_ins_montecarlo_on_a_synthetic_trajectory(tmp_path):
                  "--duration-s", "60", "--out", str(out), "--seed", "3"]) == 0
     table = pd.read_csv(out / "ins_p95_table.csv")
     assert {"h95_m", "v95_m", "h95_cov_m", "v95_cov_m"} <= set(table.columns)
+    real = pd.read_parquet(out / "ins_realisations.parquet")
+    assert real["realisation"].nunique() == 20 and {"dp_e_m", "eps_u_rad"} <= set(real.columns)
 
 
 @pytest.mark.parametrize("args, match", [

@@ -186,6 +186,17 @@ class MonteCarloResult:
     label: str = ""
     extra: dict = field(default_factory=dict)
 
+    def realisations_frame(self) -> pd.DataFrame:
+        """Long table of the kept realisations: t_s, realisation, and the 9 navigation errors
+        (dp_*_m, dv_*_mps, eps_*_rad)."""
+        from .model import STATE_NAMES
+        n_t, _, n_keep = self.samples.shape
+        cols = {"t_s": np.repeat(self.t_s, n_keep),
+                "realisation": np.tile(np.arange(n_keep), n_t)}
+        for i, name in enumerate(STATE_NAMES[:9]):
+            cols[name] = self.samples[:, i, :].reshape(-1)
+        return pd.DataFrame(cols)
+
     def to_frame(self) -> pd.DataFrame:
         """Columns t_s, h95_m, v95_m, sigma_<state>."""
         from .model import STATE_NAMES

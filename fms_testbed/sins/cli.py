@@ -69,6 +69,7 @@ def _handler(args) -> int:
         log.info("Monte-Carlo %d realisations: %.1f s", args.n, time.perf_counter() - t0)
         results[f"Monte-Carlo (N = {args.n})"] = mc
         mc.to_frame().to_csv(out / "ins_montecarlo_sigma.csv", index=False)
+        mc.realisations_frame().to_parquet(out / "ins_realisations.parquet", index=False)
     cov.to_frame().to_csv(out / "ins_covariance_sigma.csv", index=False)
     main = mc if mc is not None else cov
     table = error_table(main, args.table_every_s)
