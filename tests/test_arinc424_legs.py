@@ -180,7 +180,7 @@ def test_rf_follows_the_coded_centre_radius_and_direction_beyond_180(tmp_path):
     p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
                          app("RF", 30, fix="WC", turn="R", arc_radius_nm=2.0, centre="CTR")],
               extra=[waypoint_record("WC", *c), waypoint_record("CTR", *centre)])
-    rf = [s for s in p.segments if s.path_term == "RF"][0].geom
+    rf = [s.geom for s in arcs(p) if s.path_term == "RF"][0]
     assert rf.radius_m == pytest.approx(2.0 * NM, abs=0.05 * NM)
     assert rf.sweep_deg == pytest.approx(160.0, abs=0.1)   # clockwise from 180 to 340
     assert dist(end_of(p), c) < 0.5
@@ -193,7 +193,7 @@ def test_rf_coded_left_goes_the_long_way(tmp_path):
     p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
                          app("RF", 30, fix="WC", turn="L", arc_radius_nm=2.0, centre="CTR")],
               extra=[waypoint_record("WC", *c), waypoint_record("CTR", *centre)])
-    rf = [s for s in p.segments if s.path_term == "RF"][0].geom
+    rf = [s.geom for s in arcs(p) if s.path_term == "RF"][0]
     assert rf.sweep_deg == pytest.approx(-340.0, abs=0.1) and rf.turn == "L"
 
 
@@ -202,7 +202,7 @@ def test_af_flies_the_dme_arc_the_coded_way(tmp_path):
     p = build(tmp_path, [app("IF", 10, fix="ARC1"),
                          app("AF", 20, fix="ARC2", turn="L", navaid="TVR", theta_deg=100.0,
                              rho_nm=10.0, course_deg=200.0)])
-    af = [s for s in p.segments if s.path_term == "AF"][0].geom
+    af = [s.geom for s in arcs(p) if s.path_term == "AF"][0]
     assert dist(af.centre, w["TVR"]) < 0.5
     assert af.radius_m == pytest.approx(10.0 * NM, abs=1.0)
     assert af.sweep_deg == pytest.approx(-100.0, abs=0.01)

@@ -243,9 +243,10 @@ class LegBuilder:
         return self.line_to(state, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
 
     def connect(self, state: FlightState, lat: float, lon: float, why: str) -> FlightState:
-        """Bridge a gap with a connector line, recording a discontinuity when it exceeds 1 m."""
+        """Bridge a gap (> 1 cm) with a connector line; a gap above 0.05 NM is also recorded
+        as a discontinuity finding."""
         s, _, _ = inverse(state.lat_deg, state.lon_deg, lat, lon)
-        if s <= 1.0:
+        if s <= 0.01:
             return replace(state, lat_deg=lat, lon_deg=lon)
         if s > 0.05 * 1852.0:
             self.finding("discontinuity", f"{why}: gap of {s / 1852.0:.2f} NM bridged")
