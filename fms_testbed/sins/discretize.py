@@ -45,31 +45,38 @@ def _picard(F, Q, dt, order, tol, max_order):
     phi = np.eye(n) + tn
     qk = tm.copy()
     gam = np.eye(n) * dt + tn * (dt / 2.0)
+    buf = np.empty((n, n))
+    L = np.empty((n, n))
     i = 1
     converged = order > 0
     target = order if order > 0 else max_order
     while i < target:
         k = i + 1
-        tn = (F @ tn) * (dt / k)
-        L = F @ tm
-        tm = (L + L.T) * (dt / k)
-        phi += tn
-        qk += tm
-        gam += tn * (dt / (k + 1))
+        h = dt / k
+        hg = dt / (k + 1)
+        _mm_into(F, tn, buf)             # products skip the zeros of F (sparse INS models)
+        _mm_into(F, tm, L)
+        t_p = b_p = t_q = b_q = 0.0
+        diag_ok = True
+        for r in range(n):
+            for c in range(n):
+                v = buf[r, c] * h
+                tn[r, c] = v
+                phi[r, c] += v
+                gam[r, c] += v * hg
+                w = (L[r, c] + L[c, r]) * h
+                tm[r, c] = w
+                qk[r, c] += w
+                t_p = max(t_p, abs(v))
+                b_p = max(b_p, abs(phi[r, c]))
+                t_q = max(t_q, abs(w))
+                b_q = max(b_q, abs(qk[r, c]))
+            if abs(tm[r, r]) > tol * abs(qk[r, r]):
+                diag_ok = False
         i = k
-        if order <= 0 and i >= 2:
-            ok = np.abs(tn).max() <= tol * np.abs(phi).max()
-            if ok:
-                qmax = np.abs(qk).max()
-                ok = np.abs(tm).max() <= tol * qmax
-                if ok:
-                    for j in range(n):
-                        if abs(tm[j, j]) > tol * abs(qk[j, j]):
-                            ok = False
-                            break
-            if ok:
-                converged = True
-                break
+        if order <= 0 and i >= 2 and t_p <= tol * b_p and t_q <= tol * b_q and diag_ok:
+            converged = True
+            break
     return phi, qk, gam, i, converged
 
 
