@@ -27,9 +27,19 @@ def _T(lat, h):
     return np.array([[0.0, (rn + h) * math.cos(lat), 0.0], [rm + h, 0.0, 0.0], [0.0, 0.0, 1.0]])
 
 
-def _sensor_errors(x):
+TRUTHS = {
+    # name: (lat rad, alt m, V ENU m/s, C_B^N, specific force FRD m/s², ω_IB FRD rad/s)
+    "climbing-turn-47N": (LAT, ALT, V, C, F_B, W_IB),
+    "descent-southern-banked": (-0.6, 9000.0, np.array([-220.0, 40.0, -12.0]),
+                                dcm_body_to_enu(-0.5, -0.03, 4.2), np.array([-0.8, 0.1, -12.5]),
+                                np.array([-0.03, 0.01, -0.08])),
+    "low-slow-60N": (1.05, 300.0, np.array([20.0, -60.0, 2.0]), dcm_body_to_enu(0.05, 0.12, 2.9),
+                     np.array([1.2, -0.2, -9.6]), np.array([0.002, 0.004, -0.01])),
+}
+
+
+def _sensor_errors(x, a, w):
     ba, bg, ka, kg, ma, mg = x[9:12], x[12:15], x[15:18], x[18:21], x[21:27], x[27:33]
-    a, w = F_B, W_IB
     da = ba + ka * a + np.array([a[1] * ma[0] + a[2] * ma[1], a[0] * ma[2] + a[2] * ma[3],
                                  a[0] * ma[4] + a[1] * ma[5]])
     dw = bg + kg * w + np.array([w[1] * mg[0] + w[2] * mg[1], w[0] * mg[2] + w[2] * mg[3],
@@ -37,44 +47,46 @@ def _sensor_errors(x):
     return da, dw
 
 
-def _error_rate(x):
+def _error_rate(x, truth):
     """dx/dt of the navigation errors (9) from the exact mechanisation of truth and perturbed."""
-    T = _T(LAT, ALT)
+    lat, alt, v, c, f_b, w_ib = truth
+    T = _T(lat, alt)
     dr = np.linalg.solve(T, x[0:3])                       # (δφ, δλ, δh)
-    lat_s, h_s = LAT + dr[0], ALT + dr[2]
-    v_s = V + x[3:6]
-    c_s = scipy.linalg.expm(-_skew(x[6:9])) @ C
-    da, dw = _sensor_errors(x)
-    rt = mechanisation_rates(LAT, ALT, V, C, F_B, W_IB)
-    rs = mechanisation_rates(lat_s, h_s, v_s, c_s, F_B + da, W_IB + dw)
+    c_s = scipy.linalg.expm(-_skew(x[6:9])) @ c
+    da, dw = _sensor_errors(x, f_b, w_ib)
+    rt = mechanisation_rates(lat, alt, v, c, f_b, w_ib)
+    rs = mechanisation_rates(lat + dr[0], alt + dr[2], v + x[3:6], c_s, f_b + da, w_ib + dw)
     # δp = T(r) (r* - r):  d/dt δp = Ṫ (r* - r) + T (ṙ* - ṙ), Ṫ by central differences in φ, h
     e = 1e-6
-    dT_dlat = (_T(LAT + e, ALT) - _T(LAT - e, ALT)) / (2 * e)
-    dT_dh = (_T(LAT, ALT + 1.0) - _T(LAT, ALT - 1.0)) / 2.0
+    dT_dlat = (_T(lat + e, alt) - _T(lat - e, alt)) / (2 * e)
+    dT_dh = (_T(lat, alt + 1.0) - _T(lat, alt - 1.0)) / 2.0
     T_dot = dT_dlat * rt[0] + dT_dh * rt[2]
-    r_dot_diff = np.array([rs[0] - rt[0], rs[1] - rt[1], rs[2] - rt[2]])
-    dp_dot = T_dot @ dr + T @ r_dot_diff
+    dp_dot = T_dot @ dr + T @ np.array([rs[0] - rt[0], rs[1] - rt[1], rs[2] - rt[2]])
     dv_dot = rs[3] - rt[3]
-    e_dot_m = rs[4] @ C.T + c_s @ rt[4].T                  # d/dt (C* Cᵀ)
+    e_dot_m = rs[4] @ c.T + c_s @ rt[4].T                  # d/dt (C* Cᵀ)
     sk = 0.5 * (e_dot_m - e_dot_m.T)
     eps_dot = -np.array([sk[2, 1], sk[0, 2], sk[1, 0]])
     return np.concatenate([dp_dot, dv_dot, eps_dot])
 
 
-def test_F_matches_numerical_jacobian_of_mechanisation_to_1e6():
-    F = build_F(LAT, ALT, V, F_B, W_IB, C, DECAY, 0.0, 0.0)
+@pytest.mark.parametrize("name", list(TRUTHS))
+def test_F_matches_numerical_jacobian_of_mechanisation_to_1e6(name):
+    truth = TRUTHS[name]
+    lat, alt, v, c, f_b, w_ib = truth
+    F = build_F(lat, alt, v, f_b, w_ib, c, DECAY, 0.0, 0.0)
     steps = np.array([10.0] * 3 + [1e-2] * 3 + [1e-5] * 3 + [1e-4] * 3 + [1e-6] * 3
                      + [1e-4] * 6 + [1e-4] * 12)
     J = np.zeros((9, 33))
     for j in range(33):
         xp = np.zeros(33)
         xp[j] = steps[j]
-        J[:, j] = (_error_rate(xp) - _error_rate(-xp)) / (2 * steps[j])
+        J[:, j] = (_error_rate(xp, truth) - _error_rate(-xp, truth)) / (2 * steps[j])
     Fn = F[:9]
     scale = np.abs(J).max(axis=1, keepdims=True)          # row scale (units differ per row)
     err = np.abs(Fn - J)
     assert np.all(err <= 1e-6 * np.maximum(np.abs(J), 1e-6 * scale)), np.unravel_index(
         np.argmax(err / np.maximum(np.abs(J), 1e-6 * scale)), err.shape)
+    assert np.array_equal(np.diag(F)[9:], -DECAY)
 
 
 def _stationary_F(lat=math.radians(45.0), heading=math.pi / 2, baro_tau_s=60.0):
