@@ -93,11 +93,16 @@ def register(subparsers) -> None:
         "ins", help="SINS error analysis (covariance / Monte-Carlo) along a trajectory",
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("target", help="run directory, scenario .yaml, or synthetic:stationary|straight")
-    p.add_argument("--imu", default="STIM300", help="preset name (imu/*.yaml) or a .yaml file")
-    p.add_argument("--mode", choices=("covariance", "montecarlo"), default="covariance")
+    from .presets import list_presets
+
+    p.add_argument("--imu", default="STIM300",
+                   help=f"preset ({', '.join(list_presets())}) or an IMU .yaml file "
+                        "(default STIM300)")
+    p.add_argument("--mode", choices=("covariance", "montecarlo"), default="covariance",
+                   help="covariance propagation only, or plus a vectorised Monte-Carlo")
     p.add_argument("-n", type=int, default=1000, help="Monte-Carlo realisations (default 1000)")
     p.add_argument("--out", default="results/ins", help="output folder")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of the Monte-Carlo / flight")
     p.add_argument("--method", choices=("picard", "vanloan", "trapezoid"), default="picard")
     p.add_argument("--vertical", choices=("baro", "free"), default="baro",
                    help="baro-damped (default) or free (unstable) vertical channel")
