@@ -253,3 +253,14 @@ def test_pi_turns_45_the_coded_way_then_180_the_other(tmp_path):
               if s.leg_index == 2 and isinstance(s.geom, Arc)]
     assert 45 in sweeps and -180 in sweeps
     assert dist(end_of(p), world()["WB"]) < 0.5
+
+
+def test_fix_leg_reached_from_elsewhere_turns_the_coded_way_to_its_fix(tmp_path):
+    # after the runway heading the fix lies to the right; the FA is coded to turn left
+    p = build(tmp_path, [sid("VA", 10, course_deg=90.0, alt_desc="+", alt1_ft=400),
+                         sid("FA", 20, fix="WS", turn="L", course_deg=270.0, alt_desc="+",
+                             alt1_ft=9000)])
+    first = [s for s in arcs(p, "turn") if s.leg_index == 1][0].geom
+    assert first.turn == "L"
+    from fms_testbed.arinc424.check import leg_turn_mismatches
+    assert leg_turn_mismatches(p) == 0

@@ -31,7 +31,8 @@ class Invariants:
     max_gap_m: largest distance between consecutive segments' end and start, m;
     fix_excess_m: largest (distance from a fix leg's end to its fix − allowed), m (≤ 0 = ok);
     rf_radius_err_m: largest |built RF radius − coded radius|, m;
-    turn_mismatch: number of RF/AF arcs turning against the coded direction.
+    turn_mismatch: number of RF/AF arcs turning against the coded direction plus legs whose
+    first turn goes against it (:func:`leg_turn_mismatches`).
     """
 
     max_gap_m: float
@@ -48,7 +49,7 @@ def invariants(path: ProcedurePath) -> Invariants:
         gap = max(gap, inverse(*a.geom.end, *b.geom.start)[0])
     excess = max((fc.miss_m - fc.allowed_m for fc in leg_end_checks(path)), default=-math.inf)
     rf_err = 0.0
-    mism = 0
+    mism = leg_turn_mismatches(path)
     for seg in segs:
         if seg.role != "leg" or not isinstance(seg.geom, Arc) or seg.path_term not in ("RF", "AF"):
             continue
@@ -58,6 +59,36 @@ def invariants(path: ProcedurePath) -> Invariants:
         if rec.turn_dir in ("L", "R") and seg.geom.turn != rec.turn_dir:
             mism += 1
     return Invariants(gap, excess, rf_err, mism)
+
+
+def leg_turn_mismatches(path: ProcedurePath) -> int:
+    """Legs whose first turn goes against the coded turn direction (col 44).
+
+    The first turn of a leg is the fly-by arc that ends the previous leg into it, or the turn
+    flown from the present position at its start; later turns of the same leg (the return onto
+    a course after a 45° intercept, hold circuits, the procedure turn's 180°) are not the coded
+    turn. Turns under 1° are ignored.
+    """
+    segs = path.segments
+    first: dict[int, int] = {}
+    for k, seg in enumerate(segs):
+        first.setdefault(seg.leg_index, k)
+    bad = 0
+    for lg in path.legs:
+        d = lg.record.turn_dir
+        if d not in ("L", "R") or lg.path_term in ("HA", "HF", "HM", "PI", "RF", "AF", "IF"):
+            continue
+        k = first.get(lg.index)
+        if k is None:
+            continue
+        arc = None
+        if k > 0 and segs[k - 1].role == "flyby":
+            arc = segs[k - 1].geom
+        elif segs[k].role == "turn" and isinstance(segs[k].geom, Arc):
+            arc = segs[k].geom
+        if arc is not None and abs(arc.sweep_deg) > 1.0 and arc.turn != d:
+            bad += 1
+    return bad
 
 
 def perf_for(aircraft: str) -> Performance:

@@ -272,13 +272,19 @@ def _intercept(b: LegBuilder, s: FlightState, course: float) -> tuple[FlightStat
 
 def _from_fix(b: LegBuilder, s: FlightState, direction: str | None = "coded"
               ) -> tuple[FlightState, float]:
+    """Get to the leg's fix (direct, turning the coded way) and onto its course from there.
+
+    The coded turn direction applies to the first turn of the leg: the turn toward the fix when
+    the aircraft is elsewhere, else the turn onto the course at the fix."""
     f, c = _fix(b), _course(b)
+    d = b.turn_dir() if direction == "coded" else direction
     if s.track_deg is None:
         s = replace(b.fix_state(s, f), track_deg=c)
     elif inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[0] > 1.0:
-        s = b.direct_to(s, f, None, not b.leg.rec.fly_over)
+        s = b.direct_to(s, f, d, not b.leg.rec.fly_over)
         s = b.fix_state(s, f)
-    return b.start_course(s, c, b.turn_dir() if direction == "coded" else direction), c
+        d = None
+    return b.start_course(s, c, d), c
 
 
 class _CourseLeg(Leg):
