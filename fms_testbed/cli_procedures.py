@@ -41,7 +41,6 @@ def cmd_build(args) -> int:
     out.mkdir(parents=True, exist_ok=True)
     apt = db.airports.get(args.airport.upper())
     g = gravity_mps2(apt.lat_deg if apt else 45.0)
-    n_bad = 0
     for seq in seqs:
         path = check_path(build_sequence(db, seq, perf, params), perf, params, g)
         gj = write_geojson(path, out)
@@ -52,7 +51,6 @@ def cmd_build(args) -> int:
         for f in path.findings:
             print(f"    leg {f.leg_index + 1}: {f.category}"
                   f"{' [' + f.branch + ']' if f.branch else ''}: {f.message}")
-        n_bad += path.status == "impossible"
     for issue in db.issues[:20]:
         print(f"    rejected record: {issue}")
     return 0

@@ -264,3 +264,14 @@ def test_fix_leg_reached_from_elsewhere_turns_the_coded_way_to_its_fix(tmp_path)
     assert first.turn == "L"
     from fms_testbed.arinc424.check import leg_turn_mismatches
     assert leg_turn_mismatches(p) == 0
+
+
+def test_coded_speed_limit_caps_the_planned_speed_and_turn_radius(tmp_path):
+    legs = [sid("CA", 10, course_deg=90.0, alt_desc="+", alt1_ft=1000),
+            sid("DF", 20, fix="WS", speed_kt=180, speed_desc="-")]
+    p = build(tmp_path, legs)
+    turn = [s for s in arcs(p, "turn") if s.leg_index == 1][0]
+    assert turn.speed_mps < 180 * 1852 / 3600 * 1.05          # IAS 180 kt -> TAS at ~1000 ft
+    assert turn.geom.radius_m < R_PLAN * 0.7
+    assert turn.geom.radius_m == pytest.approx(
+        turn_radius_m(turn.speed_mps, PARAMS.bank_plan_deg, G), rel=1e-3)

@@ -12,7 +12,7 @@ import math
 from dataclasses import dataclass, replace
 
 from ..path.geodesy import direct, inverse, wrap180, wrap360
-from ..path.segments import Arc, Line, turn_angle_deg
+from ..path.segments import Arc, Line
 from .construct import _foot, direct_to_arc, ray_geodesic_intersection, turn_to_course
 from .legrecord import LegRecord
 from .model import BuildParams, Finding, FlightState, PathSegment, Performance
@@ -270,7 +270,3 @@ class LegBuilder:
         dh = alt_target_m - state.alt_m
         return max(dh, 0.0) / max(self.gradient, 1e-3)
 
-
-def signed_turn(course_in_deg: float, course_out_deg: float, direction: str | None) -> float:
-    """Signed track change (+ right), coded direction respected, deg."""
-    return turn_angle_deg(course_in_deg, course_out_deg, direction)

@@ -96,12 +96,14 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightS
 
 
 def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float) -> float:
-    """Planned TAS: the aircraft's planned TAS capped by an 'at' or 'at or below' speed limit
-    (coded as IAS, turned to TAS in the ISA), m/s."""
+    """Planned TAS: the aircraft's planned TAS capped by an 'at' or 'at or below' speed limit,
+    raised to an 'at or above' one (limits are IAS, turned to TAS in the ISA), m/s."""
     v = perf.tas_plan_mps
     lim = leg.rec.speed_limit_mps
     if lim is not None and leg.rec.speed_desc in ("", "-", "@"):
         v = min(v, isa_tas_mps(lim, alt_m))
+    elif lim is not None and leg.rec.speed_desc == "+":
+        v = max(v, isa_tas_mps(lim, alt_m))
     return v
 
 
