@@ -42,6 +42,8 @@ OVERRUN_MAX_M = 20 * 1852.0
 XTK_ABORT_M = 5 * 1852.0
 """Cross-track beyond which the flight is declared off the procedure, m."""
 STRAIGHT_MARGIN_M = 2000.0
+MIN_SEGMENT_M = 1.0
+"""Segments shorter than this (the builder's sub-metre bridges) are not flown, m."""
 
 
 @dataclass
@@ -182,7 +184,8 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     """The path as flown: a 'connector' line the builder put across a discontinuity (e.g.
     after vectors, VM/FM) that starts with a track change is flown as a direct-to — a turn at
     the planned radius from the previous segment's end, then a line to the connector's end —
-    as an FMS does after a discontinuity is cleared; other segments unchanged."""
+    as an FMS does after a discontinuity is cleared; segments shorter than MIN_SEGMENT_M are
+    dropped; other segments unchanged."""
     from dataclasses import replace as _replace
 
     from ..arinc424.construct import direct_to_arc
@@ -191,6 +194,8 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     r = tas_mps * tas_mps / (9.80665 * math.tan(math.radians(bank_deg)))
     out = []
     for k, sg in enumerate(segs):
+        if sg.geom.length_m() < MIN_SEGMENT_M and len(segs) > 1:
+            continue  # a sub-metre bridge between legs: nothing to fly
         if sg.role == "connector" and out and isinstance(sg.geom, Line):
             prev = out[-1].geom
             trk = prev.end_course_deg
