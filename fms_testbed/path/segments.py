@@ -103,9 +103,9 @@ class Arc:
         object.__setattr__(self, "_start", self._radial_point(self.start_radial_deg))
         object.__setattr__(self, "_end", self._radial_point(self.start_radial_deg + self.sweep_deg))
 
-    def _radial_point(self, radial_deg: float) -> tuple[float, float]:
-        lat, lon, _ = direct(self.centre_lat_deg, self.centre_lon_deg, radial_deg, self.radius_m)
-        return lat, lon
+    def _radial_point(self, radial_deg: float) -> tuple[float, float, float]:
+        """(lat_deg, lon_deg, outward radial azimuth at the point, deg)."""
+        return direct(self.centre_lat_deg, self.centre_lon_deg, radial_deg, self.radius_m)
 
     @property
     def turn(self) -> str:
@@ -120,12 +120,12 @@ class Arc:
     @property
     def start(self) -> tuple[float, float]:
         """Start point (lat_deg, lon_deg)."""
-        return self._start
+        return self._start[0], self._start[1]
 
     @property
     def end(self) -> tuple[float, float]:
         """End point (lat_deg, lon_deg)."""
-        return self._end
+        return self._end[0], self._end[1]
 
     @property
     def end_radial_deg(self) -> float:
@@ -136,18 +136,20 @@ class Arc:
         """Arc length R·|Ω|, m."""
         return self.radius_m * math.radians(abs(self.sweep_deg))
 
-    def _course_from_radial(self, radial_deg: float) -> float:
-        return wrap360(radial_deg + (90.0 if self.sweep_deg >= 0 else -90.0))
+    def _course_from_radial(self, radial_at_point_deg: float) -> float:
+        """Tangent course from the outward radial azimuth *at the point* (not at the centre:
+        the two differ by the meridian convergence, 0.05° for an 18-km arc at 50°N)."""
+        return wrap360(radial_at_point_deg + (90.0 if self.sweep_deg >= 0 else -90.0))
 
     @property
     def start_course_deg(self) -> float:
         """Tangent course at the start, deg true."""
-        return self._course_from_radial(self.start_radial_deg)
+        return self._course_from_radial(self._start[2])
 
     @property
     def end_course_deg(self) -> float:
         """Tangent course at the end, deg true."""
-        return self._course_from_radial(self.start_radial_deg + self.sweep_deg)
+        return self._course_from_radial(self._end[2])
 
     def radial_at(self, s_m: float) -> float:
         """Radial (azimuth from the centre) at arc distance ``s_m`` (m) from the start, deg."""
@@ -156,11 +158,12 @@ class Arc:
 
     def point_at(self, s_m: float) -> tuple[float, float]:
         """Point at arc distance ``s_m`` (m) from the start, (lat_deg, lon_deg)."""
-        return self._radial_point(self.radial_at(s_m))
+        lat, lon, _ = self._radial_point(self.radial_at(s_m))
+        return lat, lon
 
     def course_at(self, s_m: float) -> float:
         """Tangent course at arc distance ``s_m`` (m), deg true."""
-        return self._course_from_radial(self.radial_at(s_m))
+        return self._course_from_radial(self._radial_point(self.radial_at(s_m))[2])
 
 
 Segment = Line | Arc
@@ -205,7 +208,7 @@ def project(segment: Segment, lat_deg: float, lon_deg: float
             lat0, lon0, crs = direct(segment.start_lat_deg, segment.start_lon_deg,
                                      segment.start_course_deg, s)
         return s, xtk, math.radians(wrap360(crs)), 0.0
-    r, az, _ = inverse(segment.centre_lat_deg, segment.centre_lon_deg, lat_deg, lon_deg)
+    r, az, az_out = inverse(segment.centre_lat_deg, segment.centre_lon_deg, lat_deg, lon_deg)
     right = segment.sweep_deg >= 0
     if right:
         dtheta = wrap360(az - segment.start_radial_deg)
@@ -217,7 +220,7 @@ def project(segment: Segment, lat_deg: float, lon_deg: float
         dtheta -= 360.0
     along = segment.radius_m * math.radians(dtheta)
     xtk = (segment.radius_m - r) if right else (r - segment.radius_m)
-    trk = wrap360(az + (90.0 if right else -90.0))
+    trk = wrap360(az_out + (90.0 if right else -90.0))  # radial azimuth at the point
     curv = (1.0 if right else -1.0) / segment.radius_m
     return along, xtk, math.radians(trk), curv
 
