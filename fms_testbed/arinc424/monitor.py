@@ -85,6 +85,18 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
         if r.turn_dir in ("L", "R") and arc.turn != r.turn_dir:
             out.append(Finding(lg.index, "impossible", f"{lg.path_term} arc turns {arc.turn}, "
                                f"coded {r.turn_dir}"))
+        if lg.path_term == "RF" and lg.index > 0 and path.legs[lg.index - 1].record.fix \
+                and path.legs[lg.index - 1].termination.kind == "fix" and r.fix is not None:
+            # Ω: the angle the database's fixes subtend about the coded centre
+            t0 = path.legs[lg.index - 1].termination
+            _, a0, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, t0.lat_deg, t0.lon_deg)
+            _, a1, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, lg.termination.lat_deg,
+                               lg.termination.lon_deg)
+            omega_k = (a1 - a0) % 360.0 if arc.turn == "R" else (a0 - a1) % 360.0
+            built = sum(abs(s.geom.sweep_deg) for s in arcs)
+            if abs(built - omega_k) > 1.0 and abs(built - omega_k) < 359.0:
+                out.append(Finding(lg.index, "discontinuity", f"RF arc angle built "
+                                   f"{built:.1f}° vs {omega_k:.1f}° between its fixes"))
         coded_r = r.arc_radius_m if lg.path_term == "RF" else r.rho_m
         if coded_r:
             dr = arc.radius_m - coded_r
