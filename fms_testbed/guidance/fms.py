@@ -23,6 +23,7 @@ from __future__ import annotations
 import bisect
 import logging
 import math
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from ..path.geodesy import inverse
@@ -249,6 +250,33 @@ def _activate(fp: FlyablePath, db, s_base_m: float, tas_mps: float = 118.0) -> _
                    s_base_m, last)
 
 
+class _LazyLog(Mapping):
+    """The step's log, computed only when the runner reads it (at its logging rate, not at
+    every guidance step): keeps the per-call cost of guidance small."""
+
+    __slots__ = ("_f", "_args", "_d")
+
+    def __init__(self, f, args):
+        self._f, self._args, self._d = f, args, None
+
+    def _get(self) -> dict:
+        if self._d is None:
+            self._d = self._f(*self._args)
+        return self._d
+
+    def __getitem__(self, k):
+        return self._get()[k]
+
+    def __iter__(self):
+        return iter(self._get())
+
+    def __len__(self) -> int:
+        return len(self._get())
+
+    def keys(self):
+        return self._get().keys()
+
+
 class ProcedureGuidance:
     """Guidance that flies a :class:`~.procedure.FlyablePath` (implements the runner's
     ``Guidance`` protocol: ``update(dt_s, nav, truth) -> GuidanceOutput``).
@@ -458,7 +486,8 @@ class ProcedureGuidance:
                                           self.cfg.limits.cas_min_mps)
             self.next_speed_t = nav.t_s + 1.0
         return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=self.tas_cmd,
-                              log=self._log(p, along, xtk, None, seg, nav, truth, g_leg, s_path))
+                              log=_LazyLog(self._log, (p, along, xtk, None, seg, nav, truth,
+                                                       g_leg, s_path)))
 
     def _log(self, p: LocalPiece, along: float, nav_xtk: float, true_xtk, seg, nav, truth,
              g_leg: int, s_path: float) -> dict:
