@@ -117,8 +117,11 @@ class Database:
             seqs = [s for s in seqs if s.transition == transition]
         if not seqs:
             known = sorted({s.proc_id for s in self.sequences(airport)})
-            raise UserError(f"{self.path}: no procedure {procedure!r} transition {transition!r} "
-                            f"at {airport}; procedures: {', '.join(known)}")
+            what = f"procedure {procedure!r}" if procedure else "procedure"
+            if transition is not None:
+                what += f" with transition {transition!r}"
+            raise UserError(f"{self.path}: no {what} at {airport}; procedures: "
+                            f"{', '.join(known)}")
         return seqs
 
 

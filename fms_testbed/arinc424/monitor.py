@@ -174,6 +174,7 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
         need = (w.lo_m - prof.alt_m[j]) / max(prof.along_m[k] - prof.along_m[0], 1.0) \
             if j == 0 else (w.lo_m - prof.alt_m[j]) / max(ds, 1.0)
         need = max(need, (w.lo_m - prof.alt_m[0]) / max(prof.along_m[k], 1.0))
+        name = w.fix_ident or f"the end of {path.legs[w.leg_index].path_term}"
         ok = False
         vv = v
         for _ in range(params.max_iterations):
@@ -182,11 +183,11 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                 ok = True
                 break
         if ok:
-            out.append(Finding(w.leg_index, "correction", f"{w.fix_ident} at or above "
+            out.append(Finding(w.leg_index, "correction", f"{name} at or above "
                                f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.1f}% climb: speed "
                                f"{v / KT:.0f} -> {vv / KT:.0f} kt", "V,Θ"))
         else:
-            out.append(Finding(w.leg_index, "impossible", f"{w.fix_ident} at or above "
+            out.append(Finding(w.leg_index, "impossible", f"{name} at or above "
                                f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.2f}% climb, aircraft "
                                f"max {100 * perf.climb_gradient_at(perf.tas_min_mps):.2f}% at "
                                "minimum speed"))

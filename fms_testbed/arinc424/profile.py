@@ -4,7 +4,8 @@ Nodes are the path start and every leg end (distance along the built path, m). C
 (SIDs, missed approaches) climb at the aircraft's gradient, level off below every 'at or
 below' constraint ahead and at the highest climb constraint still ahead (with none: the coded
 transition altitude, else 18,000 ft); descent phases are planned backwards from the last constrained fix at
-the coded vertical angle (else 3°), clamped into each fix's altitude window. One geometry feeds
+the coded vertical angle (else 3°), clamped into each fix's altitude window and never above
+the start altitude or the highest coded altitude. One geometry feeds
 both: the distances come from the same segments the map and guidance use.
 """
 
@@ -120,6 +121,8 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
         lo_at[w.leg_index + 1], hi_at[w.leg_index + 1] = w.lo_m, w.hi_m
     # descent: backward pass from the last descent node, then clamp into windows
     desc_idx = [k for k in range(1, n + 1) if not climb[k]]
+    coded = [v for w in windows for v in (w.lo_m, w.hi_m) if v is not None]
+    ceiling = max([start_alt_m] + coded)   # never plan above the start or any coded altitude
     if desc_idx:
         last = desc_idx[-1]
         h = next((lo_at[k] if lo_at[k] is not None else hi_at[k]
@@ -132,6 +135,7 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
             if vpa:
                 ang = abs(vpa)
             h = alt[k + 1] + math.tan(math.radians(ang)) * (along[k + 1] - along[k])
+            h = min(h, ceiling)
             if hi_at[k] is not None:
                 h = min(h, hi_at[k])
             if lo_at[k] is not None:
