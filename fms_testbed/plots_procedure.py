@@ -105,7 +105,7 @@ def plot_vertical(df, summary, fp, out: Path) -> Path:
             label="altitude target to the law")
     if prof is not None:
         ax.plot(np.asarray(prof.along_m) / NM_M, np.asarray(prof.alt_m) / FT_M, "b-o", ms=3,
-                lw=0.9, alpha=0.6, label="planned profile")
+                lw=0.9, alpha=0.6, label="planned profile (builder; climbs flown at best rate to the climb top)")
         for w in prof.windows:
             x = w.along_m / NM_M
             lab = w.fix_ident or f"leg {w.leg_index + 1}"

@@ -44,7 +44,14 @@ XTK_ABORT_M = 5 * 1852.0
 """Cross-track beyond which the flight is declared off the procedure, m."""
 STRAIGHT_MARGIN_M = 2000.0
 MIN_SEGMENT_M = 1.0
-"""Segments shorter than this (the builder's sub-metre bridges) are not flown, m."""
+ARC_BANK_MARGIN_DEG = 3.0
+"""Arcs are flown at a speed that needs at most the bank limit minus this, deg."""
+DECEL_MPS2 = 0.3
+"""Deceleration assumed when slowing for an arc ahead, m/s²."""
+"""Segments shorter than this are not flown, m."""
+MIN_CONNECTOR_M = 50.0
+"""Connector segments (the builder's bridges over gaps) shorter than this are not flown: their
+course is meaningless and the lateral law absorbs a gap this small, m."""
 
 
 @dataclass
@@ -185,8 +192,8 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     """The path as flown: a 'connector' line the builder put across a discontinuity (e.g.
     after vectors, VM/FM) that starts with a track change is flown as a direct-to — a turn at
     the planned radius from the previous segment's end, then a line to the connector's end —
-    as an FMS does after a discontinuity is cleared; segments shorter than MIN_SEGMENT_M are
-    dropped; other segments unchanged."""
+    as an FMS does after a discontinuity is cleared; segments shorter than MIN_SEGMENT_M
+    (connectors: MIN_CONNECTOR_M) are dropped; other segments unchanged."""
     from dataclasses import replace as _replace
 
     from ..arinc424.construct import direct_to_arc
@@ -195,8 +202,9 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     r = tas_mps * tas_mps / (9.80665 * math.tan(math.radians(bank_deg)))
     out = []
     for k, sg in enumerate(segs):
-        if sg.geom.length_m() < MIN_SEGMENT_M and len(segs) > 1:
-            continue  # a sub-metre bridge between legs: nothing to fly
+        short = MIN_CONNECTOR_M if sg.role == "connector" else MIN_SEGMENT_M
+        if sg.geom.length_m() < short and len(segs) > 1:
+            continue  # a tiny bridge between legs: nothing to fly (the law absorbs the gap)
         if sg.role == "connector" and out and isinstance(sg.geom, Line):
             prev = out[-1].geom
             trk = prev.end_course_deg
@@ -404,6 +412,25 @@ class ProcedureGuidance:
                                       f"({len(fp.path.segments)} segments)"})
         return True
 
+    def _arc_speed_cap(self, along: float, v_mps: float) -> float:
+        """Highest TAS at which every arc within the deceleration distance ahead can be flown
+        with ARC_BANK_MARGIN_DEG to spare below the bank limit, m/s: v = sqrt(R g tan γ)
+        (the monitor's V,γ correction, applied in flight). Deceleration distance:
+        (V² - v²) / (2 a) + 10 s of flight, a = DECEL_MPS2."""
+        a = self.act
+        g_tan = 9.80665 * math.tan(math.radians(self.gains.bank_max_deg - ARC_BANK_MARGIN_DEG))
+        cap = math.inf
+        dist = -along
+        for p in a.pieces[self.i:]:
+            if p.is_arc:
+                v = math.sqrt(p.radius_m * g_tan)
+                if dist <= max(v_mps * v_mps - v * v, 0.0) / (2 * DECEL_MPS2) + 10.0 * v_mps:
+                    cap = min(cap, v)
+            dist += p.length_m
+            if dist > 30000.0:
+                break
+        return cap
+
     def _abort(self, t_s: float, why: str) -> GuidanceOutput:
         self.abort_reason = why
         self.events.append({"t_s": t_s, "kind": "abort", "leg": self.leg, "detail": why})
@@ -454,8 +481,9 @@ class ProcedureGuidance:
         if along >= p.length_m and not hold:
             if self.i + 1 >= len(a.pieces):
                 self.done = True
-                return GuidanceOutput(done=True, log=self._log(p, along, xtk, xtk, seg, nav,
-                                                               truth, g_leg, float("nan")))
+                s_end = a.seg_cum_m[p.seg_index] + p.s0_m + along
+                return GuidanceOutput(done=True, log=self._log(p, along, xtk, None, seg, nav,
+                                                               truth, g_leg, s_end))
             self.i += 1
             return self.update(dt_s, nav, truth)
         if abs(xtk) > XTK_ABORT_M:
@@ -482,8 +510,8 @@ class ProcedureGuidance:
         if nav.t_s >= self.next_speed_t:
             lim = self.limits[g_leg] if g_leg < len(self.limits) else None
             lo, hi = cas_band(lim, self.carry_max_cas if self.descent else None)
-            self.tas_cmd = tas_target_mps(self.cfg.limits.climb_tas_mps, nav.alt_m, lo, hi,
-                                          self.cfg.limits.cas_min_mps)
+            plan = min(self.cfg.limits.climb_tas_mps, self._arc_speed_cap(along, gs))
+            self.tas_cmd = tas_target_mps(plan, nav.alt_m, lo, hi, self.cfg.limits.cas_min_mps)
             self.next_speed_t = nav.t_s + 1.0
         return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=self.tas_cmd,
                               log=_LazyLog(self._log, (p, along, xtk, None, seg, nav, truth,
@@ -500,7 +528,7 @@ class ProcedureGuidance:
             b + s_seg, f + a.segs[p.seg_index].geom.length_m() - s_seg)
         return {"xtk_m": true_xtk, "nav_xtk_m": nav_xtk, "leg_index": g_leg,
                 "leg_code": seg.path_term, "seg_role": seg.role,
-                "along_m": a.s_base_m + (s_path if s_path == s_path else 0.0),
+                "along_m": a.s_base_m + s_path,
                 "curvature_1pm": p.curvature_1pm, "straight_m": flat,
                 "pde_m": a.pde_m[p.seg_index], "rnp_m": a.fp.rnp_m[seg.leg_index]
                 if seg.leg_index < len(a.fp.rnp_m) else float("nan")}

@@ -53,7 +53,8 @@ class ProcedureSpec(BaseModel):
         15000.0, description="SID/missed-approach climbs stop here (raised to the highest "
                              "'at or above' constraint when that is higher), ft")
     start_alt_ft: Annotated[float, Field(ge=-1000, le=45000)] | None = Field(
-        None, description="start altitude, ft (default: the build's planned start)")
+        None, description="start altitude, ft (default: the build's planned start; a SID "
+                          "that starts at a fix starts at that fix's 'at or above' altitude)")
 
 
 def parse_procedure(raw, source: str = "<scenario>") -> ProcedureSpec:
@@ -229,10 +230,19 @@ def build_procedure(db, spec: ProcedureSpec, cfg) -> FlyablePath:
                                    spec.runway))
     perf, params = _perf_params(cfg, spec)
     path = build_sequence(db, seq, perf, params)
-    if spec.start_alt_ft is not None and path.legs:
+    start_alt = spec.start_alt_ft * FT_M if spec.start_alt_ft is not None else None
+    if start_alt is None and seq.proc_type == "D" and path.start_kind != "runway" and path.legs:
+        # a SID that starts at a fix (the runway part is vectors): arrive there at its
+        # 'at or above' altitude, not at runway height
+        from ..arinc424.profile import window
+        r0 = seq.legs[0]
+        lo, _ = window(r0.alt_desc, r0.alt1_m, r0.alt2_m)
+        if lo is not None and lo > path.legs[0].start.alt_m:
+            start_alt = lo
+    if start_alt is not None and path.legs:
         from ..arinc424.model import FlightState
         st = path.legs[0].start
-        start = FlightState(st.lat_deg, st.lon_deg, st.track_deg, spec.start_alt_ft * FT_M,
+        start = FlightState(st.lat_deg, st.lon_deg, st.track_deg, start_alt,
                             st.flyby, st.fix_ident)
         path = replace(build_sequence(db, seq, perf, params, start=start),
                        start_kind=path.start_kind)

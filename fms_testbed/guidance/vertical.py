@@ -8,7 +8,8 @@ aircraft's gradient, levels off under 'at or below' constraints and descends at 
     H_cmd = H_plan(s + V_g τ_H),    τ_H = 2 ξ_H T_H
 
 (a second-order altitude loop follows a ramp with a lag of 2 ξ_H T_H; reading the plan that far
-ahead removes it). In a climb phase (SID, missed approach) the target is instead the top of the
+ahead removes it). Speed is also capped ahead of arcs too tight for the planned TAS within the
+bank limit (``fms.ProcedureGuidance._arc_speed_cap``). In a climb phase (SID, missed approach) the target is instead the top of the
 climb — the highest planned altitude of the phase capped by every 'at or below' constraint
 ahead — flown at the law's level-change rate, set to the aircraft's sustained climb rate
 (:func:`procedure_law`): an FMS climbs at the best rate, not along a geometric path, so 'at or
