@@ -30,7 +30,7 @@ from ..path.geodesy import inverse
 from ..path.segments import Arc, Line, project
 from ..runner import GuidanceOutput
 from .geometry import LocalPiece, local_pieces, radii_m
-from .lateral import LateralGains, anticipation_m, bank_command_rad, feedforward_bank_rad
+from .lateral import LateralGains, bank_command_rad
 from .procedure import FlyablePath, rebuild_from
 from .vertical import altitude_lead_s, cas_band, leg_speed_limits, tas_target_mps
 
@@ -412,6 +412,39 @@ class ProcedureGuidance:
                                       f"({len(fp.path.segments)} segments)"})
         return True
 
+    def _feedforward_curvature(self, p: LocalPiece, along: float, nxt: LocalPiece | None,
+                               gs: float) -> float:
+        """Curvature (1/m) whose coordinated-turn bank is fed forward now.
+
+        Each arc's bank is commanded over a window placed so that the runner's rate-limited
+        roll (``roll_rate``) is centred on the arc: a long arc from ``V_g (|φ|/(2 p) + τ)``
+        before its start to as much before its end (:func:`.lateral.anticipation_m`); an arc
+        too short to reach its bank (``L p < V_g |φ|``) gets a triangular bank profile with the
+        same heading change, peak ``tan φ_pk = sqrt(|Δχ| V_g p / g)``, commanded from
+        ``V_g (φ_pk / p + τ)`` before the arc's middle to ``V_g τ`` before it.
+        """
+        g = self.gains
+        pr = math.radians(g.roll_rate_dps)
+        lag = gs * g.roll_lag_s
+        v2 = max(gs, 10.0) ** 2
+        kappa = 0.0
+        for q, d0 in ((p, -along), (nxt, p.length_m - along)):
+            if q is None or not q.is_arc:
+                continue
+            phi = abs(math.atan(v2 * q.curvature_1pm / 9.80665))
+            if q.length_m * pr >= gs * phi:
+                on = d0 - gs * phi / (2 * pr) - lag
+                off = d0 + q.length_m - gs * phi / (2 * pr) - lag
+                k = q.curvature_1pm
+            else:
+                t_pk = math.sqrt(q.length_m * abs(q.curvature_1pm) * gs * pr / 9.80665)
+                mid = d0 + 0.5 * q.length_m
+                on, off = mid - gs * math.atan(t_pk) / pr - lag, mid - lag
+                k = math.copysign(t_pk * 9.80665 / v2, q.curvature_1pm)
+            if on <= 0.0 < off:
+                kappa = k
+        return kappa
+
     def _arc_speed_cap(self, along: float, v_mps: float) -> float:
         """Highest TAS at which every arc within the deceleration distance ahead can be flown
         with ARC_BANK_MARGIN_DEG to spare below the bank limit, m/s: v = sqrt(R g tan γ)
@@ -490,13 +523,8 @@ class ProcedureGuidance:
             return self._abort(nav.t_s, f"off the procedure: cross-track {xtk / 1852:.1f} NM "
                                f"on leg {g_leg + 1} ({bl.path_term})")
         # lateral
-        kappa = p.curvature_1pm
-        if self.i + 1 < len(a.pieces) and not hold:
-            k2 = a.pieces[self.i + 1].curvature_1pm
-            if k2 != kappa:
-                dphi = feedforward_bank_rad(gs, k2) - feedforward_bank_rad(gs, kappa)
-                if p.length_m - along < anticipation_m(gs, dphi, self.gains):
-                    kappa = k2
+        nxt = a.pieces[self.i + 1] if self.i + 1 < len(a.pieces) and not hold else None
+        kappa = self._feedforward_curvature(p, along, nxt, gs)
         terr = (trk - dtrk + math.pi) % (2 * math.pi) - math.pi
         bank = bank_command_rad(xtk, terr, gs, kappa, self.gains)
         # vertical
