@@ -113,6 +113,15 @@ class LegBuilder:
             alt += dist_m * self.gradient
         return replace(state, alt_m=alt, **changes)
 
+    def settle(self, state: FlightState) -> FlightState:
+        """End of a leg: a fly-by corner that no line consumed (a zero-length leg) is dropped,
+        and the planned track goes back to the track actually flown."""
+        if self._corner_pending and self.segments:
+            self._corner_pending = False
+            return replace(state, track_deg=self.segments[-1].geom.end_course_deg)
+        self._corner_pending = False
+        return state
+
     # ------------------------------------------------------------------ moves
     def arc(self, state: FlightState, arc: Arc, role: str = "turn") -> FlightState:
         """Fly an arc from the present position."""
@@ -144,6 +153,8 @@ class LegBuilder:
         """True when the turn onto ``course_deg`` at the present fix may be flown fly-by."""
         if state.track_deg is None or not state.flyby:
             return False
+        if self.segments and isinstance(self.segments[-1].geom, Arc):
+            return False  # corners are rounded between two lines only: turn after the arc
         short = wrap180(course_deg - state.track_deg)
         if abs(short) > self.params.flyby_max_deg:
             return False
@@ -198,10 +209,12 @@ class LegBuilder:
         """
         along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
                                  state.lon_deg)
+        n0 = len(self.segments)
         trk = state.track_deg
-        if along < 0 and math.degrees(math.atan2(abs(xtk), -along)) < 3.0:
-            # within 3° of the course line seen from the fix (variation rounding in the
-            # data): fly straight to the fix
+        if along < 0 and math.degrees(math.atan2(abs(xtk), -along)) < 5.0:
+            # within 5° of the course line seen from the fix (courses referenced to old station
+            # declinations differ from the fixes' bearing by up to ~5° in the FAA data):
+            # fly straight to the fix
             return self.direct_to(state, fix, direction, flyby_end)
         aligned = trk is None or abs(wrap180(trk - fcrs)) < 2.0
         if abs(xtk) < 30.0 and aligned and along < 0:
@@ -211,6 +224,7 @@ class LegBuilder:
         if abs(xtk) < 30.0 and along < 0:
             state = self.start_course(state, fcrs, direction)
             return self.line_to(state, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
+        state0 = state
         for _ in range(2):
             heading = wrap360(fcrs - math.copysign(45.0, xtk))
             state = self.start_course(state, heading, direction)
@@ -232,9 +246,12 @@ class LegBuilder:
         if hit[0] < lead:
             # too close to the line for the 45° capture: turn onto the course now and let a
             # direct-to absorb the small offset
+            if len(self.segments) == n0:      # nothing flown yet: drop the intercept heading
+                state, self._corner_pending = state0, False
             arc = turn_to_course(state.lat_deg, state.lon_deg, state.track_deg, fcrs, None,
                                  self.radius_m)
             if arc is not None:
+                self._corner_pending = False
                 state = self.arc(state, arc)
             return self.direct_to(state, fix, None, flyby_end)
         state = self.straight(state, state.track_deg, hit[0])

@@ -107,7 +107,11 @@ class TF(Leg):
                 return b.fix_state(s, f), _fix_term(f)
             s = b.direct_to(s, f, b.turn_dir(), not b.leg.rec.fly_over)
             return b.fix_state(s, f), _fix_term(f)
-        s = b.direct_to(s, f, b.turn_dir(), not b.leg.rec.fly_over)
+        if b.can_cut(s, inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[1], b.turn_dir()):
+            s = b.direct_to(s, f, b.turn_dir(), not b.leg.rec.fly_over)   # fly-by corner
+        else:  # over the previous fix (or after an arc): turn and rejoin the TF track
+            _, _, az2 = inverse(prev.lat_deg, prev.lon_deg, f.lat_deg, f.lon_deg)
+            s = b.join_course(s, f, az2, b.turn_dir(), not b.leg.rec.fly_over)
         return b.fix_state(s, f), _fix_term(f)
 
     @classmethod
@@ -193,10 +197,13 @@ class AF(Leg):
 
     @classmethod
     def target(cls, leg):
-        if leg.navaid is None or leg.rec.rho_m is None:
+        if leg.navaid is None or (leg.rec.rho_m is None and leg.fix is None):
             return None
         lat, lon = _dme_pos(leg.navaid)
-        return ("circle", lat, lon, leg.rec.rho_m)
+        r = leg.rec.rho_m   # the arc is flown at the fix's range (see build): intercept that
+        if leg.fix is not None:
+            r = inverse(lat, lon, leg.fix.lat_deg, leg.fix.lon_deg)[0]
+        return ("circle", lat, lon, r)
 
 
 # --------------------------------------------------------------------------- conditional
@@ -528,6 +535,7 @@ class PI(Leg):
 
     @classmethod
     def build(cls, b, s):
+        s = replace(s, flyby=False)   # a course reversal starts over its fix
         s, c = _from_fix(b, s, None)  # the coded direction is the procedure turn's
         d = b.turn_dir() or "L"
         sign = 1.0 if d == "R" else -1.0

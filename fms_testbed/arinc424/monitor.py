@@ -26,6 +26,8 @@ KT = 1852.0 / 3600.0
 RF_RADIUS_TOL_M = 0.05 * NM_M
 FIX_TOL_M = 1.0
 GAP_TOL_M = 1.0
+#: Largest track change between consecutive segments not flagged as a kink, deg.
+KINK_TOL_DEG = 10.0
 #: Legs whose end is a database fix the path must honour.
 FIX_LEGS = frozenset({"TF", "CF", "DF", "IF", "RF", "AF"})
 
@@ -218,10 +220,17 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
     out = []
     segs = path.segments
     for k in range(1, len(segs)):
-        gap = inverse(*segs[k - 1].geom.end, *segs[k].geom.start)[0]
+        a, b = segs[k - 1], segs[k]
+        gap = inverse(*a.geom.end, *b.geom.start)[0]
         if gap > GAP_TOL_M:
-            out.append(Finding(segs[k].leg_index, "discontinuity",
-                               f"gap of {gap:.1f} m before leg {segs[k].leg_index + 1}"))
+            out.append(Finding(b.leg_index, "discontinuity",
+                               f"gap of {gap:.1f} m before leg {b.leg_index + 1}"))
+        elif "connector" not in (a.role, b.role) and a.geom.length_m() > 1.0 \
+                and b.geom.length_m() > 1.0:
+            jump = abs(wrap180(b.geom.start_course_deg - a.geom.end_course_deg))
+            if jump > KINK_TOL_DEG:
+                out.append(Finding(b.leg_index, "discontinuity", f"track jumps by {jump:.0f}° "
+                                   f"in leg {b.leg_index + 1} ({b.path_term})"))
     seen: dict[tuple[str, str], int] = {}
     prev_fix = ""
     for lg in path.legs:

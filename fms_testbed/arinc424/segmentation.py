@@ -21,8 +21,9 @@ from dataclasses import replace
 from ..path.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
 from ..path.segments import Arc, Line
 from .builder import LegBuilder, ResolvedLeg
-from .construct import direct_to_arc, turn_arc
+from .construct import turn_arc
 from .database import Database, Sequence
+from .records import Fix
 from .legs import LEG_TYPES, LegError
 from .model import (BuildParams, BuiltLeg, Finding, FlightState, Performance, PathSegment,
                     ProcedurePath, isa_tas_mps, turn_radius_m)
@@ -157,6 +158,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         except LegError as exc:
             b.finding("impossible", f"leg {i + 1} {leg.pt}: {exc} (line {leg.rec.line})")
             break
+        state = b.settle(state)
         if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
             state = replace(state, alt_m=_descent_target(leg))
         built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps))
@@ -191,8 +193,8 @@ def _attach_segments(built: list[BuiltLeg], segs: list[PathSegment]) -> list[Bui
                     seg_count=count.get(lg.index, 0)) for lg in built]
 
 
-def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_deg: float
-                  ) -> list[PathSegment]:
+def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_deg: float,
+                  depth: int = 0) -> list[PathSegment]:
     """Replace every sharp fly-by corner by a tangent arc (with the monitor's corrections)."""
     segs = b.segments
     out: list[PathSegment] = []
@@ -222,7 +224,7 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
             r_geom = l_avail / t
             b.i = a.leg_index
             if r_geom <= 1.0:
-                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v, gmax, b.g)))
+                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v, gmax, b.g), depth))
                 trim_prev = 0.0
                 continue
             g_reg = math.degrees(math.atan(v * v / (r_geom * b.g)))
@@ -239,7 +241,7 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
                     r, bank, v = r_geom, gmax, v_reg
                 else:
                     out.extend(_flyover(b, a, seg, omega, turn_radius_m(
-                        perf.tas_min_mps, gmax, b.g)))
+                        perf.tas_min_mps, gmax, b.g), depth))
                     trim_prev = 0.0
                     continue
         lead = r * t
@@ -279,8 +281,8 @@ def _retarget_arc(arc: Arc, pt: tuple[float, float]) -> Arc:
     return Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, arc.start_radial_deg, sweep)
 
 
-def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: float
-             ) -> list[PathSegment]:
+def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: float,
+             depth: int = 0) -> list[PathSegment]:
     """Branch V,γ,φ,λ: the turn cannot be cut inside the fixes; fly over the corner, turn at
     the lowest speed and maximum bank, then go direct to the end of the next line."""
     at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
@@ -289,15 +291,21 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
               "V,γ,φ,λ")
     lat, lon = a.geom.end
     end = seg.geom.end
-    arc, ok = direct_to_arc(lat, lon, a.geom.end_course_deg, end[0], end[1],
-                            "R" if omega > 0 else "L", r)
-    out = []
-    if ok and arc is not None:
-        out.append(PathSegment(arc, seg.leg_index, seg.path_term, seg.fix_ident, "turn",
-                               seg.speed_mps, math.degrees(math.atan(
-                                   seg.speed_mps ** 2 / (r * b.g)))))
-        start = arc.end
+    # rejoin the next line's own course before its end, so that the legs built after it (which
+    # assumed that course) still start tangent to the path
+    tmp = LegBuilder(b.legs, b.perf, b.params, b.g, b.prev_fixes)
+    tmp.i, tmp.speed_mps, tmp.radius_m = seg.leg_index, seg.speed_mps, r
+    tmp.climbing = False
+    target = Fix(ident=seg.fix_ident, region="", section="", lat_deg=end[0], lon_deg=end[1])
+    state = FlightState(lat, lon, a.geom.end_course_deg, 0.0, flyby=False)
+    tmp.join_course(state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
+    if depth == 0:
+        segs = round_corners(tmp, b.perf, b.params, math.degrees(math.atan(
+            seg.speed_mps ** 2 / (r * b.g))), depth=1)
     else:
-        start = (lat, lon)
-    out.append(replace(seg, geom=Line(*start, *end)))
+        segs = tmp.segments
+    out = [replace(x, role="turn" if x.role == "leg" else x.role) for x in segs[:-1]]
+    out.append(replace(segs[-1], role=seg.role) if segs else replace(
+        seg, geom=Line(lat, lon, *end)))
+    b.findings.extend(f for f in tmp.findings if f.category != "info")
     return out  # 'a' is already in the caller's output list
