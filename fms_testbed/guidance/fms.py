@@ -30,7 +30,7 @@ from ..path.geodesy import inverse
 from ..path.segments import Arc, Line, project
 from ..runner import GuidanceOutput
 from .geometry import LocalPiece, local_pieces, radii_m
-from .lateral import LateralGains, bank_command_rad
+from .lateral import LateralGains, anticipation_m, bank_command_rad
 from .procedure import FlyablePath, rebuild_from
 from .vertical import altitude_lead_s, cas_band, leg_speed_limits, tas_target_mps
 
@@ -416,33 +416,44 @@ class ProcedureGuidance:
                                gs: float) -> float:
         """Curvature (1/m) whose coordinated-turn bank is fed forward now.
 
-        Each arc's bank is commanded over a window placed so that the runner's rate-limited
-        roll (``roll_rate``) is centred on the arc: a long arc from ``V_g (|φ|/(2 p) + τ)``
-        before its start to as much before its end (:func:`.lateral.anticipation_m`); an arc
-        too short to reach its bank (``L p < V_g |φ|``) gets a triangular bank profile with the
-        same heading change, peak ``tan φ_pk = sqrt(|Δχ| V_g p / g)``, commanded from
-        ``V_g (φ_pk / p + τ)`` before the arc's middle to ``V_g τ`` before it.
+        The curvature of the piece flown, switched to the next piece's once within the roll
+        anticipation distance ``V_g (|Δφ|/(2 p) + τ)`` of the boundary
+        (:func:`.lateral.anticipation_m`: the runner's rate-limited roll is centred on the
+        transition). An arc too short to reach its bank (``L p < V_g |φ|``) gets instead a
+        triangular bank profile with the same heading change, peak
+        ``tan φ_pk = sqrt(|Δχ| V_g p / g)``, commanded from ``V_g (φ_pk / p + τ)`` before the
+        arc's middle to ``V_g τ`` before it.
         """
         g = self.gains
         pr = math.radians(g.roll_rate_dps)
         lag = gs * g.roll_lag_s
         v2 = max(gs, 10.0) ** 2
-        kappa = 0.0
-        for q, d0 in ((p, -along), (nxt, p.length_m - along)):
+
+        def short_arc(q: LocalPiece, d0: float) -> float | None:
+            """Triangle-profile curvature if q is a short arc (d0: distance to its start)."""
             if q is None or not q.is_arc:
-                continue
+                return None
             phi = abs(math.atan(v2 * q.curvature_1pm / 9.80665))
             if q.length_m * pr >= gs * phi:
-                on = d0 - gs * phi / (2 * pr) - lag
-                off = d0 + q.length_m - gs * phi / (2 * pr) - lag
-                k = q.curvature_1pm
-            else:
-                t_pk = math.sqrt(q.length_m * abs(q.curvature_1pm) * gs * pr / 9.80665)
-                mid = d0 + 0.5 * q.length_m
-                on, off = mid - gs * math.atan(t_pk) / pr - lag, mid - lag
-                k = math.copysign(t_pk * 9.80665 / v2, q.curvature_1pm)
-            if on <= 0.0 < off:
-                kappa = k
+                return None
+            t_pk = math.sqrt(q.length_m * abs(q.curvature_1pm) * gs * pr / 9.80665)
+            mid = d0 + 0.5 * q.length_m
+            on, off = mid - gs * math.atan(t_pk) / pr - lag, mid - lag
+            return math.copysign(t_pk * 9.80665 / v2, q.curvature_1pm) if on <= 0.0 < off \
+                else 0.0
+
+        k = short_arc(p, -along)
+        kappa = p.curvature_1pm if k is None else k
+        if nxt is None:
+            return kappa
+        k = short_arc(nxt, p.length_m - along)
+        if k is not None:
+            return k if k != 0.0 else kappa
+        k2 = nxt.curvature_1pm
+        if k2 != kappa:
+            dphi = math.atan(v2 * k2 / 9.80665) - math.atan(v2 * kappa / 9.80665)
+            if p.length_m - along < anticipation_m(gs, dphi, g):
+                return k2
         return kappa
 
     def _arc_speed_cap(self, along: float, v_mps: float) -> float:
