@@ -254,8 +254,25 @@ def _activate(fp: FlyablePath, db, s_base_m: float, tas_mps: float = 118.0) -> _
     for i, p in enumerate(pieces):
         last[segs[p.seg_index].leg_index] = i
     return _Active(fp, segs, pieces, cum, pde, list(zip(before, after)),
-                   [float(x) for x in prof.along_m], [float(x) for x in prof.alt_m], climb_tgt,
-                   s_base_m, last)
+                   profile_nodes_at_fixes(fp.path, prof), [float(x) for x in prof.alt_m],
+                   climb_tgt, s_base_m, last)
+
+
+def profile_nodes_at_fixes(path, prof) -> list[float]:
+    """Profile node distances (m) with each fly-by fix's node moved from the end of its fly-by
+    arc (where the planned profile puts a leg's end) back to the arc's middle, abeam the fix,
+    where the aircraft passes the fix and its altitude constraint is checked."""
+    s = [float(x) for x in prof.along_m]
+    last: dict[int, object] = {}
+    for sg in path.segments:
+        last[sg.leg_index] = sg
+    for j in range(1, len(s)):
+        sg = last.get(path.legs[j - 1].index) if j - 1 < len(path.legs) else None
+        if sg is not None and sg.role == "flyby":
+            s[j] -= 0.5 * sg.geom.length_m()
+    for j in range(1, len(s)):  # keep the nodes ordered
+        s[j] = max(s[j], s[j - 1])
+    return s
 
 
 class _LazyLog(Mapping):
