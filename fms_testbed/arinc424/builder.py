@@ -101,7 +101,7 @@ class LegBuilder:
         bank = 0.0
         if isinstance(geom, Arc):
             bank = math.degrees(math.atan(self.speed_mps ** 2 / (geom.radius_m * self.g)))
-        if self._corner_pending and isinstance(geom, Line):
+        if self._corner_pending:
             self.corners.add(len(self.segments))
         self._corner_pending = False
         self.segments.append(PathSegment(geom, self.i, pt, ident, role, self.speed_mps, bank))

@@ -13,7 +13,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from ..path.geodesy import direct, inverse, wrap180, wrap360
-from ..path.segments import Arc
+from ..path.segments import Arc, Line
 from .builder import LegBuilder
 from .construct import ray_circle_distance, ray_geodesic_intersection, turn_to_course
 from .model import FlightState, Termination
@@ -151,6 +151,15 @@ class DF(Leg):
         return b.fix_state(s, f), _fix_term(f)
 
 
+def _corner_onto(b: LegBuilder, s: FlightState, arc: Arc) -> None:
+    """Mark a non-tangent entry onto a coded arc as a fly-by corner when the state allows it
+    (the segmentation then fits a line-to-arc fillet)."""
+    if b.segments and isinstance(b.segments[-1].geom, Line) and \
+            b.can_cut(s, arc.start_course_deg, None) and \
+            abs(wrap180(arc.start_course_deg - s.track_deg)) >= 0.5:
+        b._corner_pending = True
+
+
 class RF(Leg):
     """Constant-radius arc about the coded centre fix, in the coded direction, to the fix."""
 
@@ -170,7 +179,9 @@ class RF(Leg):
         s = b.connect(s, start_pt[0], start_pt[1], "RF start not on the arc")
         sweep = wrap360(rad_end - rad_start) if d == "R" else -wrap360(rad_start - rad_end)
         if abs(sweep) > 0.01:
-            s = b.arc(s, Arc(c.lat_deg, c.lon_deg, r_end, rad_start, sweep), role="leg")
+            arc = Arc(c.lat_deg, c.lon_deg, r_end, rad_start, sweep)
+            _corner_onto(b, s, arc)
+            s = b.arc(s, arc, role="leg")
         return b.fix_state(replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f), _fix_term(f)
 
 
@@ -192,7 +203,9 @@ class AF(Leg):
         s = b.connect(s, start_pt[0], start_pt[1], "AF start not on the DME arc")
         sweep = wrap360(rad_end - rad_start) if d == "R" else -wrap360(rad_start - rad_end)
         if abs(sweep) > 0.01:
-            s = b.arc(s, Arc(nlat, nlon, r_end, rad_start, sweep), role="leg")
+            arc = Arc(nlat, nlon, r_end, rad_start, sweep)
+            _corner_onto(b, s, arc)
+            s = b.arc(s, arc, role="leg")
         return b.fix_state(replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f), _fix_term(f)
 
     @classmethod

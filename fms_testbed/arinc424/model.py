@@ -123,7 +123,8 @@ class PathSegment:
 
     role: 'leg' (the leg's own path), 'turn' (turn flown from the present position onto the
     leg), 'flyby' (fly-by transition arc, tagged with the leg it ends), 'hold', 'connector'
-    (bridge over a discontinuity); speed_mps: planned TAS; bank_deg: planned bank (arcs).
+    (bridge over a discontinuity); speed_mps: planned TAS; bank_deg: planned bank (arcs);
+    lead_m: turn anticipation of a fly-by arc.
     """
 
     geom: Line | Arc
@@ -133,6 +134,8 @@ class PathSegment:
     role: str = "leg"
     speed_mps: float = 0.0
     bank_deg: float = 0.0
+    lead_m: float = 0.0
+    """Fly-by arcs: turn anticipation, the distance from the corner to where the turn starts, m."""
 
 
 @dataclass(frozen=True, slots=True)

@@ -59,7 +59,8 @@ def leg_end_checks(path: ProcedurePath) -> list[FixCheck]:
             end = (lg.end.lat_deg, lg.end.lon_deg)
         elif path.segments[k].role == "flyby":
             arc = path.segments[k].geom
-            allowed += arc.radius_m * math.tan(math.radians(abs(arc.sweep_deg)) / 2.0)
+            allowed += path.segments[k].lead_m or \
+                arc.radius_m * math.tan(math.radians(abs(arc.sweep_deg)) / 2.0)
             end = arc.start
         else:
             end = path.segments[k].geom.end

@@ -18,7 +18,7 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from ..path.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
+from ..path.geodesy import LocalFrame, direct, gravity_mps2, inverse, wrap180, wrap360
 from ..path.segments import Arc, Line
 from .builder import LegBuilder, ResolvedLeg
 from .construct import turn_arc
@@ -201,6 +201,10 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
     trim_prev = 0.0
     gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for k, seg in enumerate(segs):
+        if k in b.corners and out and isinstance(seg.geom, Arc) \
+                and isinstance(out[-1].geom, Line):
+            out.extend(_line_arc_fillet(b, out, seg, perf, params, bank_deg))
+            continue
         if k not in b.corners or not out or not isinstance(seg.geom, Line) \
                 or not isinstance(out[-1].geom, Line):
             out.append(seg)
@@ -253,7 +257,8 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         out[-1] = replace(a, geom=new_a)
         if new_a.length_m() < 0.01:
             out.pop()
-        out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "flyby", v, bank))
+        out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "flyby", v, bank,
+                               lead))
         t2 = seg.geom.point_at(lead)
         # end the arc exactly where the next line resumes
         fixed = _retarget_arc(arc, t2)
@@ -263,6 +268,93 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
             out.append(replace(seg, geom=rest))
         trim_prev = 0.0  # out[-1] is already the trimmed line
     return out
+
+
+def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
+                     perf: Performance, params: BuildParams, bank_deg: float
+                     ) -> list[PathSegment]:
+    """Fly-by from a line onto a coded arc (CI/VI onto a DME arc, a non-tangent RF entry).
+
+    The fillet of radius r = V²/(g tan γ) is tangent to the line and to the arc (internally when
+    both turn the same way, |F − C| = R − r; externally otherwise, |F − C| = R + r), solved in a
+    local plane about the junction; γ is raised to the monitor's limit when the planned radius
+    does not fit. Returns the segments that replace ``seg`` (``out[-1]`` is trimmed in place);
+    when no fillet fits the sharp corner is kept (the monitor then reports the track jump).
+    """
+    a = out[-1]
+    arc = seg.geom
+    omega = wrap180(arc.start_course_deg - a.geom.end_course_deg)
+    if abs(omega) < 0.5:
+        return [seg]
+    sgn = 1.0 if omega > 0 else -1.0
+    same = (arc.sweep_deg > 0) == (omega > 0)
+    fr = LocalFrame(*arc.start)
+    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
+    u = math.radians(a.geom.end_course_deg)
+    ux, uy = math.sin(u), math.cos(u)
+    nx, ny = sgn * uy, -sgn * ux          # unit normal toward the turn side
+    v = min(a.speed_mps, seg.speed_mps)
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    for bank in (bank_deg, gmax):
+        r = turn_radius_m(v, bank, b.g)
+        d = arc.radius_m - r if same else arc.radius_m + r
+        if d <= 0:
+            continue
+        # F = -L u + r n, |F - C| = d  ->  L² + 2 L (u·(C - r n)) + |C - r n|² - d² = 0 ... in -L
+        px, py = r * nx - cx, r * ny - cy
+        bq = -(px * ux + py * uy)
+        cq = px * px + py * py - d * d
+        disc = bq * bq - cq
+        if disc < 0:
+            continue
+        roots = sorted(x for x in (-bq - math.sqrt(disc), -bq + math.sqrt(disc)) if x >= 0)
+        if not roots or roots[0] > a.geom.length_m():
+            continue
+        lead = roots[0]
+        fx, fy = -lead * ux + r * nx, -lead * uy + r * ny
+        # the contact point lies on the ray from C through F (planar radial from C) ...
+        radial_t2 = math.degrees(math.atan2(fx - cx, fy - cy))
+        # ... and from here on the geometry is exact: the contact point on the coded arc and a
+        # fillet started on the line, ended on the radial through the contact point
+        t2 = direct(arc.centre_lat_deg, arc.centre_lon_deg, _geo_radial(fr, arc, radial_t2),
+                    arc.radius_m)[:2]
+        la = a.geom.length_m()
+        t1 = a.geom.point_at(la - lead)
+        fillet = _retarget_arc(turn_arc(t1[0], t1[1], a.geom.course_at(la - lead), omega, r),
+                               t2)
+        _, r2, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, *fillet.end)
+        used = (r2 - arc.start_radial_deg) % 360.0 if arc.sweep_deg > 0 else \
+            (arc.start_radial_deg - r2) % 360.0
+        if used >= abs(arc.sweep_deg) or used > 180.0:
+            continue
+        rest = Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, r2,
+                   arc.sweep_deg - math.copysign(used, arc.sweep_deg))
+        new_a = Line(a.geom.start_lat_deg, a.geom.start_lon_deg, *fillet.start)
+        out[-1] = replace(a, geom=new_a)
+        if new_a.length_m() < 0.01:
+            out.pop()
+        g_used = math.degrees(math.atan(v * v / (r * b.g)))
+        res = [PathSegment(fillet, a.leg_index, a.path_term, a.fix_ident, "flyby", v, g_used,
+                           lead)]
+        gap = inverse(*fillet.end, *rest.start)[0]
+        if gap > 0.01:
+            res.append(replace(seg, geom=Line(*fillet.end, *rest.start), role="connector"))
+        res.append(replace(seg, geom=rest))
+        if bank > bank_deg:
+            b.i = seg.leg_index
+            b.finding("correction", f"fly-by onto the {seg.path_term} arc: bank "
+                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ")
+        return res
+    return [seg]
+
+
+def _geo_radial(fr: LocalFrame, arc: Arc, planar_radial_deg: float) -> float:
+    """Geodesic radial from the arc centre matching a radial measured in the local plane."""
+    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
+    a = math.radians(planar_radial_deg)
+    px, py = cx + arc.radius_m * math.sin(a), cy + arc.radius_m * math.cos(a)
+    lat, lon = fr.to_latlon(px, py)
+    return inverse(arc.centre_lat_deg, arc.centre_lon_deg, lat, lon)[1]
 
 
 def _retarget_arc(arc: Arc, pt: tuple[float, float]) -> Arc:
