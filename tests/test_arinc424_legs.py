@@ -275,3 +275,22 @@ def test_coded_speed_limit_caps_the_planned_speed_and_turn_radius(tmp_path):
     assert turn.geom.radius_m < R_PLAN * 0.7
     assert turn.geom.radius_m == pytest.approx(
         turn_radius_m(turn.speed_mps, PARAMS.bank_plan_deg, G), rel=1e-3)
+
+
+def test_intercept_onto_a_dme_arc_is_flown_with_a_tangent_fillet(tmp_path):
+    w = world()
+    start = offset(*APT, 225.0, 8.0)
+    p = build(tmp_path, [app("IF", 10, fix="WQ"), app("CI", 20, course_deg=45.0),
+                         app("AF", 30, fix="ARC2", turn="L", navaid="TVR", theta_deg=100.0,
+                             rho_nm=10.0, course_deg=200.0)],
+              extra=[waypoint_record("WQ", *start)])
+    segs = p.segments
+    k = next(i for i, s in enumerate(segs) if s.role == "flyby")
+    before, fillet, after = segs[k - 1], segs[k], segs[k + 1]
+    assert isinstance(before.geom, type(segs[0].geom)) and after.path_term == "AF"
+    assert isinstance(after.geom, Arc) and after.geom.sweep_deg < 0
+    for x, y in ((before, fillet), (fillet, after)):
+        assert dist(x.geom.end, y.geom.start) < 0.02
+        assert abs((y.geom.start_course_deg - x.geom.end_course_deg + 180) % 360 - 180) < 0.5
+    assert dist(end_of(p), w["ARC2"]) < 0.5
+    assert p.status in ("ok", "corrected")
