@@ -34,7 +34,7 @@ def procedure_steps_per_s(sim_s: float, rate_hz: float) -> tuple[float, float, f
     call)."""
     import yaml
 
-    from fms_testbed.fly import prepare
+    from fms_testbed.fly import prepare, runner_log_every
     from fms_testbed.guidance.fms import ProcedureGuidance
     from fms_testbed.guidance.vertical import procedure_law
     from fms_testbed.runner import fly
@@ -46,7 +46,7 @@ def procedure_steps_per_s(sim_s: float, rate_hz: float) -> tuple[float, float, f
     scn, spec, fp, db = prepare(raw, "demo-sid.yaml")
     build = time.perf_counter() - t0
     cfg = load_aircraft(scn.aircraft)
-    g = ProcedureGuidance(fp, cfg, db=db, spec=spec)
+    g = ProcedureGuidance(fp, cfg, db=db, spec=spec, log_every=runner_log_every(scn))
     calls = [0, 0.0]
     inner = g.update
 
@@ -65,6 +65,20 @@ def procedure_steps_per_s(sim_s: float, rate_hz: float) -> tuple[float, float, f
     return summary["duration_s"] / DT_S / wall, build, 1e6 * calls[1] / max(calls[0], 1)
 
 
+def runner_only_steps_per_s(sim_s: float, rate_hz: float) -> float:
+    """Frames per wall second of the runner alone at the same rates (coupled law holding the
+    trimmed state, no guidance): the share of the slowdown that is not guidance."""
+    from fms_testbed.runner import run_scenario
+
+    scn = {"name": "bench", "aircraft": "737", "duration_s": sim_s, "hold": True,
+           "outer_rate_hz": rate_hz, "initial": {"lat_deg": 40.6, "lon_deg": -73.8,
+                                                 "alt_m": 3000.0, "tas_mps": 118.0,
+                                                 "heading_deg": 300.0}}
+    t0 = time.perf_counter()
+    res = run_scenario(scn, progress=False)
+    return res.summary["duration_s"] / DT_S / (time.perf_counter() - t0)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--sim-s", type=float, default=900.0)
@@ -77,9 +91,11 @@ def main() -> None:
     pt = cfg.default_condition
     bare = []
     runs = {r: ([], [], []) for r in args.rates}
+    bare_runner = {r: [] for r in args.rates}
     for _ in range(args.repeat):
         bare.append(bare_steps_per_s(cfg, pt.alt_m, pt.tas_mps, args.sim_s))
         for r in args.rates:
+            bare_runner[r].append(runner_only_steps_per_s(args.sim_s, r))
             p, b, c = procedure_steps_per_s(args.sim_s, r)
             for lst, v in zip(runs[r], (p, b, c)):
                 lst.append(v)
@@ -91,6 +107,8 @@ def main() -> None:
         print(f"procedure flight @ {r:4.0f} Hz: {p:9.0f} steps/s ({p * DT_S:6.0f}x real time), "
               f"ratio {p / b:.2f} (goal >= 0.50); guidance {statistics.median(per_call):.1f} "
               f"µs per call")
+        q = statistics.median(bare_runner[r])
+        print(f"  runner alone @ {r:4.0f} Hz:  {q:9.0f} steps/s, ratio {q / b:.2f} (no guidance)")
     print(f"path build {statistics.median(runs[args.rates[0]][1]):.2f} s (once, excluded)")
 
 if __name__ == "__main__":

@@ -34,6 +34,14 @@ runs LNAV/VNAV at 5-20 Hz; on the demo SID 10 Hz and 20 Hz give FTE95 6.22 / 6.2
 max 17.0 / 16.9 m, and 10 Hz meets the speed goal). A scenario's ``outer_rate_hz`` wins."""
 
 
+def runner_log_every(scn: Scenario) -> int:
+    """Outer steps between two logged rows, computed as the runner does (JSBSim at 120 Hz)."""
+    from .jsbsim_core import DT_S
+
+    n_outer = max(1, int(round(1.0 / (scn.outer_rate_hz * DT_S))))
+    return max(1, int(round(1.0 / (scn.log_rate_hz * n_outer * DT_S))))
+
+
 def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     """The scenario ``initial`` block for the start of a built path (module docstring)."""
     from .guidance.vertical import cas_band, leg_speed_limits, tas_target_mps
@@ -110,7 +118,7 @@ def fly_procedure(scn: Scenario, spec: ProcedureSpec, fp: FlyablePath, db,
     from .runner import RunResult, fly, write_outputs
 
     cfg = load_aircraft(scn.aircraft)
-    g = ProcedureGuidance(fp, cfg, db=db, spec=spec)
+    g = ProcedureGuidance(fp, cfg, db=db, spec=spec, log_every=runner_log_every(scn))
     law = procedure_law(cfg) if scn.vertical_law == "coupled" and cfg.coupled_law else None
     df, summary = fly(scn, cfg=cfg, seed=seed, guidance=g, progress=progress, vertical_law=law)
     if g.abort_reason:

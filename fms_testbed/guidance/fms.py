@@ -23,7 +23,6 @@ from __future__ import annotations
 import bisect
 import logging
 import math
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 from ..path.geodesy import inverse
@@ -275,33 +274,6 @@ def profile_nodes_at_fixes(path, prof) -> list[float]:
     return s
 
 
-class _LazyLog(Mapping):
-    """The step's log, computed only when the runner reads it (at its logging rate, not at
-    every guidance step): keeps the per-call cost of guidance small."""
-
-    __slots__ = ("_f", "_args", "_d")
-
-    def __init__(self, f, args):
-        self._f, self._args, self._d = f, args, None
-
-    def _get(self) -> dict:
-        if self._d is None:
-            self._d = self._f(*self._args)
-        return self._d
-
-    def __getitem__(self, k):
-        return self._get()[k]
-
-    def __iter__(self):
-        return iter(self._get())
-
-    def __len__(self) -> int:
-        return len(self._get())
-
-    def keys(self):
-        return self._get().keys()
-
-
 class ProcedureGuidance:
     """Guidance that flies a :class:`~.procedure.FlyablePath` (implements the runner's
     ``Guidance`` protocol: ``update(dt_s, nav, truth) -> GuidanceOutput``).
@@ -312,6 +284,8 @@ class ProcedureGuidance:
     cfg : aircraft configuration (bank limit, roll rate, minimum speed, coupled-law timing)
     db : the database it came from (in-flight rebuilds, PDE); spec : its ProcedureSpec
     gains : lateral tuning (default: :meth:`LateralGains.for_aircraft`)
+    log_every : build the log only every this many calls — the runner's logging cadence
+        (``round(outer_rate_hz / log_rate_hz)``, logging at calls 0, n, 2n, ...); 1 = always
 
     Attributes
     ----------
@@ -321,7 +295,8 @@ class ProcedureGuidance:
     rebuilt : the paths rebuilt in flight (rest of the procedure), in order
     """
 
-    def __init__(self, fp: FlyablePath, cfg, db=None, spec=None, gains: LateralGains | None = None):
+    def __init__(self, fp: FlyablePath, cfg, db=None, spec=None, gains: LateralGains | None = None,
+                 log_every: int = 1):
         self.whole = fp
         self.cfg, self.db, self.spec = cfg, db, spec
         self.gains = gains or LateralGains.for_aircraft(cfg)
@@ -345,6 +320,8 @@ class ProcedureGuidance:
         self.next_speed_t = -1.0
         self.cond_start: tuple | None = None
         self.done = False
+        self.calls = 0
+        self.log_every = max(1, int(log_every))
         self.rebuilt: list[FlyablePath] = []
 
     # ------------------------------------------------------------------ helpers
@@ -569,9 +546,11 @@ class ProcedureGuidance:
             plan = min(self.cfg.limits.climb_tas_mps, self._arc_speed_cap(along, gs))
             self.tas_cmd = tas_target_mps(plan, nav.alt_m, lo, hi, self.cfg.limits.cas_min_mps)
             self.next_speed_t = nav.t_s + 1.0
+        self.calls += 1
+        due = (self.calls - 1) % self.log_every == 0
         return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=self.tas_cmd,
-                              log=_LazyLog(self._log, (p, along, xtk, None, seg, nav, truth,
-                                                       g_leg, s_path)))
+                              log=self._log(p, along, xtk, None, seg, nav, truth, g_leg, s_path)
+                              if due else {})
 
     def _log(self, p: LocalPiece, along: float, nav_xtk: float, true_xtk, seg, nav, truth,
              g_leg: int, s_path: float) -> dict:
