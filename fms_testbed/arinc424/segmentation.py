@@ -198,7 +198,6 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
     """Replace every sharp fly-by corner by a tangent arc (with the monitor's corrections)."""
     segs = b.segments
     out: list[PathSegment] = []
-    trim_prev = 0.0
     gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for k, seg in enumerate(segs):
         if k in b.corners and out and isinstance(seg.geom, Arc) \
@@ -208,18 +207,16 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         if k not in b.corners or not out or not isinstance(seg.geom, Line) \
                 or not isinstance(out[-1].geom, Line):
             out.append(seg)
-            trim_prev = 0.0
             continue
         a = out[-1]
         omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
         if abs(omega) < 0.5:
             out.append(seg)
-            trim_prev = 0.0
             continue
         v = min(a.speed_mps, seg.speed_mps)
         r = turn_radius_m(v, bank_deg, b.g)
         t = math.tan(math.radians(abs(omega)) / 2.0)
-        avail_a = a.geom.length_m() - trim_prev
+        avail_a = a.geom.length_m()  # already trimmed by the previous corner, if any
         avail_c = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
         l_avail = max(min(avail_a, avail_c), 0.0)
         bank = bank_deg
@@ -229,7 +226,6 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
             b.i = a.leg_index
             if r_geom <= 1.0:
                 out.extend(_flyover(b, a, seg, omega, turn_radius_m(v, gmax, b.g), depth))
-                trim_prev = 0.0
                 continue
             g_reg = math.degrees(math.atan(v * v / (r_geom * b.g)))
             if g_reg <= gmax:
@@ -246,7 +242,6 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
                 else:
                     out.extend(_flyover(b, a, seg, omega, turn_radius_m(
                         perf.tas_min_mps, gmax, b.g), depth))
-                    trim_prev = 0.0
                     continue
         lead = r * t
         la = a.geom.length_m()
@@ -266,7 +261,6 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         rest = Line(*fixed.end, seg.geom.end_lat_deg, seg.geom.end_lon_deg)
         if rest.length_m() >= 0.01:
             out.append(replace(seg, geom=rest))
-        trim_prev = 0.0  # out[-1] is already the trimmed line
     return out
 
 
