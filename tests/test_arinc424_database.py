@@ -58,6 +58,7 @@ def test_geojson_has_one_feature_per_segment_with_the_issue_fields():
     assert len(fc["features"]) == len(path.segments)
     arcs = [f["properties"] for f in fc["features"] if f["properties"]["segment_type"] == "arc"]
     assert arcs and {"centre_lat_deg", "radius_m", "turn_direction", "subtended_angle_deg",
+                     "planned_alt_start_ft", "along_end_nm",
                      "planned_speed_kt", "bank_deg", "altitude_descriptor", "leg_index",
                      "path_terminator", "fix_ident"} <= set(arcs[0])
     json.dumps(fc, allow_nan=False)

@@ -31,8 +31,11 @@ def _coords(geom) -> list[list[float]]:
 def to_feature_collection(path: ProcedurePath) -> dict:
     """GeoJSON FeatureCollection (dict) of a built path, with the monitor outcome on top."""
     feats = []
+    s0 = 0.0
+    prof = path.profile
     for k, seg in enumerate(path.segments):
         g = seg.geom
+        s1 = s0 + g.length_m()
         rec = path.legs[min(seg.leg_index, len(path.legs) - 1)].record if path.legs else None
         props = {
             "segment_index": k, "leg_index": seg.leg_index, "path_terminator": seg.path_term,
@@ -43,6 +46,11 @@ def to_feature_collection(path: ProcedurePath) -> dict:
             "planned_speed_kt": round(seg.speed_mps / KT_MPS, 1),
             "bank_deg": round(seg.bank_deg, 2),
         }
+        if prof is not None:
+            props.update(along_start_nm=round(s0 / 1852.0, 4), along_end_nm=round(s1 / 1852.0, 4),
+                         planned_alt_start_ft=round(float(prof.alt_at(s0)) / FT_M),
+                         planned_alt_end_ft=round(float(prof.alt_at(s1)) / FT_M))
+        s0 = s1
         if isinstance(g, Arc):
             props.update(centre_lat_deg=g.centre_lat_deg, centre_lon_deg=g.centre_lon_deg,
                          radius_m=round(g.radius_m, 2), turn_direction=g.turn,
