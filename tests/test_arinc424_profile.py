@@ -1,0 +1,59 @@
+"""Planned vertical profile: altitude windows from the descriptors, climbs that level off,
+descents at the coded angle, never above the start or the highest coded altitude."""
+
+import math
+
+import pytest
+
+from fms_testbed.arinc424.profile import window
+from fms_testbed.arinc424.synth import leg_record as L
+from fms_testbed.arinc424.synth import offset, waypoint_record
+from tests.test_arinc424_world import APT, PERF, build, world
+
+FT = 0.3048
+
+
+@pytest.mark.parametrize("desc, lo, hi", [("+", 1000, None), ("-", None, 1000),
+                                          (" ", 1000, 1000), ("B", 500, 1000),
+                                          ("C", 500, None), ("G", 1000, 1000)])
+def test_windows_from_altitude_descriptors(desc, lo, hi):
+    assert window(desc.strip(), 1000.0, 500.0) == (lo, hi)
+
+
+def test_sid_climbs_at_the_aircraft_gradient_and_levels_off_below_the_ceiling(tmp_path):
+    e2 = offset(*APT, 90.0, 40.0)
+    p = build(tmp_path, [L("XTST", "TSID1", "VA", 10, proc_type="D", transition="RW09",
+                           route_type="1", course_deg=90.0, alt_desc="+", alt1_ft=400),
+                         L("XTST", "TSID1", "DF", 20, proc_type="D", transition="RW09",
+                           route_type="1", fix="WE", alt_desc="+", alt1_ft=5000),
+                         L("XTST", "TSID1", "TF", 30, proc_type="D", transition="RW09",
+                           route_type="1", fix="WE2", alt_desc="-", alt1_ft=6000)],
+              extra=[waypoint_record("WE2", *e2)])
+    prof = p.profile
+    g = PERF.climb_gradient_at(PERF.tas_plan_mps)
+    grads = prof.gradients()
+    assert grads[0] == pytest.approx(g, rel=1e-9)                # climbing at capability
+    assert prof.alt_m[2] >= 5000 * FT - 1e-6                    # WE at or above 5000 ft
+    assert prof.alt_m[-1] == pytest.approx(6000 * FT)           # levelled at or below 6000 ft
+    assert prof.alt_at(prof.along_m[-1] + 1.0) == pytest.approx(6000 * FT)
+
+
+def test_approach_descends_at_the_coded_angle_and_never_above_the_start(tmp_path):
+    w = world()
+    c = offset(*w["WB"], 90.0, 10.0)
+    p = build(tmp_path, [L("XTST", "T09", "IF", 10, fix="WA", alt_desc="+", alt1_ft=6000),
+                         L("XTST", "T09", "TF", 20, fix="WB", alt_desc="+", alt1_ft=3000),
+                         L("XTST", "T09", "TF", 30, fix="WC", alt_desc=" ", alt1_ft=1000)],
+              extra=[waypoint_record("WC", *c)])
+    prof = p.profile
+    # last piece: at 3°, from the 'at' constraint back up
+    last = prof.alt_m[-2] - prof.alt_m[-1]
+    run = prof.along_m[-1] - prof.along_m[-2]
+    assert prof.alt_m[-1] == pytest.approx(1000 * FT)
+    assert last / run == pytest.approx(math.tan(math.radians(3.0)), rel=1e-6) or \
+        prof.alt_m[-2] == pytest.approx(3000 * FT)
+    assert max(prof.alt_m) <= 6000 * FT + 1e-6
+    for wdw in prof.windows:
+        h = prof.alt_m[wdw.leg_index + 1]
+        assert wdw.lo_m is None or h >= wdw.lo_m - 1e-6
+        assert wdw.hi_m is None or h <= wdw.hi_m + 1e-6
