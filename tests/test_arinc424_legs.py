@@ -222,6 +222,9 @@ def test_hf_flies_one_circuit_in_the_coded_direction_and_leaves_over_the_fix(tmp
     assert sum(abs(a.sweep_deg) for a in holds) == pytest.approx(360.0, abs=1.0)
     assert dist(end_of(p), w["WB"]) < 0.5
     assert p.legs[2].termination.kind == "circuit"
+    # a one-minute outbound leg at the timed-leg speed of 210 kt is 3.5 NM
+    outbound = [s.geom.length_m() for s in p.segments if s.leg_index == 2 and s.role == "leg"]
+    assert any(abs(x - 3.5 * NM) < 1.0 for x in outbound)
 
 
 def test_hm_is_a_manual_termination_at_the_fix(tmp_path):

@@ -433,12 +433,19 @@ class FC(_FixCourseLeg):
 
 
 # --------------------------------------------------------------------------- holds, PI
+def _timed_speed(b: LegBuilder) -> float:
+    """Speed for timed legs: the coded speed limit's planned speed, else 210 kt."""
+    return b.speed_mps if b.leg.rec.speed_limit_mps else b.params.timed_speed_mps
+
+
 def _hold_leg_m(b: LegBuilder, alt_m: float) -> float:
+    """Outbound leg of a hold, m: the coded distance, else the coded time (default 1 min at or
+    below 14,000 ft, 1.5 min above) at the timed-leg speed."""
     rec = b.leg.rec
     if rec.distance_m is not None:
         return rec.distance_m
     t = rec.time_s if rec.time_s is not None else (60.0 if alt_m <= 14000 * 0.3048 else 90.0)
-    return t * b.speed_mps
+    return t * _timed_speed(b)
 
 
 def _circuit(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: float
@@ -557,7 +564,7 @@ class PI(Leg):
         s = b.straight(s, c, out_m)
         arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, c + 45.0 * sign, d, b.radius_m)
         s = b.arc(s, arc)
-        s = b.straight(s, s.track_deg, 60.0 * b.speed_mps)
+        s = b.straight(s, s.track_deg, 60.0 * _timed_speed(b))
         other = "L" if d == "R" else "R"
         arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg,
                              wrap360(c + 45.0 * sign + 180.0), other, b.radius_m)

@@ -23,8 +23,9 @@ class BuildParams:
 
     bank_plan_deg: nominal bank for planned turns; bank_limit_deg: the monitor's |γ| bound (25°
     by the paper, lowered to the aircraft's ``bank_max_deg`` when that is smaller);
-    manual_leg_m: length flown on FM/VM/HM legs before the crew takes over; timed_speed_mps:
-    speed for timed legs when nothing else is coded (210 kt); flyby_max_deg: largest track change
+    manual_leg_m: length flown on FM/VM legs before the crew takes over; timed_speed_mps:
+    speed for timed legs (hold legs given in minutes, the procedure turn's minute) when no
+    speed limit is coded (210 kt = 3.5 NM/min); flyby_max_deg: largest track change
     flown as a fly-by turn (above it the turn is flown over the fix); climb_min_gradient: the
     3.3 % minimum climb gradient; descent_angle_deg: default descent path angle.
     """
