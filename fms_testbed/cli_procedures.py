@@ -108,7 +108,7 @@ def register(subparsers) -> None:
                    help="transition ident (e.g. RW04B; '' for the common route)")
     b.add_argument("--aircraft", default="737", help="aircraft name or YAML (default 737)")
     b.add_argument("--manual-nm", type=float, default=5.0,
-                   help="distance flown on FM/VM/HM legs, NM (default 5)")
+                   help="distance flown on FM/VM legs, NM (default 5)")
     b.add_argument("--out", required=True, help="output folder")
     b.set_defaults(func=cmd_build)
     c = sub.add_parser("check", help="build and monitor every procedure transition")
@@ -117,7 +117,7 @@ def register(subparsers) -> None:
     c.add_argument("--workers", type=int, default=1, help="processes (default 1)")
     c.add_argument("--aircraft", default="737", help="aircraft name or YAML (default 737)")
     c.add_argument("--manual-nm", type=float, default=5.0,
-                   help="distance flown on FM/VM/HM legs, NM (default 5)")
+                   help="distance flown on FM/VM legs, NM (default 5)")
     c.add_argument("--no-progress", action="store_true", help="no progress bar")
     c.add_argument("--out", required=True, help="output folder")
     c.set_defaults(func=cmd_check)
