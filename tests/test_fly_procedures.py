@@ -174,3 +174,35 @@ def test_an_impossible_speed_ends_the_flight_with_a_clear_status(db, tmp_path):
     assert s["status"] == "diverged"
     assert "stall" in s["reason"], s["reason"]
     assert not s["sequencing"]["completed"]
+
+
+def test_fly_over_fix_is_overflown_not_cut(db):
+    """DEEZZ5 RW31L: YNKEE is a fly-over fix (waypoint description 'Y'): the aircraft passes
+    over it, unlike a fly-by fix whose corner is cut by the turn anticipation."""
+    from fms_testbed.flight_errors import _dist_m
+
+    res, fp = flown(db, "KJFK", "DEEZZ5", runway="31L", transition="CANDR")
+    df = res.df
+    legs = {lg.termination.fix_ident: lg for lg in fp.path.legs if lg.termination.kind == "fix"}
+    yn, ce = legs["YNKEE"], legs["DEEZZ"]
+    assert yn.record.fly_over and not ce.record.fly_over
+
+    def closest(t):
+        return float(np.min(_dist_m(df["lat_deg"].to_numpy(), df["lon_deg"].to_numpy(),
+                                    t.lat_deg, t.lon_deg)))
+    assert closest(yn.termination) < 30.0
+    # the fly-by fix DEEZZ (a turn of about 90°) is cut by the turn: passed well inside it
+    assert closest(ce.termination) > 300.0
+
+
+def test_df_after_the_end_of_vectors_turns_from_that_point_to_the_fix(db):
+    """DEEZZ5 RW31L: after the VM vectors end (a point, not a fix to cut), the DF leg is a turn
+    from there and then the line to DEEZZ, tracked within the goal."""
+    res, fp = flown(db, "KJFK", "DEEZZ5", runway="31L", transition="CANDR")
+    df = res.df
+    k = next(i for i, lg in enumerate(fp.seq.legs) if lg.path_term == "DF")
+    assert fp.seq.legs[k - 1].path_term == "VM"
+    dfl = df[df["leg_index"] == k]
+    roles = list(dict.fromkeys(dfl["seg_role"]))
+    assert roles[0] == "turn" and "leg" in roles
+    assert dfl["nav_xtk_m"].abs().max() < 0.1 * NM
