@@ -206,3 +206,18 @@ def test_df_after_the_end_of_vectors_turns_from_that_point_to_the_fix(db):
     roles = list(dict.fromkeys(dfl["seg_role"]))
     assert roles[0] == "turn" and "leg" in roles
     assert dfl["nav_xtk_m"].abs().max() < 0.1 * NM
+
+
+def test_vr_leg_ends_when_the_radial_is_crossed(db):
+    """KDLS DALLS1 RW13 starts with VR (heading to a radial): the leg ends in flight when the
+    aircraft's bearing from the navaid crosses the coded radial."""
+    from fms_testbed.path import inverse
+
+    res, fp = flown(db, "KDLS", "DALLS1", runway="13")
+    t = fp.path.legs[0].termination
+    assert fp.path.legs[0].path_term == "VR" and t.kind == "radial"
+    ev = [e for e in res.summary["guidance_events"] if e["kind"] == "condition" and e["leg"] == 0]
+    assert ev and "radial" in ev[0]["detail"]
+    row = res.df[res.df["t_s"] >= ev[0]["t_s"] - 1e-6].iloc[0]
+    _, az, _ = inverse(t.navaid_lat_deg, t.navaid_lon_deg, row["lat_deg"], row["lon_deg"])
+    assert abs((az - t.radial_deg + 180.0) % 360.0 - 180.0) < 0.5
