@@ -68,6 +68,22 @@ class Leg:
 
     @classmethod
     def build(cls, b: LegBuilder, s: FlightState) -> tuple[FlightState, Termination]:
+        """Append the leg's segments to ``b`` and return its end.
+
+        Parameters
+        ----------
+        b : the transition's builder; ``b.leg`` is this leg (fixes resolved, course true, deg),
+            ``b.speed_mps``/``b.radius_m`` the planned TAS (m/s) and turn radius (m)
+        s : planned state where the previous leg ended (deg, deg true, m)
+
+        Returns
+        -------
+        (state, termination): the planned state at the leg's end and how the leg ends.
+
+        Raises
+        ------
+        LegError when a field the leg needs is missing (the transition is then impossible).
+        """
         raise NotImplementedError
 
     @classmethod
