@@ -25,7 +25,7 @@ import logging
 import math
 from dataclasses import dataclass, field
 
-from ..path.geodesy import inverse
+from ..path.geodesy import direct, inverse
 from ..path.segments import Arc, Line, project
 from ..runner import GuidanceOutput
 from .geometry import LocalPiece, local_pieces, radii_m
@@ -189,9 +189,9 @@ def climb_targets(prof) -> list[float | None]:
 
 def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     """The path as flown: a 'connector' line the builder put across a discontinuity (e.g.
-    after vectors, VM/FM) that starts with a track change is flown as a direct-to — a turn at
-    the planned radius from the previous segment's end, then a line to the connector's end —
-    as an FMS does after a discontinuity is cleared; segments shorter than MIN_SEGMENT_M
+    after vectors, VM/FM) that starts with a track change is flown as a direct-to — straight on
+    for the roll-in anticipation distance, a turn at the planned radius, then a line to the
+    connector's end — as an FMS does after a discontinuity is cleared; segments shorter than MIN_SEGMENT_M
     (connectors: MIN_CONNECTOR_M) are dropped; other segments unchanged."""
     from dataclasses import replace as _replace
 
@@ -199,6 +199,7 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     from ..path.geodesy import wrap180
 
     r = tas_mps * tas_mps / (9.80665 * math.tan(math.radians(bank_deg)))
+    lead_m = anticipation_m(tas_mps, math.radians(bank_deg), LateralGains())
     out = []
     for k, sg in enumerate(segs):
         short = MIN_CONNECTOR_M if sg.role == "connector" else MIN_SEGMENT_M
@@ -208,10 +209,13 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
             prev = out[-1].geom
             trk = prev.end_course_deg
             if abs(wrap180(sg.geom.start_course_deg - trk)) > 2.0:
-                lat, lon = sg.geom.start
+                lat0, lon0 = sg.geom.start
                 tlat, tlon = sg.geom.end
+                # run straight on for the roll-in anticipation, then turn direct to the end
+                lat, lon, _ = direct(lat0, lon0, trk, lead_m)
                 arc, ok = direct_to_arc(lat, lon, trk, tlat, tlon, None, r)
                 if ok and arc is not None:
+                    out.append(_replace(sg, geom=Line(lat0, lon0, lat, lon), role="connector"))
                     out.append(_replace(sg, geom=arc, role="turn"))
                     out.append(_replace(sg, geom=Line(*arc.end, tlat, tlon)))
                     continue
@@ -219,8 +223,18 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     return out
 
 
-def _activate(fp: FlyablePath, db, s_base_m: float, tas_mps: float = 118.0) -> _Active:
+def _activate(fp: FlyablePath, db, s_base_m: float, tas_mps: float = 118.0,
+              lead_from: tuple[float, float] | None = None) -> _Active:
     segs = smooth_connectors(list(fp.path.segments), tas_mps)
+    lead_m = 0.0
+    if lead_from is not None and segs:
+        # the straight run-in from the aircraft to where the rebuilt path starts
+        from dataclasses import replace as _replace
+        first = segs[0]
+        run_in = Line(lead_from[0], lead_from[1], *first.geom.start)
+        if run_in.length_m() >= MIN_SEGMENT_M:
+            segs.insert(0, _replace(first, geom=run_in, role="leg"))
+            lead_m = run_in.length_m()
     geoms = [s.geom for s in segs]
     pieces = local_pieces(geoms)
     cum, s = [], 0.0
@@ -253,8 +267,8 @@ def _activate(fp: FlyablePath, db, s_base_m: float, tas_mps: float = 118.0) -> _
     for i, p in enumerate(pieces):
         last[segs[p.seg_index].leg_index] = i
     return _Active(fp, segs, pieces, cum, pde, list(zip(before, after)),
-                   profile_nodes_at_fixes(fp.path, prof), [float(x) for x in prof.alt_m],
-                   climb_tgt, s_base_m, last)
+                   [x + lead_m for x in profile_nodes_at_fixes(fp.path, prof)],
+                   [float(x) for x in prof.alt_m], climb_tgt, s_base_m, last)
 
 
 def profile_nodes_at_fixes(path, prof) -> list[float]:
@@ -393,12 +407,19 @@ class ProcedureGuidance:
         if nxt >= len(self.whole.seq.legs):
             return False
         fp = None
+        # start the rebuilt path one roll-in anticipation ahead on the present track, so the
+        # first turn's roll is centred on its start as for any planned turn
+        v = self.cfg.limits.climb_tas_mps
+        phi = math.radians(20.0)  # the builder's planned bank
+        lead = anticipation_m(v, phi, self.gains)
+        la, lo, _ = direct(math.degrees(lat), math.degrees(lon), math.degrees(trk), lead)
         if self.db is not None and self.spec is not None:
-            fp = rebuild_from(self.db, self.whole, self.spec, self.cfg, nxt, math.degrees(lat),
-                              math.degrees(lon), math.degrees(trk) % 360.0, alt)
+            fp = rebuild_from(self.db, self.whole, self.spec, self.cfg, nxt, la, lo,
+                              math.degrees(trk) % 360.0, alt)
         if fp is None:
             return False
-        self.act = _activate(fp, self.db, s_now, self.cfg.limits.climb_tas_mps)
+        self.act = _activate(fp, self.db, s_now, v,
+                             lead_from=(math.degrees(lat), math.degrees(lon)))
         self.rebuilt.append(fp)
         self.i = 0
         self.events.append({"t_s": t_s, "kind": "rebuild", "leg": nxt,
