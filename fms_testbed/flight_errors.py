@@ -21,8 +21,6 @@ an altitude-terminated leg) the true altitude must be inside the coded window wi
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pandas as pd
 
@@ -203,4 +201,4 @@ def flight_errors(df: pd.DataFrame, fp, guidance) -> dict:
 
 
 __all__ = ["error_columns", "error_stats", "per_leg", "constraint_checks", "sequencing",
-           "flight_errors", "math"]
+           "flight_errors"]

@@ -22,6 +22,8 @@ MIN_CAS_FACTOR × the aircraft's minimum CAS.
 
 from __future__ import annotations
 
+import bisect
+import math
 from dataclasses import dataclass
 
 from ..atmosphere import cas_to_tas
@@ -97,3 +99,96 @@ def procedure_law(cfg):
     dh = max(g.dH_limit_m, LAW_CLIMB_FRACTION * cfg.limits.climb_rate_max_mps
              * 2.0 * g.xi_H * g.T_H_s)
     return CoupledLaw(params=params_from_config(cfg, dH_limit_m=dh))
+
+
+BLEND_S = 6.0
+"""Each slope change of the planned profile is blended over ±BLEND_S seconds of flight."""
+
+
+def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
+                    extend: bool) -> tuple[float, float, float]:
+    """Planned altitude at path distance ``s_m`` with every slope change blended by a parabola
+    over ±``w_m`` (constant vertical acceleration), and its first and second derivatives along
+    the path: (h m, dh/ds, d²h/ds² 1/m). The blend lies on the outside of each corner (above a
+    descent-to-level knee). ``extend``: the last slope continues past the last node (the final
+    approach path goes on to the runway); otherwise the profile is flat beyond its ends.
+
+    Guidance commands ``H_cmd = h + 2 ξ_H T_H V dh/ds + T_H² V² d²h/ds²``, the inverse of the
+    coupled law's altitude dynamics ``T_H² Ḧ + 2 ξ_H T_H Ḣ + H = H_cmd`` along the smooth profile,
+    so the aircraft flies the profile itself without lag."""
+    n = len(ps)
+    if n == 1:
+        return ph[0], 0.0, 0.0
+
+    def slope(k: int) -> float:  # slope of piece k (between nodes k-1 and k); 0 off the ends
+        if k <= 0:
+            return 0.0
+        if k >= n:
+            return slope(n - 1) if extend else 0.0
+        d = ps[k] - ps[k - 1]
+        return (ph[k] - ph[k - 1]) / d if d > 1e-6 else 0.0
+
+    j = bisect.bisect_right(ps, s_m)
+    m = slope(j)
+    if j <= 0:
+        h = ph[0]
+    elif j >= n:
+        h = ph[-1] + m * (s_m - ps[-1])
+    else:
+        h = ph[j - 1] + m * (s_m - ps[j - 1])
+    dh, ddh = m, 0.0
+    if w_m <= 0:
+        return h, dh, ddh
+    for k in range(max(j - 2, 0), min(j + 2, n)):
+        sk = ps[k]
+        if abs(s_m - sk) >= w_m:
+            continue
+        delta = slope(k + 1) - slope(k)
+        if delta == 0.0:
+            continue
+        u = s_m - sk + w_m
+        after = 1.0 if s_m > sk else 0.0
+        h += delta * u * u / (4.0 * w_m) - delta * (s_m - sk) * after
+        dh += delta * u / (2.0 * w_m) - delta * after
+        ddh += delta / (2.0 * w_m)
+    return h, dh, ddh
+
+
+def climb_targets(prof) -> list[float | None]:
+    """Per profile node j: in a climb phase (``prof.climb[j]``), the altitude to climb to at
+    the law's level-change rate while flying toward node j — the highest planned altitude of the
+    rest of that climb phase, capped by every 'at or below'/'at' constraint ahead in it, m
+    (None outside climb phases, where the planned profile itself is flown)."""
+    n = len(prof.along_m)
+    hi = [None] * n
+    for w in prof.windows:
+        if w.hi_m is not None and w.leg_index + 1 < n:
+            hi[w.leg_index + 1] = w.hi_m
+    out: list[float | None] = [None] * n
+    run_max, run_cap = -math.inf, math.inf
+    for j in range(n - 1, -1, -1):
+        if not bool(prof.climb[j]):
+            run_max, run_cap = -math.inf, math.inf
+            continue
+        run_max = max(run_max, float(prof.alt_m[j]))
+        if hi[j] is not None:
+            run_cap = min(run_cap, hi[j])
+        out[j] = min(run_max, run_cap)
+    return out
+
+
+def profile_nodes_at_fixes(path, prof) -> list[float]:
+    """Profile node distances (m) with each fly-by fix's node moved from the end of its fly-by
+    arc (where the planned profile puts a leg's end) back to the arc's middle, abeam the fix,
+    where the aircraft passes the fix and its altitude constraint is checked."""
+    s = [float(x) for x in prof.along_m]
+    last: dict[int, object] = {}
+    for sg in path.segments:
+        last[sg.leg_index] = sg
+    for j in range(1, len(s)):
+        sg = last.get(path.legs[j - 1].index) if j - 1 < len(path.legs) else None
+        if sg is not None and sg.role == "flyby":
+            s[j] -= 0.5 * sg.geom.length_m()
+    for j in range(1, len(s)):  # keep the nodes ordered
+        s[j] = max(s[j], s[j - 1])
+    return s
