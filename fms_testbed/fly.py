@@ -2,12 +2,15 @@
 loop with :class:`~fms_testbed.guidance.fms.ProcedureGuidance`, then measure the flight errors.
 
 Start condition (stated plainly, it is a simplification): JSBSim cannot take off here in a
-useful way, so a SID starts **airborne over the departure end of the runway (DER)** at the
+useful way, so a SID starts **airborne at the departure end of the runway (DER)** at the
 builder's planned start altitude (35 ft above the runway), trimmed straight and level at the
 aircraft's planned climb TAS on the runway heading; the profile then climbs it. STARs and
-approaches start over their first fix at the first coded altitude, on the first segment's
-course, at the planned TAS moved into the first leg's coded speed limit. An approach ends at the runway/MAP (the missed approach is not flown). JSBSim's terrain
-is at mean sea level, so height above ground is altitude above MSL.
+approaches start at their first fix at the first coded altitude, on the first segment's
+course. In both cases the aircraft is placed one roll-in anticipation distance (≈ 400 m for the
+737) *before* the path start on that course, so a turn that begins at the path start is entered
+like any other planned turn. The start speed is the planned TAS moved into the first leg's coded
+speed limit. An approach ends at the runway/MAP (the missed approach is not flown). JSBSim's
+terrain is at mean sea level, so height above ground is altitude above MSL.
 """
 
 from __future__ import annotations
@@ -46,13 +49,21 @@ def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     """The scenario ``initial`` block for the start of a built path (module docstring)."""
     from .guidance.vertical import cas_band, leg_speed_limits, tas_target_mps
 
+    from .guidance.lateral import LateralGains, anticipation_m
+    from .path import direct
+
     seg0 = fp.path.segments[0].geom
-    lat, lon = seg0.start
+    crs = seg0.start_course_deg
+    # start one roll-in anticipation before the path start on its initial course, so that a
+    # turn beginning at the path start (a fly-by at the DER) is flown like any planned turn
+    lead = anticipation_m(cfg.limits.climb_tas_mps, math.radians(20.0),
+                          LateralGains.for_aircraft(cfg))
+    lat, lon, _ = direct(seg0.start[0], seg0.start[1], crs + 180.0, lead)
     alt = fp.path.legs[0].start.alt_m
     lo, hi = cas_band(leg_speed_limits(fp.seq.legs[:1])[0], None)
     tas = tas_target_mps(cfg.limits.climb_tas_mps, alt, lo, hi, cfg.limits.cas_min_mps)
     return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,
-            "tas_mps": round(tas, 3), "heading_deg": seg0.start_course_deg % 360.0}
+            "tas_mps": round(tas, 3), "heading_deg": crs % 360.0}
 
 
 def prepare(raw: dict, source: str = "<scenario>", db=None
