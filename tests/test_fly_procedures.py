@@ -221,3 +221,16 @@ def test_vr_leg_ends_when_the_radial_is_crossed(db):
     row = res.df[res.df["t_s"] >= ev[0]["t_s"] - 1e-6].iloc[0]
     _, az, _ = inverse(t.navaid_lat_deg, t.navaid_lon_deg, row["lat_deg"], row["lon_deg"])
     assert abs((az - t.radial_deg + 180.0) % 360.0 - 180.0) < 0.5
+
+
+def test_pde_is_zero_on_tf_and_the_radius_difference_on_rf(db):
+    """PDE of TF legs (built geodesic = coded geodesic) is ~0; on RF legs it is the distance of
+    the built arc (through the database fixes) from the coded centre/radius, within the
+    monitor's RF tolerance (0.05 NM); undefined (None) on the IF."""
+    res, _ = flown(db, "KBFI", "H14RZ", transition="ZUVEN")
+    rows = {r["leg"]: r for r in res.summary["errors"]["per_leg"]}
+    tf = [r for r in rows.values() if r["code"] == "TF" and r["samples"]]
+    rf = [r for r in rows.values() if r["code"] == "RF"]
+    assert tf and all(r["pde_max_m"] is not None and r["pde_max_m"] < 0.5 for r in tf)
+    assert rf and all(r["pde_max_m"] is not None and r["pde_max_m"] < 0.05 * NM for r in rf)
+    assert rows[1]["code"] == "IF" and rows[1].get("pde95_m") is None
