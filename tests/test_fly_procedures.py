@@ -234,3 +234,24 @@ def test_pde_is_zero_on_tf_and_the_radius_difference_on_rf(db):
     assert tf and all(r["pde_max_m"] is not None and r["pde_max_m"] < 0.5 for r in tf)
     assert rf and all(r["pde_max_m"] is not None and r["pde_max_m"] < 0.05 * NM for r in rf)
     assert rows[1]["code"] == "IF" and rows[1].get("pde95_m") is None
+
+
+def test_ha_hold_is_left_over_the_fix_once_the_altitude_is_reached(db):
+    """KENV ENV1 RW08 ends with HA at BVL (hold to 9000 ft): the aircraft climbs faster than the
+    plan's gradient, so it leaves the hold over BVL at the end of the first circuit completed
+    at the altitude instead of flying every planned circuit."""
+    from fms_testbed.flight_errors import _dist_m
+
+    res, fp = flown(db, "KENV", "ENV1", runway="08")
+    _completed(res)
+    ha = fp.path.legs[-1]
+    assert ha.path_term == "HA"
+    ev = [e for e in res.summary["guidance_events"] if "HA altitude reached" in e.get("detail", "")]
+    assert len(ev) == 1
+    end = res.df.iloc[-1]
+    assert end["alt_m"] >= ha.termination.alt_m - 50 * 0.3048
+    assert _dist_m(end["lat_deg"], end["lon_deg"], ha.termination.lat_deg,
+                   ha.termination.lon_deg) < 300.0
+    planned_ha_m = sum(s.geom.length_m() for s in fp.path.segments if s.leg_index == ha.index)
+    flown_ha_m = res.df.loc[res.df["leg_index"] == ha.index, "along_m"].agg(np.ptp)
+    assert flown_ha_m < 0.8 * planned_ha_m

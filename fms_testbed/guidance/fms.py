@@ -9,7 +9,8 @@ Every outer step (20 Hz by default) it
 3. ends a conditional leg (altitude, DME distance, radial) when the condition is actually met —
    earlier than planned: the rest of the procedure is rebuilt from the aircraft's state
    (:func:`.procedure.rebuild_from`); later: the leg's last line is flown on beyond its planned
-   end until the condition is met;
+   end until the condition is met; an HA hold is left over its fix at the end of the first
+   circuit that completes with the altitude reached;
 4. commands bank from :func:`.lateral.bank_command_rad` with the curvature of the piece ahead
    once inside the roll anticipation distance, and altitude/TAS targets from :mod:`.vertical`;
 5. logs ``xtk_m`` (true cross-track, TSE), ``nav_xtk_m`` (FTE), ``leg_index``, ``leg_code`` and
@@ -37,7 +38,9 @@ from .vertical import (BLEND_S, altitude_lead_s, blended_profile, cas_band, clim
 log = logging.getLogger(__name__)
 
 CONDITIONAL = frozenset({"CA", "FA", "VA", "CD", "FD", "VD", "CR", "VR"})
-"""Legs whose end is a condition checked in flight (HA is flown as built)."""
+"""Legs whose end is a condition checked in flight (HA: at the fix, see ``_ha_done``)."""
+ALT_CAPTURE_M = 15.0
+"""An HA hold's altitude counts as reached within this (the law levels off at it), m."""
 OVERRUN_MAX_M = 20 * 1852.0
 """A conditional leg flown this far past its planned end without the condition: give up, m."""
 XTK_ABORT_M = 5 * 1852.0
@@ -287,6 +290,22 @@ class ProcedureGuidance:
             return False
         return d * self.cond_start[0] <= 0.0
 
+    def _ha_done(self, p: LocalPiece, seg, bl, alt_m: float) -> bool:
+        """HA (hold to altitude): True when the piece just completed ends over the hold fix
+        (a circuit is complete) and the altitude is reached — the hold is left there instead
+        of flying the rest of the circuits the plan assumed."""
+        t = bl.termination
+        if t.alt_m is None or t.lat_deg is None or alt_m < t.alt_m - ALT_CAPTURE_M:
+            return False
+        if p.s0_m + p.length_m < seg.geom.length_m() - 1.0:
+            return False  # not the last chunk of its segment
+        lat, lon = seg.geom.end
+        la0, lo0 = math.radians(t.lat_deg), math.radians(t.lon_deg)
+        m0, n0 = radii_m(la0)
+        x = (math.radians(lon) - lo0) * n0 * math.cos(la0)
+        y = (math.radians(lat) - la0) * m0
+        return math.hypot(x, y) < 100.0
+
     def _df_fix_passed(self, k: int, lat: float, lon: float, trk: float) -> bool:
         """True when leg ``k`` is a DF whose fix is behind or abeam the aircraft within a turn
         diameter, or within 0.3 NM: a direct-to would loop back; the fix counts as passed."""
@@ -451,6 +470,15 @@ class ProcedureGuidance:
                 s_end = a.seg_cum_m[p.seg_index] + p.s0_m + along
                 return GuidanceOutput(done=True, log=self._log(p, along, xtk, None, seg, nav,
                                                                truth, g_leg, s_end))
+            if bl.path_term == "HA" and self._ha_done(p, seg, bl, nav.alt_m):
+                self.events.append({"t_s": nav.t_s, "kind": "condition", "leg": g_leg,
+                                    "detail": "HA altitude reached: hold left over the fix"})
+                nxt = a.last_piece_of_leg[seg.leg_index] + 1
+                if nxt >= len(a.pieces):
+                    self.done = True
+                    return GuidanceOutput(done=True)
+                self.i = nxt
+                return self.update(dt_s, nav, truth)
             self.i += 1
             return self.update(dt_s, nav, truth)
         if abs(xtk) > XTK_ABORT_M:
