@@ -12,7 +12,9 @@ Every outer step (20 Hz by default) it
    end until the condition is met; an HA hold is left over its fix at the end of the first
    circuit that completes with the altitude reached;
 4. commands bank from :func:`.lateral.bank_command_rad` with the curvature of the piece ahead
-   once inside the roll anticipation distance, and altitude/TAS targets from :mod:`.vertical`;
+   once inside the roll anticipation distance (on the straight part of a heading leg, V*, it
+   holds the coded heading instead and lets the wind drift the track), and altitude/TAS
+   targets from :mod:`.vertical`;
 5. logs ``xtk_m`` (true cross-track, TSE), ``nav_xtk_m`` (FTE), ``leg_index``, ``leg_code`` and
    the other per-step quantities :mod:`fms_testbed.flight_errors` needs.
 
@@ -37,6 +39,8 @@ from .vertical import (BLEND_S, altitude_lead_s, blended_profile, cas_band, clim
 
 log = logging.getLogger(__name__)
 
+HEADING_LEGS = frozenset({"VA", "VD", "VI", "VM", "VR"})
+"""Heading legs: their straight part is flown as a heading (drift allowed), not a track."""
 CONDITIONAL = frozenset({"CA", "FA", "VA", "CD", "FD", "VD", "CR", "VR"})
 """Legs whose end is a condition checked in flight (HA: at the fix, see ``_ha_done``)."""
 ALT_CAPTURE_M = 15.0
@@ -232,6 +236,7 @@ class ProcedureGuidance:
         self.legs_sequenced: list[int] = []
         self.abort_reason = ""
         self.lead_s = altitude_lead_s(cfg)
+        self.heading_kp = cfg.inner_loops.heading_kp
         top = spec.climb_top_ft * 0.3048 if spec is not None else 4572.0
         los = [w.lo_m for w in (fp.path.profile.windows if fp.path.profile else ())
                if w.lo_m is not None]
@@ -487,8 +492,16 @@ class ProcedureGuidance:
         # lateral
         nxt = a.pieces[self.i + 1] if self.i + 1 < len(a.pieces) and not hold else None
         kappa = self._feedforward_curvature(p, along, nxt, gs)
-        terr = (trk - dtrk + math.pi) % (2 * math.pi) - math.pi
-        bank = bank_command_rad(xtk, terr, gs, kappa, self.gains)
+        if seg.path_term in HEADING_LEGS and seg.role == "leg" and not p.is_arc \
+                and kappa == 0.0:
+            # a heading leg (V*): fly the coded heading — the built line's direction — and let
+            # the wind drift the track; the leg still ends at its condition/planned distance
+            herr = (dtrk - nav.heading_rad + math.pi) % (2 * math.pi) - math.pi
+            lim = math.radians(self.gains.bank_max_deg)
+            bank = max(-lim, min(lim, self.heading_kp * herr))
+        else:
+            terr = (trk - dtrk + math.pi) % (2 * math.pi) - math.pi
+            bank = bank_command_rad(xtk, terr, gs, kappa, self.gains)
         # vertical
         s_path = a.seg_cum_m[p.seg_index] + p.s0_m + along
         ps = a.prof_s
