@@ -96,3 +96,17 @@ def test_sins_navigation_errors_show_in_tse_and_break_rnp_containment(tmp_path):
     # TSE = FTE minus the navigation error's cross-track component (same piece, same time)
     assert (df["xtk_m"] - df["nav_xtk_m"]).abs().max() <= df["nse_m"].max() + 1.0 \
         if "nse_m" in df else True
+
+
+def test_every_shipped_procedure_scenario_validates_and_builds():
+    import yaml
+
+    from fms_testbed.fly import load_procedure_scenario
+    from fms_testbed.paths import scenarios_dir
+
+    files = [p for p in sorted(scenarios_dir().glob("*.yaml"))
+             if "procedure" in (yaml.safe_load(p.read_text()) or {})]
+    assert any(p.name == "demo-sid.yaml" for p in files)
+    for p in files:
+        scn, spec, fp, db = load_procedure_scenario(p)
+        assert fp.path.segments and scn.initial.tas_mps > 0, p
