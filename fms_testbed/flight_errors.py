@@ -10,6 +10,10 @@ Definitions (RNP, ICAO Doc 9613; ``shared/notes/navigation-monitoring.md``), all
   evaluated per built segment (``pde_m``);
 * TSE — total system error: the true position's cross-track from the path (``xtk_m``).
 
+The straight parts of heading legs (VA/VD/VI/VM/VR, flown as a heading; ``heading_leg`` = 1)
+have no defined ground track: they are left out of the FTE and TSE statistics and of RNP
+containment (their turn arcs count); ``errors.heading_leg_samples`` says how many samples that is.
+
 Statistics are the 95th percentile of the absolute value and the maximum, over the whole flight,
 over **straight flight** (on a line segment at least :data:`STRAIGHT_MARGIN_M` from the nearest
 arc, so roll-in/roll-out transients count as turns), and per leg. RNP containment: TSE95 ≤ the
@@ -52,10 +56,13 @@ def _stats(x: np.ndarray) -> dict[str, float | None]:
 
 
 def error_columns(df: pd.DataFrame) -> pd.DataFrame:
-    """Add ``fte_m`` (= nav_xtk_m), ``tse_m`` (= xtk_m) and ``nse_m`` (nav vs truth) columns."""
+    """Add ``fte_m`` (= nav_xtk_m), ``tse_m`` (= xtk_m) and ``nse_m`` (nav vs truth) columns;
+    FTE and TSE are NaN on the straight part of heading legs (``heading_leg``), which have no
+    defined ground track."""
     df = df.copy()
-    df["fte_m"] = df["nav_xtk_m"]
-    df["tse_m"] = df["xtk_m"]
+    free = df["heading_leg"].to_numpy() == 1 if "heading_leg" in df else np.zeros(len(df), bool)
+    df["fte_m"] = np.where(free, np.nan, df["nav_xtk_m"])
+    df["tse_m"] = np.where(free, np.nan, df["xtk_m"])
     df["nse_m"] = _dist_m(df["lat_deg"].to_numpy(), df["lon_deg"].to_numpy(),
                           df["nav_lat_deg"].to_numpy(), df["nav_lon_deg"].to_numpy())
     return df
@@ -86,7 +93,8 @@ def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
                 s = _stats(d[f"{name}_m"].to_numpy(dtype=float))
                 row[f"{name}95_m"], row[f"{name}_max_m"] = s["p95_m"], s["max_m"]
             row["rnp_nm"] = round(rnp / 1852.0, 2)
-            row["rnp_contained"] = bool(row["tse95_m"] is not None and row["tse95_m"] <= rnp)
+            row["rnp_contained"] = (None if row["tse95_m"] is None
+                                    else bool(row["tse95_m"] <= rnp))
         rows.append(row)
     return rows
 
@@ -189,9 +197,11 @@ def flight_errors(df: pd.DataFrame, fp, guidance) -> dict:
     cons = constraint_checks(d, fp)
     tse95 = _stats(d["tse_m"].to_numpy(dtype=float))["p95_m"]
     return {
-        "errors": {**error_stats(d), "per_leg": legs},
-        "rnp": {"contained": all(r["rnp_contained"] for r in flown),
-                "legs_not_contained": [r["leg"] for r in flown if not r["rnp_contained"]],
+        "errors": {**error_stats(d), "per_leg": legs,
+                   "heading_leg_samples": int(d["heading_leg"].sum()) if "heading_leg" in d
+                   else 0},
+        "rnp": {"contained": all(r["rnp_contained"] is not False for r in flown),
+                "legs_not_contained": [r["leg"] for r in flown if r["rnp_contained"] is False],
                 "tse95_m": tse95,
                 "min_rnp_nm": round(min(r["rnp_nm"] for r in flown), 2) if flown else None},
         "constraints": cons,

@@ -151,8 +151,13 @@ def plot_errors(df, summary, fp, out: Path) -> Path:
     """FTE, TSE, NSE and PDE (m) along the path, leg boundaries labelled, RNP stated."""
     fig, ax = plt.subplots(figsize=(10, 5))
     s_nm = df["along_m"].to_numpy() / NM_M
-    ax.plot(s_nm, df["nav_xtk_m"], lw=1.0, label="FTE (navigation vs path), m")
-    ax.plot(s_nm, df["xtk_m"], lw=1.0, label="TSE (truth vs path), m")
+    fte = df["fte_m"] if "fte_m" in df else df["nav_xtk_m"]
+    tse = df["tse_m"] if "tse_m" in df else df["xtk_m"]
+    ax.plot(s_nm, fte, lw=1.0, label="FTE (navigation vs path), m")
+    ax.plot(s_nm, tse, lw=1.0, label="TSE (truth vs path), m")
+    if "heading_leg" in df and (df["heading_leg"] == 1).any():
+        ax.plot(s_nm, df["xtk_m"].where(df["heading_leg"] == 1), lw=0.8, color="gray",
+                label="heading legs: drift from the calm-air line (no defined path), m")
     if "nse_m" in df:
         ax.plot(s_nm, df["nse_m"], lw=0.8, label="NSE (navigation vs truth), m")
     if "pde_m" in df and np.isfinite(df["pde_m"]).any():

@@ -255,3 +255,14 @@ def test_ha_hold_is_left_over_the_fix_once_the_altitude_is_reached(db):
     planned_ha_m = sum(s.geom.length_m() for s in fp.path.segments if s.leg_index == ha.index)
     flown_ha_m = res.df.loc[res.df["leg_index"] == ha.index, "along_m"].agg(np.ptp)
     assert flown_ha_m < 0.8 * planned_ha_m
+
+
+def test_heading_legs_are_left_out_of_the_path_error_statistics(db):
+    """VM (vectors) in DEEZZ5 RW31L is a heading with no defined ground track: its straight
+    samples are flagged and excluded from FTE/TSE and RNP containment."""
+    res, _ = flown(db, "KJFK", "DEEZZ5", runway="31L", transition="CANDR")
+    e = res.summary["errors"]
+    vm = next(r for r in e["per_leg"] if r["code"] == "VM")
+    assert e["heading_leg_samples"] >= vm["samples"] > 0
+    assert vm["fte95_m"] is None and vm["rnp_contained"] is None
+    assert (res.df.loc[res.df["leg_code"] == "VM", "heading_leg"] == 1).all()

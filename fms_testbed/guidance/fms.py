@@ -535,5 +535,7 @@ class ProcedureGuidance:
                 "leg_code": seg.path_term, "seg_role": seg.role,
                 "along_m": a.s_base_m + s_path,
                 "curvature_1pm": p.curvature_1pm, "straight_m": flat,
+                "heading_leg": int(seg.path_term in HEADING_LEGS and seg.role == "leg"
+                                   and not p.is_arc),
                 "pde_m": a.pde_m[p.seg_index], "rnp_m": a.fp.rnp_m[seg.leg_index]
                 if seg.leg_index < len(a.fp.rnp_m) else float("nan")}
