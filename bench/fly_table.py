@@ -137,20 +137,29 @@ def main() -> None:
         rows.append(row)
         legs_ok = f"{q['legs_entered']}/{q['legs']}" + ("" if not (q["skipped"] or q["repeated"])
                                                          else "!")
+        def num(v, w):
+            return f"{v:{w}.1f}" if v is not None else f"{'n/a':>{w}s}"
         print(f"{row['name'][:34]:34s} {row['type']:8s} {len(row['legs']):4d} "
-              f"{row['length_nm']:6.1f} {row['fte95_straight_m'] or float('nan'):9.1f} "
-              f"{row['fte95_m']:7.1f} {row['fte_max_m']:7.1f} {am:8.0f} {sm:8.1f} {legs_ok:>7s} "
+              f"{row['length_nm']:6.1f} {num(row['fte95_straight_m'], 9)} "
+              f"{num(row['fte95_m'], 7)} {num(row['fte_max_m'], 7)} {am:8.0f} {sm:8.1f} "
+              f"{legs_ok:>7s} "
               f"{s['status']}" + ("" if s["status"] == "ok" else f" ({s['reason']})"), flush=True)
     flown = [r for r in rows if "fte95_m" in r]
+    headings = [r["name"] for r in flown if r["fte95_m"] is None]
+    if headings:
+        print(f"no path-defined leg (heading legs only, no FTE): {', '.join(headings)}")
+    scored = [r for r in flown if r["fte95_m"] is not None]
     ok = [r for r in flown if r["status"] == "ok"]
     print(f"\n{len(rows)} procedures, {len(flown)} flown, {len(ok)} completed, "
           f"{time.perf_counter() - t0:.0f} s wall")
     if flown:
         def frac(cond):
             return f"{sum(1 for r in flown if cond(r))}/{len(flown)}"
-        print(f"FTE95 straight ≤ 30 m: {frac(lambda r: (r['fte95_straight_m'] or 0) <= 30)}; "
-              f"FTE95 ≤ 150 m: {frac(lambda r: r['fte95_m'] <= 150)}; "
-              f"FTE max ≤ 185 m: {frac(lambda r: r['fte_max_m'] <= 185.2)}; "
+        def frac_s(cond):
+            return f"{sum(1 for r in scored if cond(r))}/{len(scored)}"
+        print(f"FTE95 straight ≤ 30 m: {frac_s(lambda r: (r['fte95_straight_m'] or 0) <= 30)}; "
+              f"FTE95 ≤ 150 m: {frac_s(lambda r: r['fte95_m'] <= 150)}; "
+              f"FTE max ≤ 185 m: {frac_s(lambda r: r['fte_max_m'] <= 185.2)}; "
               f"constraints met (±50 ft, ±5 kt): {frac(lambda r: r['constraints_met'])}; "
               f"no leg skipped/repeated: {frac(lambda r: not r['skipped'] and not r['repeated'])}")
     out = Path(args.out)
