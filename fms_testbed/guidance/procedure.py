@@ -115,7 +115,7 @@ def select_parts(db, airport: str, procedure: str, transition: str | None,
             t = [s for s in seqs if s.route_type == "A" and s.transition == transition]
             if not t:
                 raise UserError(f"{name}: no approach transition {transition!r}; transitions: "
-                                f"{', '.join(x for x in trans if x)}")
+                                f"{', '.join(x for x in trans if x) or 'none'}")
             parts.append(t[0])
         parts.append(final[0])
         return parts
