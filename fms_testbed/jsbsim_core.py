@@ -271,15 +271,15 @@ class JSBSimAircraft:
 
     # -- trim ------------------------------------------------------------------------
     def trim(self, alt_m: float, tas_mps: float, heading_deg: float = 0.0,
-             lat_deg: float = 45.0, lon_deg: float = 0.0, gamma_deg: float = 0.0,
-             wind_ned_mps: tuple[float, float, float] = (0.0, 0.0, 0.0)) -> TrimResult:
-        """Trim in steady straight flight; raise :class:`TrimError` naming aircraft and condition.
+             lat_deg: float = 45.0, lon_deg: float = 0.0, gamma_deg: float = 0.0) -> TrimResult:
+        """Trim in steady straight flight in calm air; raise :class:`TrimError` naming aircraft and
+        condition (JSBSim 1.3.3 cannot trim in wind: the runner ramps the wind in afterwards).
 
         Bounded alpha search (``trim.alpha_max_deg``), engines running, gear up. JSBSim's trim
         sometimes fails from the state a previous run left (engine and FCS internals survive
         ``run_ic``); a failure is retried once on a freshly loaded instance before it is reported.
         """
-        args = (alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg, wind_ned_mps)
+        args = (alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg)
         if self.fdm.get_sim_time() > 0.0:
             try:
                 return self._trim_once(*args)
@@ -288,7 +288,7 @@ class JSBSimAircraft:
                 self._load()
         return self._trim_once(*args)
 
-    def _trim_once(self, alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg, wind_ned_mps):
+    def _trim_once(self, alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg):
         fdm, c = self.fdm, self.cfg
         cond = (f"{c.name} ({c.jsbsim_model}) at {alt_m:.0f} m / {tas_mps * 3.6:.0f} km/h TAS, "
                 f"gamma {gamma_deg:.1f} deg")
@@ -299,9 +299,8 @@ class JSBSimAircraft:
         fdm["ic/psi-true-deg"] = heading_deg
         fdm["ic/gamma-deg"] = gamma_deg
         fdm["ic/phi-deg"] = 0.0
-        fdm["atmosphere/wind-north-fps"] = wind_ned_mps[0] / FT
-        fdm["atmosphere/wind-east-fps"] = wind_ned_mps[1] / FT
-        fdm["atmosphere/wind-down-fps"] = wind_ned_mps[2] / FT
+        for comp in ("north", "east", "down"):
+            fdm[f"atmosphere/wind-{comp}-fps"] = 0.0
         fdm["aero/alpha-max-rad"] = math.radians(c.trim.alpha_max_deg)
         fdm["aero/alpha-min-rad"] = math.radians(c.trim.alpha_min_deg)
         fdm["fms/ap/master"] = 0.0

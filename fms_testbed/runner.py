@@ -31,6 +31,9 @@ from .timeseries import COLUMNS, build_row
 
 log = logging.getLogger(__name__)
 
+#: The scenario's steady wind grows linearly from zero to its value over this time after trim, s.
+WIND_RAMP_S = 20.0
+
 _TURB_SEVERITY = {"light": (3, 25.0), "moderate": (4, 50.0), "severe": (6, 75.0)}  # (index, kt@20ft)
 
 
@@ -206,8 +209,13 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     ini = scn.initial
     kind, spd = ini.speed
     tas0 = float(cas_to_tas(spd, ini.altitude_m)) if kind == "cas" else spd
+    # Trim in calm air: JSBSim 1.3.3 fails to trim in wind, and run_ic() resets the atmosphere's
+    # wind to the initial condition's. The steady wind is ramped in after the trim (WIND_RAMP_S).
     ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
-            lon_deg=ini.lon_deg, wind_ned_mps=_wind_ned(scn))
+            lon_deg=ini.lon_deg)
+    wind_ned = _wind_ned(scn)
+    wind_nodes = [fdm.get_property_manager().get_node(f"atmosphere/wind-{c}-fps", False)
+                  for c in ("north", "east", "down")]
     if scn.turbulence is not None:  # after trim: JSBSim cannot trim in turbulence
         idx, w20 = _TURB_SEVERITY[scn.turbulence.severity]
         fdm["atmosphere/turb-type"] = 4
@@ -254,6 +262,10 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
         if why:
             status, reason = "diverged", why
             break
+        if s.t_s <= WIND_RAMP_S + dt_outer and any(wind_ned):
+            frac = min(1.0, s.t_s / WIND_RAMP_S)
+            for node, w in zip(wind_nodes, wind_ned):
+                node.set_double_value(frac * w / FT)
         nav = navigate(s)
         for ev in events.due(s.t_s, s.alt_m):
             _apply(ev, tg)

@@ -59,9 +59,6 @@ def test_procedure_block_errors_name_the_file_and_field():
         parse_procedure({"airport": "KJFK", "procedure": "R04RY", "manual_leg_nm": -1}, "s.yaml")
 
 
-@pytest.mark.xfail(strict=True, reason="foundation bug: JSBSim's trim zeroes atmosphere/wind-*; "
-                   "jsbsim_core.trim sets the wind before do_simple_trim, so runs are calm "
-                   "(reported to the lead: set the wind after the trim)")
 def test_scenario_file_with_wind_flies_the_ground_track(tmp_path):
     """A crosswind scenario file: the aircraft crabs, the ground track stays on the path."""
     scn_file = tmp_path / "xwind.yaml"

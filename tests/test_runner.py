@@ -94,3 +94,18 @@ def test_cas_target_converted_with_altitude():
     from fms_testbed.atmosphere import cas_to_tas
     last = df.iloc[-1]
     assert last["cmd_tas_mps"] == pytest.approx(float(cas_to_tas(200 * 0.514444, last["alt_m"])), rel=1e-4)
+
+
+def test_steady_wind_is_ramped_in_and_then_held():
+    """JSBSim trims in calm air; the scenario's wind then ramps in over 20 s and stays."""
+    from fms_testbed.runner import WIND_RAMP_S
+
+    scn = {**BASE, "duration_s": 90, "hold": True, "wind": {"from_deg": 0, "speed_kt": 30},
+           "events": [{"t_s": 1, "heading_deg": 90}]}
+    df = run_scenario(scn).df
+    late = df[df.t_s > WIND_RAMP_S + 40]
+    # wind from the north at 30 kt: ground velocity has a southward component, heading crabs left
+    assert late["vn_mps"].mean() == pytest.approx(-30 * 0.514444, abs=0.5)
+    crab_deg = ((late["heading_deg"] - late["track_deg"] + 180) % 360 - 180).mean()
+    assert crab_deg == pytest.approx(-math.degrees(math.asin(30 * 0.514444 / 111.1)), abs=0.5)
+    assert late["tas_mps"].mean() == pytest.approx(111.1, abs=0.3)
