@@ -9,7 +9,37 @@ from pathlib import Path
 from .errors import UserError
 from .paths import results_dir, scenarios_dir
 
-DEMO_SCENARIO = "demo.yaml"
+DEMO_SCENARIO = "demo-sid.yaml"
+
+
+def _has_procedure(path: Path) -> bool:
+    """True when the scenario file has a ``procedure:`` block (flown by the procedure guidance)."""
+    import yaml
+
+    try:
+        raw = yaml.safe_load(path.read_text())
+    except (OSError, yaml.YAMLError):
+        return False  # the scenario loader reports it with file and line
+    return isinstance(raw, dict) and "procedure" in raw
+
+
+def _fly_file(path: Path, out: Path, args) -> int:
+    """Fly a scenario file: a procedure flight when it has a ``procedure:`` block."""
+    if _has_procedure(path):
+        from .cli_fly import _print as print_fly
+        from .fly import fly_procedure, load_procedure_scenario
+
+        scn, spec, fp, db = load_procedure_scenario(path)
+        res = fly_procedure(scn, spec, fp, db, out_dir=out, seed=args.seed, csv=args.csv,
+                            plots=not getattr(args, "no_plots", False), progress=None)
+        print_fly(res)
+        return 0 if res.summary["status"] == "ok" else 1
+    from .runner import run_scenario
+
+    res = run_scenario(path, out_dir=out, seed=args.seed, csv=args.csv,
+                       plots=not getattr(args, "no_plots", False), progress=None)
+    _print_summary(res)
+    return 0 if res.summary["status"] == "ok" else 1
 
 
 def _print_summary(res) -> None:
@@ -22,29 +52,20 @@ def _print_summary(res) -> None:
 
 
 def cmd_run(args) -> int:
-    """Fly one scenario file."""
-    from .runner import run_scenario
-
+    """Fly one scenario file (a procedure flight when it has a ``procedure:`` block)."""
     scn = Path(args.scenario)
     out = Path(args.out) if args.out else results_dir() / scn.stem
-    res = run_scenario(scn, out_dir=out, seed=args.seed, csv=args.csv, plots=not args.no_plots,
-                       progress=None)
-    _print_summary(res)
-    return 0 if res.summary["status"] == "ok" else 1
+    return _fly_file(scn, out, args)
 
 
 def cmd_demo(args) -> int:
-    """Fly the shipped demo scenario into results/demo."""
-    from .runner import run_scenario
-
+    """Fly the embedded demo (a real SID from the embedded database) into results/demo."""
     scn = scenarios_dir() / DEMO_SCENARIO
     if not scn.exists():
         raise UserError(f"demo scenario {scn} is missing (is the package installed from a clone "
                         "with `pip install -e .`, or FMS_TESTBED_HOME set?)")
     out = Path(args.out) if args.out else results_dir() / "demo"
-    res = run_scenario(scn, out_dir=out, seed=args.seed, csv=args.csv, progress=None)
-    _print_summary(res)
-    return 0 if res.summary["status"] == "ok" else 1
+    return _fly_file(scn, out, args)
 
 
 def cmd_inner(args) -> int:
@@ -85,7 +106,7 @@ def register(sub) -> None:
     p.add_argument("--csv", action="store_true", help="also write timeseries.csv")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     p.set_defaults(func=cmd_run)
-    p = sub.add_parser("demo", help="fly the embedded demo into results/demo")
+    p = sub.add_parser("demo", help="fly the embedded demo (KJFK DEEZZ5 SID) into results/demo")
     p.add_argument("--out", help="output folder (default results/demo)")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--csv", action="store_true")

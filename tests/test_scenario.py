@@ -81,4 +81,12 @@ def test_cli_missing_file(tmp_path):
 
 @pytest.mark.parametrize("path", sorted(scenarios_dir().glob("*.yaml")), ids=lambda p: p.name)
 def test_shipped_scenarios_validate(path):
-    load_scenario(path)
+    import yaml
+
+    if "procedure" in yaml.safe_load(path.read_text()):
+        from fms_testbed.fly import load_procedure_scenario
+
+        scn, spec, fp, db = load_procedure_scenario(path)
+        assert fp.path.segments
+    else:
+        load_scenario(path)
