@@ -35,6 +35,7 @@ LBF = 4.4482216152605
 SLUG = 14.593902937
 G0 = 9.80665
 DT_S = 1.0 / 120.0
+_RAD = math.pi / 180.0
 
 # ----------------------------------------------------------------------------------- logging
 
@@ -399,16 +400,18 @@ class JSBSimAircraft:
             r[k] *= sc
         return r
 
-    def state(self, raw: dict[str, float] | None = None) -> AircraftState:
-        """Return the true state as an :class:`AircraftState`."""
+    def state(self, raw: dict[str, float] | None = None,
+              ny: float | None = None) -> AircraftState:
+        """Return the true state as an :class:`AircraftState` (``ny`` overrides the measured
+        normal load factor, e.g. with its vertical-plane component for the vertical laws)."""
         r = raw if raw is not None else self.read()
         m = r["mass_kg"]
+        rad = _RAD
+        # positional, in AircraftState's field order (cheaper than keywords on the hot path)
         return AircraftState(
-            t_s=r["t_s"], lat_rad=math.radians(r["lat_deg"]), lon_rad=math.radians(r["lon_deg"]),
-            alt_m=r["alt_m"], tas_mps=r["tas_mps"], cas_mps=r["cas_mps"], gs_mps=r["gs_mps"],
-            vs_mps=r["vs_mps"], v_enu_mps=np.array([r["ve"], r["vn"], -r["vd"]]),
-            roll_rad=r["roll_rad"], pitch_rad=r["pitch_rad"], heading_rad=r["heading_rad"],
-            track_rad=r["track_rad"], alpha_rad=r["alpha_rad"], beta_rad=r["beta_rad"],
-            gamma_rad=r["gamma_rad"], p_rps=r["p_rps"], q_rps=r["q_rps"], r_rps=r["r_rps"],
-            nx=r["nx"], ny=r["ny"], f_body_mps2=np.array([r["fx"], r["fy"], r["fz"]]) / m,
-            mach=r["mach"], agl_m=r["agl_m"], throttle=r["throttle"], mass_kg=m)
+            r["t_s"], r["lat_deg"] * rad, r["lon_deg"] * rad, r["alt_m"], r["tas_mps"],
+            r["cas_mps"], r["gs_mps"], r["vs_mps"], np.array((r["ve"], r["vn"], -r["vd"])),
+            r["roll_rad"], r["pitch_rad"], r["heading_rad"], r["track_rad"], r["alpha_rad"],
+            r["beta_rad"], r["gamma_rad"], r["p_rps"], r["q_rps"], r["r_rps"], r["nx"],
+            r["ny"] if ny is None else ny, np.array((r["fx"] / m, r["fy"] / m, r["fz"] / m)),
+            r["mach"], r["agl_m"], r["throttle"], m)

@@ -145,19 +145,6 @@ def _divergence(s: AircraftState, cfg: AircraftConfig, wow: float) -> str | None
     return None
 
 
-class _VerticalPlane:
-    """A view of an :class:`AircraftState` whose ``ny`` is the vertical-plane component
-    ``n_y cos φ`` (what the vertical laws work with); every other attribute is the state's."""
-
-    __slots__ = ("_s", "ny")
-
-    def __init__(self, s: AircraftState, ny_vert: float):
-        self._s, self.ny = s, ny_vert
-
-    def __getattr__(self, name):
-        return getattr(self._s, name)
-
-
 class _NavHold:
     """Apply the last navigation errors to truth between navigation updates."""
 
@@ -297,8 +284,8 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
                 tg.speed_kind, tg.speed_mps = "tas", s.tas_mps
             tas_cmd = (float(cas_to_tas(tg.speed_mps, s.alt_m)) if tg.speed_kind == "cas"
                        else tg.speed_mps)
-            # the law works in the vertical plane: give it the vertical component of n_y
-            s_v = _VerticalPlane(s, s.ny * math.cos(s.roll_rad))
+            # the law works in the vertical plane: give it the vertical component n_y cos φ
+            s_v = ac.state(raw, ny=s.ny * math.cos(s.roll_rad))
             if not law_engaged:
                 law.engage(s_v, alt_cmd, tas_cmd)
                 law_engaged = True
