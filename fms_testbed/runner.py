@@ -243,6 +243,7 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
         bar = tqdm(total=int(scn.duration_s), unit="sim s", delay=2.0, leave=False,
                    disable=None if progress is None else False, desc=scn.name or "run")
     raw = ac.read()
+    loop0 = time.perf_counter()
     for k in range(n_total + 1):
         s = ac.state(raw)
         why = _divergence(s, cfg, raw["wow"])
@@ -323,6 +324,7 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
             bar.refresh()
     if bar is not None:
         bar.close()
+    loop_wall = time.perf_counter() - loop0
     wall = time.perf_counter() - wall0
     df = pd.DataFrame.from_records(rows, columns=[c for c, _ in COLUMNS])
     if extra_rows and any(extra_rows):
@@ -333,6 +335,8 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
         "status": status, "reason": reason, "seed": seed,
         "duration_s": round(flown, 3), "wall_time_s": round(wall, 3),
         "real_time_factor": round(flown / wall, 1) if wall > 0 else None,
+        "loop_wall_time_s": round(loop_wall, 4),
+        "loop_steps_per_s": round(flown / ac.dt_s / loop_wall) if loop_wall > 0 else None,
         "trim": {"alt_m": trim.alt_m, "tas_mps": round(trim.tas_mps, 3),
                  "alpha_deg": round(trim.alpha_deg, 3), "pitch_deg": round(trim.pitch_deg, 3),
                  "throttle": round(trim.throttle, 4), "elevator": round(trim.elevator, 4)},

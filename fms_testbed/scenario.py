@@ -191,7 +191,7 @@ class Scenario(_Strict):
     hold: bool = Field(False, description="engage the vertical law at t=0 holding the initial "
                                           "altitude and speed")
     outer_rate_hz: Annotated[float, Field(ge=5, le=120)] = Field(
-        20.0, description="rate of navigation, guidance, heading hold and the vertical law, Hz")
+        10.0, description="rate of navigation, guidance, heading hold and the vertical law, Hz")
     log_rate_hz: Annotated[float, Field(ge=1, le=120)] = Field(
         10.0, description="timeseries rate, Hz (at most the outer rate)")
     navigation: dict[str, Any] | None = None
