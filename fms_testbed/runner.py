@@ -216,7 +216,6 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     nav_seed = int(nav_spec.get("seed", seed))
     source = make_source(nav_spec, seed=nav_seed)
     nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
-    navigate = _NavHold(source, nav_dt) if nav_dt > 0 else source.update
 
     law = vertical_law or VERTICAL_LAWS[scn.vertical_law](cfg)
     tg = _Targets()
@@ -225,6 +224,8 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     events = _EventQueue(scn.events)
     n_outer = max(1, int(round(1.0 / (scn.outer_rate_hz * ac.dt_s))))
     dt_outer = n_outer * ac.dt_s
+    # hold the navigation errors between updates only when navigation runs slower than guidance
+    navigate = _NavHold(source, nav_dt) if nav_dt > dt_outer + 1e-9 else source.update
     log_every = max(1, int(round(1.0 / (scn.log_rate_hz * dt_outer))))
     n_total = int(math.ceil(scn.duration_s / dt_outer))
     lim = cfg.limits
