@@ -14,11 +14,11 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Annotated
 
-import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from .errors import ConfigError
 from .paths import aircraft_dir
+from .yamlfile import read_mapping, validation_message
 
 Pos = Annotated[float, Field(gt=0)]
 NonNeg = Annotated[float, Field(ge=0)]
@@ -149,32 +149,16 @@ def list_aircraft() -> list[str]:
     return sorted(p.stem for p in aircraft_dir().glob("*.yaml"))
 
 
-def _format_validation(path: Path, err: ValidationError) -> str:
-    e = err.errors()[0]
-    loc = ".".join(str(x) for x in e["loc"]) or "<root>"
-    more = f" (+{len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
-    return f"{path}: field '{loc}': {e['msg']}{more}"
-
-
 def load_aircraft_file(path: str | Path) -> AircraftConfig:
     """Load and validate an aircraft YAML file; raise :class:`ConfigError` naming file and field."""
     path = Path(path)
-    try:
-        raw = yaml.safe_load(path.read_text())
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: no such aircraft file") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" line {mark.line + 1}" if mark else ""
-        raise ConfigError(f"{path}:{where}: invalid YAML: {getattr(exc, 'problem', exc)}") from None
-    if not isinstance(raw, dict):
-        raise ConfigError(f"{path}: expected a mapping at the top level")
+    raw = read_mapping(path, "aircraft file")
     raw.setdefault("name", path.stem)
     raw["source_file"] = str(path)
     try:
         return AircraftConfig.model_validate(raw)
     except ValidationError as err:
-        raise ConfigError(_format_validation(path, err)) from None
+        raise ConfigError(validation_message(str(path), err)) from None
 
 
 @lru_cache(maxsize=32)

@@ -20,7 +20,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-import yaml
 
 from .aircraft import load_aircraft
 from .errors import ConfigError
@@ -28,6 +27,7 @@ from .guidance.fms import ProcedureGuidance
 from .guidance.vertical import procedure_law
 from .guidance.procedure import FlyablePath, ProcedureSpec, build_procedure, load_db, \
     parse_procedure
+from .yamlfile import read_mapping
 from .scenario import Scenario, parse_scenario
 
 MPS_KT = 3600.0 / 1852.0
@@ -101,16 +101,7 @@ def prepare(raw: dict, source: str = "<scenario>", db=None
 def load_procedure_scenario(path: str | Path):
     """Read a procedure scenario YAML file and :func:`prepare` it."""
     path = Path(path)
-    try:
-        raw = yaml.safe_load(path.read_text())
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: no such scenario file") from None
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" line {mark.line + 1}:" if mark else ""
-        raise ConfigError(f"{path}:{where} invalid YAML: {getattr(exc, 'problem', exc)}") from None
-    if not isinstance(raw, dict):
-        raise ConfigError(f"{path}: expected a mapping at the top level")
+    raw = read_mapping(path, "scenario file")
     raw.setdefault("name", path.stem)
     return prepare(raw, str(path))
 

@@ -22,12 +22,12 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Annotated, Any, Literal
 
-import yaml
 from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_validator,
                       model_validator)
 
 from .aircraft import list_aircraft
 from .errors import ConfigError
+from .yamlfile import read_mapping, validation_message
 
 FT = 0.3048
 KT = 1852.0 / 3600.0
@@ -217,16 +217,6 @@ class Scenario(_Strict):
         return v
 
 
-def _format(path: str, err: ValidationError) -> str:
-    e = err.errors()[0]
-    loc = ".".join(str(x) for x in e["loc"]) or "<root>"
-    msg = e["msg"].removeprefix("Value error, ")
-    if e["type"] == "extra_forbidden":
-        msg = "unknown field"
-    more = f" (+{len(err.errors()) - 1} more)" if len(err.errors()) > 1 else ""
-    return f"{path}: field '{loc}': {msg}{more}"
-
-
 def parse_scenario(raw: Any, source: str = "<scenario>") -> Scenario:
     """Validate a scenario mapping; raise :class:`ConfigError` naming ``source`` and the field."""
     if not isinstance(raw, dict):
@@ -236,26 +226,14 @@ def parse_scenario(raw: Any, source: str = "<scenario>") -> Scenario:
     try:
         return Scenario.model_validate(raw)
     except ValidationError as err:
-        raise ConfigError(_format(source, err)) from None
+        raise ConfigError(validation_message(source, err)) from None
 
 
 def load_scenario(path: str | Path, overrides: dict | None = None) -> Scenario:
     """Read and validate a scenario YAML file (``overrides`` are merged in before validation)."""
     path = Path(path)
-    try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise ConfigError(f"{path}: no such scenario file") from None
-    except IsADirectoryError:
-        raise ConfigError(f"{path}: is a folder, not a scenario file") from None
-    try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f" line {mark.line + 1}, column {mark.column + 1}:" if mark else ""
-        raise ConfigError(f"{path}:{where} invalid YAML: {getattr(exc, 'problem', exc)}") from None
-    if isinstance(raw, dict):
-        raw.setdefault("name", path.stem)
-        if overrides:
-            raw.update(overrides)
+    raw = read_mapping(path, "scenario file")
+    raw.setdefault("name", path.stem)
+    if overrides:
+        raw.update(overrides)
     return parse_scenario(raw, str(path))

@@ -101,7 +101,6 @@ def _pde(db, fp: FlyablePath, seg, prev_leg) -> float:
                    for p in pts)
     if lg.path_term == "CF" and isinstance(g, Line) and lg.record.course_deg is not None:
         from ..path.geodesy import direct
-        crs = g.end_course_deg  # the built course; compare with the coded course line
         coded = (lg.record.course_deg if lg.record.course_true else
                  lg.record.course_deg + _magvar(db, fp, lg))
         back = direct(t.lat_deg, t.lon_deg, coded + 180.0, max(g.length_m(), 1000.0))
