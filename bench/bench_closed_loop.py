@@ -23,8 +23,8 @@ from fms_testbed.jsbsim_core import DT_S, FT, KT, bare_fdm
 from fms_testbed.runner import run_scenario
 
 
-def bare_steps_per_s(cfg, alt_m: float, tas_mps: float, sim_s: float) -> float:
-    """Steps per second of a trimmed bare JSBSim instance."""
+def trimmed_bare_fdm(cfg, alt_m: float, tas_mps: float):
+    """A sanitised JSBSim instance of ``cfg``'s model without the inner loops, trimmed."""
     import math
 
     fdm = bare_fdm(cfg.jsbsim_model)
@@ -39,6 +39,12 @@ def bare_steps_per_s(cfg, alt_m: float, tas_mps: float, sim_s: float) -> float:
         fdm["simulation/do_simple_trim"] = 1
     except Exception:  # the timing does not need a perfect trim
         pass
+    return fdm
+
+
+def bare_steps_per_s(cfg, alt_m: float, tas_mps: float, sim_s: float) -> float:
+    """Steps per second of a trimmed bare JSBSim instance."""
+    fdm = trimmed_bare_fdm(cfg, alt_m, tas_mps)
     n = int(sim_s / DT_S)
     run = fdm.run
     t0 = time.perf_counter()

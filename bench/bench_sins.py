@@ -77,23 +77,15 @@ def bench_montecarlo(imu, n_real: int, duration_s: float) -> dict:
 
 
 def _bare_fdm_trimmed():
-    from fms_testbed.aircraft import load_aircraft
-    from fms_testbed.jsbsim_core import FT, KT, bare_fdm
+    import sys
+    from pathlib import Path
 
-    cfg = load_aircraft("737")
-    fdm = bare_fdm(cfg.jsbsim_model)
-    fdm["aero/alpha-max-rad"] = math.radians(cfg.trim.alpha_max_deg)
-    fdm["ic/h-sl-ft"] = 3000.0 / FT
-    fdm["ic/vt-kts"] = 120.0 / KT
-    fdm["ic/lat-geod-deg"] = 47.0
-    fdm["gear/gear-cmd-norm"] = 0
-    fdm.run_ic()
-    fdm["propulsion/set-running"] = -1
-    try:
-        fdm["simulation/do_simple_trim"] = 1
-    except Exception:  # the timing does not need a perfect trim
-        pass
-    return fdm
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from bench_closed_loop import trimmed_bare_fdm
+
+    from fms_testbed.aircraft import load_aircraft
+
+    return trimmed_bare_fdm(load_aircraft("737"), 3000.0, 120.0)
 
 
 def _states(n: int):
