@@ -269,15 +269,26 @@ def test_fix_leg_reached_from_elsewhere_turns_the_coded_way_to_its_fix(tmp_path)
     assert leg_turn_mismatches(p) == 0
 
 
-def test_coded_speed_limit_caps_the_planned_speed_and_turn_radius(tmp_path):
+def test_coded_speed_limit_caps_the_planned_speed_but_not_the_entry_turn(tmp_path):
+    """An 'at or below 180 kt' limit caps the leg's planned speed, but the turn at the start of
+    the leg is entered at the previous leg's speed, so its radius is planned for that."""
     legs = [sid("CA", 10, course_deg=90.0, alt_desc="+", alt1_ft=1000),
             sid("DF", 20, fix="WS", speed_kt=180, speed_desc="-")]
     p = build(tmp_path, legs)
     turn = [s for s in arcs(p, "turn") if s.leg_index == 1][0]
     assert turn.speed_mps < 180 * 1852 / 3600 * 1.05          # IAS 180 kt -> TAS at ~1000 ft
+    assert turn.geom.radius_m == pytest.approx(R_PLAN, rel=1e-3)
+
+
+def test_speed_limit_on_both_legs_gives_the_smaller_turn(tmp_path):
+    legs = [sid("CA", 10, course_deg=90.0, alt_desc="+", alt1_ft=1000, speed_kt=180,
+                speed_desc="-"),
+            sid("DF", 20, fix="WS", speed_kt=180, speed_desc="-")]
+    p = build(tmp_path, legs)
+    turn = [s for s in arcs(p, "turn") if s.leg_index == 1][0]
     assert turn.geom.radius_m < R_PLAN * 0.7
     assert turn.geom.radius_m == pytest.approx(
-        turn_radius_m(turn.speed_mps, PARAMS.bank_plan_deg, G), rel=1e-3)
+        turn_radius_m(turn.speed_mps, PARAMS.bank_plan_deg, G), rel=1e-2)
 
 
 def test_intercept_onto_a_dme_arc_is_flown_with_a_tangent_fillet(tmp_path):

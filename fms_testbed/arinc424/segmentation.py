@@ -97,15 +97,19 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightS
 
 
 def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float) -> float:
-    """Planned TAS: the aircraft's planned TAS capped by an 'at' or 'at or below' speed limit,
-    raised to an 'at or above' one (limits are IAS, turned to TAS in the ISA), m/s."""
+    """Planned TAS: the aircraft's planned TAS capped by an 'at or below' speed limit, raised to
+    an 'at or above' one, and equal to an 'at' one — the speed guidance will fly there, so turn
+    radii are planned for it (limits are IAS, turned to TAS in the ISA), m/s."""
     v = perf.tas_plan_mps
     lim = leg.rec.speed_limit_mps
-    if lim is not None and leg.rec.speed_desc in ("", "-", "@"):
-        v = min(v, isa_tas_mps(lim, alt_m))
-    elif lim is not None and leg.rec.speed_desc == "+":
-        v = max(v, isa_tas_mps(lim, alt_m))
-    return v
+    if lim is None:
+        return v
+    lim_tas = isa_tas_mps(lim, alt_m)
+    if leg.rec.speed_desc == "-":
+        return min(v, lim_tas)
+    if leg.rec.speed_desc == "+":
+        return max(v, lim_tas)
+    return lim_tas  # blank or '@': at
 
 
 def build_sequence(db: Database, seq: Sequence, perf: Performance,
@@ -149,9 +153,12 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         b.i = i
         if leg.rec.missed_approach_start:
             b.climbing = True
+        speed_in = b.speed_mps if i else None
         b.speed_mps = planned_speed_mps(perf, leg, state.alt_m)
         b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
-        b.radius_m = turn_radius_m(b.speed_mps, bank, g)
+        # a turn at the start of the leg is entered at the previous leg's speed: plan its radius
+        # for the faster of the two
+        b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0), bank, g)
         start_st = state
         try:
             state, term = LEG_TYPES[leg.pt].build(b, state)
@@ -213,7 +220,9 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         if abs(omega) < 0.5:
             out.append(seg)
             continue
-        v = min(a.speed_mps, seg.speed_mps)
+        # the aircraft enters the turn at the inbound speed and leaves it at the outbound one:
+        # plan the radius for the faster, which the bank limit must cover
+        v = max(a.speed_mps, seg.speed_mps)
         r = turn_radius_m(v, bank_deg, b.g)
         t = math.tan(math.radians(abs(omega)) / 2.0)
         avail_a = a.geom.length_m()  # already trimmed by the previous corner, if any
