@@ -246,8 +246,7 @@ class JSBSimAircraft:
         if missing:
             raise UserError(f"{cfg.jsbsim_model}: JSBSim properties missing: {missing}")
         self._keys = tuple(_READ)
-        self._getters = tuple(self._nodes[k].get_double_value for k in self._keys)
-        self._scaled = tuple((k, sc) for k, (_, sc) in _READ.items() if sc != 1.0)
+        self._getters = tuple((self._nodes[k].get_double_value, sc) for k, (_, sc) in _READ.items())
         self._w = {name: pm.get_node(name, True) for name in (
             "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
             "fms/ap/bank-trigger", "fms/ap/yaw-trigger", "fms/ap/ny-trigger",
@@ -395,10 +394,7 @@ class JSBSimAircraft:
 
     def read(self) -> dict[str, float]:
         """Read every logged property through its cached node (SI units)."""
-        r = dict(zip(self._keys, [g() for g in self._getters]))
-        for k, sc in self._scaled:
-            r[k] *= sc
-        return r
+        return dict(zip(self._keys, [g() * sc for g, sc in self._getters]))
 
     def state(self, raw: dict[str, float] | None = None,
               ny: float | None = None) -> AircraftState:

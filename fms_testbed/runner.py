@@ -256,8 +256,9 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
             for node, w in zip(wind_nodes, wind_ned):
                 node.set_double_value(frac * w / FT)
         nav = navigate(s)
-        for ev in events.due(s.t_s, s.alt_m):
-            _apply(ev, tg)
+        if events.pending:
+            for ev in events.due(s.t_s, s.alt_m):
+                _apply(ev, tg)
         gout = guidance.update(dt_outer, nav, s) if guidance is not None else None
         if gout is not None:
             if gout.bank_rad is not None:
