@@ -7,7 +7,7 @@ import pytest
 from fms_testbed.arinc424.construct import _foot
 from fms_testbed.arinc424.legs import LEG_TYPES
 from fms_testbed.arinc424.legrecord import PATH_TERMINATORS
-from fms_testbed.arinc424.model import turn_radius_m
+from fms_testbed.arinc424.model import isa_tas_mps, turn_radius_m
 from fms_testbed.arinc424.synth import leg_record as L
 from fms_testbed.arinc424.synth import offset, waypoint_record
 from fms_testbed.path import Arc, gravity_mps2, inverse
@@ -60,9 +60,13 @@ def test_tf_fly_by_turn_uses_radius_and_lead_from_speed_and_bank(tmp_path):
     fb = arcs(p, "flyby")
     assert len(fb) == 1
     arc = fb[0].geom
-    assert arc.radius_m == pytest.approx(R_PLAN, rel=1e-6)
+    # the planned speed is flown as a CAS: its TAS at the leg's planned altitude
+    v = isa_tas_mps(PERF.tas_plan_mps, p.legs[1].end.alt_m)
+    assert fb[0].speed_mps == pytest.approx(v, rel=1e-6)
+    r_plan = turn_radius_m(v, PARAMS.bank_plan_deg, G)
+    assert arc.radius_m == pytest.approx(r_plan, rel=1e-6)
     assert arc.sweep_deg == pytest.approx(60.0, abs=0.3)
-    lead = R_PLAN * math.tan(math.radians(abs(arc.sweep_deg)) / 2)
+    lead = r_plan * math.tan(math.radians(abs(arc.sweep_deg)) / 2)
     assert dist(arc.start, w["WB"]) == pytest.approx(lead, abs=1.0)
     assert dist(arc.end, w["WB"]) == pytest.approx(lead, abs=1.0)
     assert fb[0].bank_deg == pytest.approx(PARAMS.bank_plan_deg, abs=1e-6)
@@ -103,7 +107,7 @@ def test_df_turns_the_coded_way_even_beyond_180(tmp_path):
 def test_fa_ends_where_the_climb_reaches_the_altitude(tmp_path):
     p = build(tmp_path, [sid("IF", 10, fix="WB"),
                          sid("FA", 20, fix="WB", course_deg=90.0, alt_desc="+", alt1_ft=3000)])
-    grad = PERF.climb_gradient_at(PERF.tas_plan_mps)
+    grad = PERF.climb_gradient_at(p.legs[1].speed_mps)
     assert p.legs[1].termination.kind == "altitude"
     assert p.length_m() == pytest.approx((3000 - 35) * FT / grad, abs=1.0)
 
@@ -134,7 +138,7 @@ def test_fm_flies_the_manual_distance(tmp_path):
 @pytest.mark.parametrize("pt", ["CA", "VA"])
 def test_course_or_heading_to_altitude_from_the_runway(tmp_path, pt):
     p = build(tmp_path, [sid(pt, 10, course_deg=90.0, alt_desc="+", alt1_ft=2000)])
-    grad = PERF.climb_gradient_at(PERF.tas_plan_mps)
+    grad = PERF.climb_gradient_at(p.legs[0].speed_mps)
     assert p.length_m() == pytest.approx((2000 - 35) * FT / grad, abs=1.0)
     assert p.legs[0].termination.alt_m == pytest.approx(2000 * FT)
 
@@ -277,7 +281,9 @@ def test_coded_speed_limit_caps_the_planned_speed_but_not_the_entry_turn(tmp_pat
     p = build(tmp_path, legs)
     turn = [s for s in arcs(p, "turn") if s.leg_index == 1][0]
     assert turn.speed_mps < 180 * 1852 / 3600 * 1.05          # IAS 180 kt -> TAS at ~1000 ft
-    assert turn.geom.radius_m == pytest.approx(R_PLAN, rel=1e-3)
+    assert turn.geom.radius_m == pytest.approx(
+        turn_radius_m(p.legs[0].speed_mps, PARAMS.bank_plan_deg, G), rel=1e-3)
+    assert turn.geom.radius_m > R_PLAN
 
 
 def test_speed_limit_on_both_legs_gives_the_smaller_turn(tmp_path):

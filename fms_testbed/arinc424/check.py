@@ -82,7 +82,9 @@ def leg_turn_mismatches(path: ProcedurePath) -> int:
         if k is None:
             continue
         arc = None
-        if k > 0 and segs[k - 1].role == "flyby":
+        if k > 0 and segs[k - 1].role == "flyby" and segs[k - 1].leg_index == lg.index - 1:
+            # a fly-by ending the previous leg into this one (not one ending an earlier leg
+            # into a leg that came out zero-length)
             arc = segs[k - 1].geom
         elif segs[k].role == "turn" and isinstance(segs[k].geom, Arc):
             arc = segs[k].geom

@@ -97,10 +97,11 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightS
 
 
 def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float) -> float:
-    """Planned TAS: the aircraft's planned TAS capped by an 'at or below' speed limit, raised to
+    """Planned TAS: the aircraft's planned speed (flown as a CAS: its TAS at ``alt_m``) capped by
+    an 'at or below' speed limit, raised to
     an 'at or above' one, and equal to an 'at' one — the speed guidance will fly there, so turn
     radii are planned for it (limits are IAS, turned to TAS in the ISA), m/s."""
-    v = perf.tas_plan_mps
+    v = isa_tas_mps(perf.tas_plan_mps, alt_m)  # the planned speed is flown as a CAS
     lim = leg.rec.speed_limit_mps
     if lim is None:
         return v
