@@ -45,7 +45,9 @@ class Limits(_Frozen):
     climb_gradient_max: Annotated[float, Field(gt=0, lt=0.5)] = Field(
         description="max climb gradient (rise over run) at the planned speed, dimensionless")
     descent_rate_max_mps: Pos = Field(description="max planned descent rate, m/s")
-    climb_tas_mps: Pos = Field(description="planned climb/approach TAS for path building, m/s")
+    climb_tas_mps: Pos = Field(
+        description="planned terminal-area speed for path building and guidance, m/s: the TAS "
+                    "at sea level, flown as that CAS at altitude")
 
     @model_validator(mode="after")
     def _order(self):
