@@ -13,7 +13,7 @@ Typical use::
 
 ``path.segments`` are :class:`fms_testbed.path.Line`/:class:`~fms_testbed.path.Arc` tagged with
 their leg; ``path.legs[i].termination`` says how each leg ends; ``path.profile`` is the planned
-vertical profile. See ``docs/readme/procedures.md``.
+vertical profile. See the README section "ARINC-424 procedures".
 """
 
 from .database import Database, Sequence, load_database

@@ -17,7 +17,8 @@ are the cross-couplings that make the closed-loop transfer matrix from (V_cmd, H
 diagonal. ``ΔH_lim = clip(ΔH, ±dH_limit_m)`` turns a large step into a constant-V_y level change
 followed by a second-order capture. ``form="paper"`` uses the small-angle law of eq. 19 instead.
 
-Realisation on a 6-DoF aircraft (each addition measured on JSBSim, see docs/readme/coupled-law.md):
+Realisation on a 6-DoF aircraft (each addition measured on JSBSim; see the README section on
+the coupled law):
 
 * the damping term uses the measured n_xa (``(n_xa - sin θ) = V'/g``), so n_x tracking error of
   the inner loop does not turn into ΔV;
