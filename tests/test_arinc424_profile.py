@@ -57,3 +57,21 @@ def test_approach_descends_at_the_coded_angle_and_never_above_the_start(tmp_path
         h = prof.alt_m[wdw.leg_index + 1]
         assert wdw.lo_m is None or h >= wdw.lo_m - 1e-6
         assert wdw.hi_m is None or h <= wdw.hi_m + 1e-6
+
+
+def test_star_descent_never_climbs_after_its_last_constraint(tmp_path):
+    """KDCA CAPSS3-like: an 'at' fix followed by unconstrained legs. The backward pass from the
+    final node used to plan the later fixes above the 'at' fix (a climb inside a STAR)."""
+    w = world()
+    c = offset(*w["WB"], 90.0, 15.0)
+    d = offset(*c, 90.0, 15.0)
+    star = dict(proc_type="E", transition="RW09", route_type="6")
+    p = build(tmp_path, [L("XTST", "TSTR1", "IF", 10, fix="WA", alt_desc="B", alt1_ft=13000,
+                           alt2_ft=10000, **star),
+                         L("XTST", "TSTR1", "TF", 20, fix="WB", alt_desc=" ", alt1_ft=9000, **star),
+                         L("XTST", "TSTR1", "TF", 30, fix="WC", **star),
+                         L("XTST", "TSTR1", "TF", 40, fix="WD", **star)],
+              extra=[waypoint_record("WC", *c), waypoint_record("WD", *d)])
+    alt = p.profile.alt_m
+    assert all(b <= a + 1e-6 for a, b in zip(alt[:-1], alt[1:])), alt
+    assert alt[2] == pytest.approx(9000 * FT) and alt[-1] == pytest.approx(9000 * FT)

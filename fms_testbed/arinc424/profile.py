@@ -4,8 +4,8 @@ Nodes are the path start and every leg end (distance along the built path, m). C
 (SIDs, missed approaches) climb at the aircraft's gradient, level off below every 'at or
 below' constraint ahead and at the highest climb constraint still ahead (with none: the coded
 transition altitude, else 18,000 ft); descent phases are planned backwards from the last constrained fix at
-the coded vertical angle (else 3°), clamped into each fix's altitude window and never above
-the start altitude or the highest coded altitude. One geometry feeds
+the coded vertical angle (else 3°), clamped into each fix's altitude window, never above
+the start altitude or the highest coded altitude, and never climbing within a descent phase. One geometry feeds
 both: the distances come from the same segments the map and guidance use.
 """
 
@@ -150,6 +150,11 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
             floor = alt[k - 1] - math.tan(math.radians(ang)) * (along[k] - along[k - 1])
             if floor > alt[k]:
                 alt[k] = floor if hi_at[k] is None else min(floor, max(hi_at[k], alt[k]))
+        # a descent phase never climbs: after the last constraint (e.g. a STAR ending in vectors)
+        # the backward pass from the final node can plan above an earlier 'at' fix
+        for k in range(1, n + 1):
+            if not climb[k] and not climb[k - 1] and alt[k] > alt[k - 1]:
+                alt[k] = max(alt[k - 1], lo_at[k] if lo_at[k] is not None else -np.inf)
     # climb: forward pass, capped by every 'at or below' ahead and levelling off at the
     # highest climb constraint still ahead (else the coded transition altitude, else 18,000 ft)
     cap = np.full(n + 1, np.inf)
