@@ -8,7 +8,6 @@ plane, exact enough for a drawing), distances along the path in NM, altitudes in
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import matplotlib
@@ -17,20 +16,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
+from .plots import local_en_km  # noqa: E402
+
 FT_M = 0.3048
 NM_M = 1852.0
-_R_M = 6371008.8
-
-
-class _Plane:
-    def __init__(self, lat0: float, lon0: float):
-        self.lat0, self.lon0 = lat0, lon0
-        self.c = math.cos(math.radians(lat0))
-
-    def xy_km(self, lat, lon):
-        lat, lon = np.asarray(lat, float), np.asarray(lon, float)
-        return (np.radians(lon - self.lon0) * self.c * _R_M / 1000.0,
-                np.radians(lat - self.lat0) * _R_M / 1000.0)
 
 
 def _sample(geom, step_m: float = 200.0):
@@ -44,23 +33,25 @@ def plot_ground_track(df, summary, fp, out: Path, flown_paths=()) -> Path:
     labelled '<n> <code> <fix>' at its middle; constrained fixes marked."""
     path = fp.path
     s0 = path.segments[0].geom.start
-    pl = _Plane(*s0)
+    def xy_km(lat, lon):
+        return local_en_km(lat, lon, *s0)
+
     fig, ax = plt.subplots(figsize=(9, 8))
     colors = plt.cm.tab10.colors
     for k, seg in enumerate(path.segments):
         la, lo = _sample(seg.geom)
-        x, y = pl.xy_km(la, lo)
+        x, y = xy_km(la, lo)
         ax.plot(x, y, color=colors[seg.leg_index % 10], lw=3.0, alpha=0.45,
                 label="designed path (colour = leg)" if k == 0 else None)
     for j, extra in enumerate(flown_paths):
         for k, seg in enumerate(extra.path.segments):
             la, lo = _sample(seg.geom)
-            x, y = pl.xy_km(la, lo)
+            x, y = xy_km(la, lo)
             ax.plot(x, y, "k--", lw=0.8, label="path rebuilt in flight" if j == k == 0 else None)
-    x, y = pl.xy_km(df["lat_deg"], df["lon_deg"])
+    x, y = xy_km(df["lat_deg"], df["lon_deg"])
     ax.plot(x, y, color="crimson", lw=1.2, label="flown (truth)")
     if summary.get("procedure", {}).get("navigation", "truth") != "truth":
-        xn, yn = pl.xy_km(df["nav_lat_deg"], df["nav_lon_deg"])
+        xn, yn = xy_km(df["nav_lat_deg"], df["nav_lon_deg"])
         ax.plot(xn, yn, color="navy", lw=0.8, ls=":", label="navigation solution")
     for lg in path.legs:
         if not lg.seg_count:
@@ -68,14 +59,14 @@ def plot_ground_track(df, summary, fp, out: Path, flown_paths=()) -> Path:
         segs = path.segments[lg.seg_first:lg.seg_first + lg.seg_count]
         longest = max(segs, key=lambda s: s.geom.length_m())
         la, lo = longest.geom.point_at(0.5 * longest.geom.length_m())
-        xm, ym = pl.xy_km(la, lo)
+        xm, ym = xy_km(la, lo)
         fix = lg.termination.fix_ident or (lg.record.fix.ident if lg.record.fix else "")
         ax.annotate(f"{lg.index + 1} {lg.path_term} {fix}".strip(), (float(xm), float(ym)),
                     fontsize=8, xytext=(4, 4), textcoords="offset points",
                     bbox={"boxstyle": "round,pad=0.2", "fc": "white", "alpha": 0.7})
         t = lg.termination
         if t.kind == "fix" and t.lat_deg is not None:
-            xf, yf = pl.xy_km(t.lat_deg, t.lon_deg)
+            xf, yf = xy_km(t.lat_deg, t.lon_deg)
             ax.plot(float(xf), float(yf), "k^", ms=5)
     ax.plot(0, 0, "go", ms=8, label="start")
     ax.set_xlabel("east of start, km")
