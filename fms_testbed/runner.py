@@ -214,7 +214,11 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
 
     nav_spec = scn.navigation or {}
     nav_seed = int(nav_spec.get("seed", seed))
-    source = make_source(nav_spec, seed=nav_seed)
+    try:
+        source = make_source(nav_spec, seed=nav_seed)
+    except UserError as exc:
+        where = scn.source_file or scn.name or "scenario"
+        raise type(exc)(f"{where}: {exc}") from None
     nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
 
     law = vertical_law or VERTICAL_LAWS[scn.vertical_law](cfg)

@@ -90,3 +90,11 @@ def test_shipped_scenarios_validate(path):
         assert fp.path.segments
     else:
         load_scenario(path)
+
+
+def test_bad_navigation_block_names_the_scenario_file(tmp_path):
+    p = _file(tmp_path, GOOD + "navigation: {source: sins, imu: STIM300, sead: 3}\n")
+    r = subprocess.run([sys.executable, "-m", "fms_testbed.cli", "run", str(p)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2
+    assert str(p) in r.stderr and "navigation.sead" in r.stderr and "Traceback" not in r.stderr
