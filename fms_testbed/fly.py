@@ -32,9 +32,8 @@ from .scenario import Scenario, parse_scenario
 
 MPS_KT = 3600.0 / 1852.0
 OUTER_RATE_HZ = 10.0
-"""Default rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS
-runs LNAV/VNAV at 5-20 Hz; on the demo SID 10 Hz and 20 Hz give FTE95 6.22 / 6.20 m and
-max 17.0 / 16.9 m, and 10 Hz meets the speed goal). A scenario's ``outer_rate_hz`` wins."""
+"""Rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS runs
+LNAV/VNAV at 5-20 Hz; the same as the scenario default). A scenario's ``outer_rate_hz`` wins."""
 
 
 def runner_log_every(scn: Scenario) -> int:

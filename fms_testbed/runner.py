@@ -1,7 +1,7 @@
 """Fly a scenario: trim, then the closed loop JSBSim → navigation → guidance/laws → inner loops.
 
 Rates: JSBSim and the inner loops at 120 Hz (inside JSBSim); navigation, guidance, heading hold and
-the vertical law at ``outer_rate_hz`` (default 40 Hz); logging at ``log_rate_hz``.
+the vertical law at ``outer_rate_hz`` (default 10 Hz); logging at ``log_rate_hz`` (default 10 Hz).
 
 A run ends with a status: ``ok`` (duration flown or guidance finished) or ``diverged`` with a
 reason (non-finite state, ground contact, stall, overspeed) — never a hang or a bare traceback.

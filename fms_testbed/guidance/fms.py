@@ -1,6 +1,6 @@
 """``ProcedureGuidance``: flies a built ARINC-424 procedure through the runner's Guidance hook.
 
-Every outer step (20 Hz by default) it
+Every outer step (10 Hz by default) it
 
 1. projects the *navigation* position on the active path piece (local tangent plane, see
    :mod:`.geometry`) — guidance flies on the navigation solution, so NSE shows in the true track;

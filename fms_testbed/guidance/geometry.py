@@ -1,4 +1,4 @@
-"""Precomputed local-plane geometry of a built path, for cross-track at 20 Hz without geodesy.
+"""Precomputed local-plane geometry of a built path, for cross-track at the outer rate without geodesy.
 
 Each :class:`~fms_testbed.path.Line` is cut into chunks of at most :data:`CHUNK_M` metres; each
 chunk and each :class:`~fms_testbed.path.Arc` gets a local tangent plane about an origin (chunk
