@@ -83,7 +83,8 @@ class PIDGains(_Frozen):
 
 
 class InnerLoopGains(_Frozen):
-    """Inner-loop tuning (run inside JSBSim as ``<system>`` components at 120 Hz).
+    """Inner-loop tuning (run inside JSBSim as ``<system>`` components every
+    ``frames_per_update`` JSBSim frames: 60 Hz by default at JSBSim's 120 Hz).
 
     * bank: aileron (norm) per rad of bank error; kd per rad/s of roll rate
     * yaw: rudder (norm) per rad of sideslip (kp) and per rad/s of yaw rate (kd)
@@ -101,6 +102,9 @@ class InnerLoopGains(_Frozen):
     elevator_rate_max_ps: Pos = Field(1.5, description="elevator command rate limit, norm/s")
     throttle_min: Annotated[float, Field(ge=0, le=1)] = 0.0
     throttle_max: Annotated[float, Field(ge=0, le=1.0)] = 1.0
+    frames_per_update: Annotated[int, Field(ge=1, le=4)] = Field(
+        2, description="inner loops run every N JSBSim frames (JSBSim channel execrate): "
+                       "1 = 120 Hz, 2 = 60 Hz (a flight-control computer's rate; half the cost)")
 
 
 class InnerLoopSpec(_Frozen):

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 T0_K = 288.15
@@ -32,6 +34,20 @@ def cas_to_tas(cas_mps, alt_m):
     qc = P0_PA * ((1 + (GAMMA - 1) / 2 * (cas / A0_MPS) ** 2) ** (GAMMA / (GAMMA - 1)) - 1)
     mach = np.sqrt(2 / (GAMMA - 1) * ((qc / p + 1) ** ((GAMMA - 1) / GAMMA) - 1))
     return mach * np.sqrt(GAMMA * R_JPKGK * t)
+
+
+def cas_to_tas_scalar(cas_mps: float, alt_m: float) -> float:
+    """:func:`cas_to_tas` for one float (m/s at ISA altitude m): the same formula in ``math``,
+    ~20x faster than the numpy version on a scalar (the guidance calls it every outer step)."""
+    h = float(alt_m)
+    t = T0_K - LAPSE_KPM * min(h, H_TROP_M)
+    p = P0_PA * (t / T0_K) ** (G0_MPS2 / (LAPSE_KPM * R_JPKGK))
+    if h > H_TROP_M:
+        p *= math.exp(-G0_MPS2 * (h - H_TROP_M) / (R_JPKGK * t))
+    k = (GAMMA - 1) / GAMMA
+    qc = P0_PA * ((1 + (GAMMA - 1) / 2 * (cas_mps / A0_MPS) ** 2) ** (1 / k) - 1)
+    mach = math.sqrt(2 / (GAMMA - 1) * ((qc / p + 1) ** k - 1))
+    return mach * math.sqrt(GAMMA * R_JPKGK * t)
 
 
 def tas_to_cas(tas_mps, alt_m):

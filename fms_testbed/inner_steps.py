@@ -91,12 +91,11 @@ def step_response(ac: JSBSimAircraft, spec: StepSpec, point: EnvelopePoint,
     base = {"bank": 0.0, "ny": 1.0, "nx": 0.0}[spec.loop]
     target = base + spec.amplitude
     ac.command(**{"bank_rad" if spec.loop == "bank" else spec.loop: target})
-    node = ac._nodes[key]
     n = int(round(spec.duration_s / ac.dt_s))
     y = np.empty(n)
     for i in range(n):
         ac.run(1)
-        y[i] = node.get_double_value()
+        y[i] = getattr(ac.state(), key)  # this frame's value (not the loops' sampled one)
     t = (np.arange(n) + 1) * ac.dt_s
     settle, over = step_metrics(t, y, base, target)
     return StepResult(spec, t, y, target, settle, over)

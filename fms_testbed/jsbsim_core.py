@@ -111,17 +111,20 @@ def count_engines(model: str) -> int:
     return len(root.findall("./propulsion/engine"))
 
 
-def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None) -> Path:
+def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None,
+                            frames_per_update: int = 1) -> Path:
     """Copy ``model`` from the jsbsim wheel into the sandbox without I/O elements.
 
     Returns the sandbox's ``aircraft`` folder (to pass to ``set_aircraft_path``). Removes every
     top-level ``<input>`` and ``<output>`` element and appends the inner-loop ``<system>``
-    (not when ``elevator_rate_max_ps`` is None: the bare model, for benchmarks).
+    (not when ``elevator_rate_max_ps`` is None: the bare model, for benchmarks), updated every
+    ``frames_per_update`` frames.
     """
     src = Path(jsbsim.get_default_root_dir()) / "aircraft" / model
     if not (src / f"{model}.xml").exists():
         raise UserError(f"JSBSim model '{model}' is not in the jsbsim package's aircraft folder")
-    key = f"{model}-er{elevator_rate_max_ps:g}" if elevator_rate_max_ps else f"{model}-bare"
+    key = (f"{model}-er{elevator_rate_max_ps:g}-x{frames_per_update}" if elevator_rate_max_ps
+           else f"{model}-bare")
     dst_root = _sandbox_dir() / key
     dst = dst_root / model
     if (dst / f"{model}.xml").exists():
@@ -136,7 +139,7 @@ def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None) -> P
             removed += 1
     n_eng = len(root.findall("./propulsion/engine"))
     if elevator_rate_max_ps:
-        root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S)))
+        root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S, frames_per_update)))
     tree.write(dst / f"{model}.xml", encoding="utf-8", xml_declaration=True)
     log.debug("sanitised %s: removed %d I/O elements, %d engines", model, removed, n_eng)
     return dst_root
@@ -148,6 +151,7 @@ def bare_fdm(model: str, dt_s: float = DT_S) -> "jsbsim.FGFDMExec":
     fdm = jsbsim.FGFDMExec(jsbsim.get_default_root_dir())
     fdm.set_debug_level(0)
     fdm.disable_output()
+    fdm.set_dt(dt_s)
     fdm.set_aircraft_path(str(sanitized_aircraft_path(model, None)))
     if not fdm.load_model(model):
         raise UserError(f"JSBSim could not load model '{model}'")
@@ -195,8 +199,7 @@ _READ = {  # state field -> (property, scale)
     "p_rps": ("velocities/p-rad_sec", 1.0),
     "q_rps": ("velocities/q-rad_sec", 1.0),
     "r_rps": ("velocities/r-rad_sec", 1.0),
-    "nx": ("fms/meas/nx", 1.0),
-    "ny": ("fms/meas/ny", 1.0),
+    "weight_lbs": ("inertia/weight-lbs", 1.0),
     "fx": ("forces/fbx-total-lbs", LBF),
     "fy": ("forces/fby-total-lbs", LBF),
     "fz": ("forces/fbz-total-lbs", LBF),
@@ -208,6 +211,36 @@ _READ = {  # state field -> (property, scale)
     "rudder": ("fcs/rudder-cmd-norm", 1.0),
     "wow": ("gear/wow", 1.0),
 }
+
+
+def wind_axis_load_factors(fx_lbs, fz_lbs, alpha_rad, weight_lbs, cos=math.cos, sin=math.sin):
+    """Tangential and normal load factors (g) from JSBSim's total body forces, gravity excluded:
+    ``n_x = (F_x cos α + F_z sin α) / W``, ``n_y = (F_x sin α - F_z cos α) / W`` (coupled-law note,
+    an accelerometer along the wind axes). Scalars with ``math`` (default) or arrays with
+    ``cos=np.cos, sin=np.sin``."""
+    ca, sa = cos(alpha_rad), sin(alpha_rad)
+    return (fx_lbs * ca + fz_lbs * sa) / weight_lbs, (fx_lbs * sa - fz_lbs * ca) / weight_lbs
+
+
+def raw_to_si(raw: np.ndarray) -> dict[str, np.ndarray]:
+    """Columns of stacked :meth:`JSBSimAircraft.read_raw` rows (shape (n, len(_READ))) in SI,
+    keyed like ``_READ``, plus ``nx`` and ``ny`` (g) — the vectorised twin of
+    :meth:`JSBSimAircraft.state`, used to build the logged timeseries at the end of a run."""
+    raw = np.asarray(raw, dtype=float).reshape(-1, len(_READ))
+    out = {k: raw[:, i] * sc for i, (k, (_, sc)) in enumerate(_READ.items())}
+    r = {k: raw[:, i] for i, k in enumerate(_READ)}
+    out["nx"], out["ny"] = wind_axis_load_factors(r["fx"], r["fz"], r["alpha_rad"],
+                                                  r["weight_lbs"], np.cos, np.sin)
+    return out
+
+
+#: Position of each ``_READ`` field in a :meth:`JSBSimAircraft.read_raw` list.
+RAW = {k: i for i, k in enumerate(_READ)}
+# the order JSBSimAircraft.state unpacks (a test keeps the two in step)
+_STATE_ORDER = ("t_s", "lat_deg", "lon_deg", "alt_m", "agl_m", "tas_mps", "cas_mps", "gs_mps",
+                "vs_mps", "vn", "ve", "vd", "roll_rad", "pitch_rad", "heading_rad", "track_rad",
+                "alpha_rad", "beta_rad", "gamma_rad", "p_rps", "q_rps", "r_rps", "weight_lbs",
+                "fx", "fy", "fz", "mach", "throttle", "mass_kg")
 
 
 class JSBSimAircraft:
@@ -230,10 +263,14 @@ class JSBSimAircraft:
         """(Re)create the JSBSim instance and cache the property nodes."""
         cfg, dt_s = self.cfg, self.dt_s
         root = jsbsim.get_default_root_dir()
-        ac_path = sanitized_aircraft_path(cfg.jsbsim_model, cfg.inner_loops.elevator_rate_max_ps)
+        ac_path = sanitized_aircraft_path(cfg.jsbsim_model, cfg.inner_loops.elevator_rate_max_ps,
+                                          cfg.inner_loops.frames_per_update)
         fdm = jsbsim.FGFDMExec(root)
         fdm.set_debug_level(0)
         fdm.disable_output()
+        # before loading: JSBSim's FCS components take their step (frame time x channel rate)
+        # when they are built
+        fdm.set_dt(dt_s)
         fdm.set_aircraft_path(str(ac_path))
         if not fdm.load_model(cfg.jsbsim_model):
             raise UserError(f"JSBSim could not load model '{cfg.jsbsim_model}' for aircraft {cfg.name}")
@@ -247,6 +284,7 @@ class JSBSimAircraft:
             raise UserError(f"{cfg.jsbsim_model}: JSBSim properties missing: {missing}")
         self._keys = tuple(_READ)
         self._getters = tuple((self._nodes[k].get_double_value, sc) for k, (_, sc) in _READ.items())
+        self._raw_getters = tuple(g for g, _ in self._getters)
         self._w = {name: pm.get_node(name, True) for name in (
             "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
             "fms/ap/bank-trigger", "fms/ap/yaw-trigger", "fms/ap/ny-trigger",
@@ -392,22 +430,24 @@ class JSBSimAircraft:
                 return False
         return True
 
-    def read(self) -> dict[str, float]:
-        """Read every logged property through its cached node (SI units)."""
-        return dict(zip(self._keys, [g() * sc for g, sc in self._getters]))
+    def read_raw(self) -> list[float]:
+        """Read every property of ``_READ`` through its cached node, in JSBSim's units, in
+        ``_READ`` order (index with :data:`RAW`); the hot path's one read per outer step."""
+        return [g() for g in self._raw_getters]
 
-    def state(self, raw: dict[str, float] | None = None,
-              ny: float | None = None) -> AircraftState:
-        """Return the true state as an :class:`AircraftState` (``ny`` overrides the measured
-        normal load factor, e.g. with its vertical-plane component for the vertical laws)."""
-        r = raw if raw is not None else self.read()
-        m = r["mass_kg"]
+    def state(self, raw: list[float] | None = None) -> AircraftState:
+        """Return the true state as an :class:`AircraftState` (SI) from a :meth:`read_raw`
+        list (read now when ``raw`` is None)."""
+        (t, lat, lon, h, agl, vt, vc, vg, hdot, vn, ve, vd, phi, theta, psi, trk, alpha, beta,
+         gamma, p, q, r, w_lbs, fx, fy, fz, mach, thr, m_slug, *_rest) = (
+            raw if raw is not None else self.read_raw())
         rad = _RAD
+        k = LBF / (m_slug * SLUG)
+        # from this frame's forces (the inner loops' own measurement runs at the loop rate)
+        nx, ny = wind_axis_load_factors(fx, fz, alpha, w_lbs)
         # positional, in AircraftState's field order (cheaper than keywords on the hot path)
         return AircraftState(
-            r["t_s"], r["lat_deg"] * rad, r["lon_deg"] * rad, r["alt_m"], r["tas_mps"],
-            r["cas_mps"], r["gs_mps"], r["vs_mps"], np.array((r["ve"], r["vn"], -r["vd"])),
-            r["roll_rad"], r["pitch_rad"], r["heading_rad"], r["track_rad"], r["alpha_rad"],
-            r["beta_rad"], r["gamma_rad"], r["p_rps"], r["q_rps"], r["r_rps"], r["nx"],
-            r["ny"] if ny is None else ny, np.array((r["fx"] / m, r["fy"] / m, r["fz"] / m)),
-            r["mach"], r["agl_m"], r["throttle"], m)
+            t, lat * rad, lon * rad, h * FT, vt * FT, vc * KT, vg * FT, hdot * FT,
+            np.array((ve * FT, vn * FT, -vd * FT)), phi, theta, psi, trk, alpha, beta, gamma,
+            p, q, r, nx, ny, np.array((fx * k, fy * k, fz * k)), mach, agl * FT, thr,
+            m_slug * SLUG)

@@ -21,13 +21,13 @@ import numpy as np
 import pandas as pd
 
 from .aircraft import AircraftConfig, load_aircraft
-from .atmosphere import cas_to_tas
+from .atmosphere import cas_to_tas, cas_to_tas_scalar
 from .errors import UserError
-from .jsbsim_core import FT, JSBSimAircraft
+from .jsbsim_core import FT, RAW, JSBSimAircraft
 from .navigation import make_source
 from .scenario import Event, Scenario, load_scenario, parse_scenario
 from .state import AircraftState, NavSolution
-from .timeseries import COLUMNS, build_row
+from .timeseries import build_frame
 
 log = logging.getLogger(__name__)
 
@@ -171,10 +171,12 @@ class _NavHold:
                            errors=self.errors)
 
 
-def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = None,
-        guidance: Guidance | None = None, progress: bool | None = None,
-        vertical_law=None) -> tuple[pd.DataFrame, dict[str, Any]]:
-    """Fly a validated scenario and return (timeseries DataFrame, summary dict).
+class Flight:
+    """A closed-loop flight, loaded and trimmed, flown one outer step at a time.
+
+    ``Flight(scn).run()`` flies the whole scenario; :meth:`step` advances it by outer steps
+    (``1 / outer_rate_hz`` s of simulated time each), so a notebook or a benchmark can stop,
+    look and go on. :meth:`result` builds the timeseries and the summary of what was flown.
 
     Parameters
     ----------
@@ -185,170 +187,231 @@ def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = Non
     progress : show a progress bar (default: when stderr is a terminal)
     vertical_law : a vertical-law instance overriding ``scn.vertical_law``
     """
-    from .control import VERTICAL_LAWS
 
-    seed = 0 if seed is None else int(seed)
-    cfg = cfg or load_aircraft(scn.aircraft)
-    wall0 = time.perf_counter()
-    ac = JSBSimAircraft(cfg)
-    fdm = ac.fdm
-    fdm["simulation/randomseed"] = seed
-    ini = scn.initial
-    kind, spd = ini.speed
-    tas0 = float(cas_to_tas(spd, ini.altitude_m)) if kind == "cas" else spd
-    # Trim in calm air: JSBSim 1.3.3 fails to trim in wind, and run_ic() resets the atmosphere's
-    # wind to the initial condition's. The steady wind is ramped in after the trim (WIND_RAMP_S).
-    ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
-            lon_deg=ini.lon_deg)
-    wind_ned = _wind_ned(scn)
-    wind_nodes = [fdm.get_property_manager().get_node(f"atmosphere/wind-{c}-fps", False)
-                  for c in ("north", "east", "down")]
-    if scn.turbulence is not None:  # after trim: JSBSim cannot trim in turbulence
-        idx, w20 = _TURB_SEVERITY[scn.turbulence.severity]
-        fdm["atmosphere/turb-type"] = 4
-        fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20 * 1.6878
-        fdm["atmosphere/turbulence/milspec/severity"] = idx
-    trim = ac.trim_result
-    ac.engage()
-    ac.command(bank_rad=0.0, ny=1.0, nx=0.0)
+    def __init__(self, scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = None,
+                 guidance: Guidance | None = None, progress: bool | None = None,
+                 vertical_law=None):
+        from .control import VERTICAL_LAWS
 
-    nav_spec = scn.navigation or {}
-    nav_seed = int(nav_spec.get("seed", seed))
-    try:
-        source = make_source(nav_spec, seed=nav_seed)
-    except UserError as exc:
-        where = scn.source_file or scn.name or "scenario"
-        raise type(exc)(f"{where}: {exc}") from None
-    nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
+        self.scn = scn
+        self.seed = 0 if seed is None else int(seed)
+        self.cfg = cfg = cfg or load_aircraft(scn.aircraft)
+        self._wall0 = time.perf_counter()
+        self.aircraft = ac = JSBSimAircraft(cfg)
+        ac.fdm["simulation/randomseed"] = self.seed
+        ini = scn.initial
+        kind, spd = ini.speed
+        tas0 = float(cas_to_tas(spd, ini.altitude_m)) if kind == "cas" else spd
+        # Trim in calm air: JSBSim 1.3.3 fails to trim in wind, and run_ic() resets the
+        # atmosphere's wind to the initial condition's. The steady wind is ramped in after the
+        # trim (WIND_RAMP_S).
+        ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
+                lon_deg=ini.lon_deg)
+        if scn.turbulence is not None:  # after trim: JSBSim cannot trim in turbulence
+            idx, w20 = _TURB_SEVERITY[scn.turbulence.severity]
+            ac.fdm["atmosphere/turb-type"] = 4
+            ac.fdm["atmosphere/turbulence/milspec/windspeed_at_20ft_AGL-fps"] = w20 * 1.6878
+            ac.fdm["atmosphere/turbulence/milspec/severity"] = idx
+        ac.engage()
+        ac.command(bank_rad=0.0, ny=1.0, nx=0.0)
 
-    law = vertical_law or VERTICAL_LAWS[scn.vertical_law](cfg)
-    tg = _Targets()
-    if scn.hold:
-        tg.alt_m, tg.speed_kind, tg.speed_mps, tg.vertical = ini.altitude_m, kind, spd, True
-    events = _EventQueue(scn.events)
-    n_outer = max(1, int(round(1.0 / (scn.outer_rate_hz * ac.dt_s))))
-    dt_outer = n_outer * ac.dt_s
-    # hold the navigation errors between updates only when navigation runs slower than guidance
-    navigate = _NavHold(source, nav_dt) if nav_dt > dt_outer + 1e-9 else source.update
-    log_every = max(1, int(round(1.0 / (scn.log_rate_hz * dt_outer))))
-    n_total = int(math.ceil(scn.duration_s / dt_outer))
-    lim = cfg.limits
-    bank_max = math.radians(lim.bank_max_deg)
-    roll_rate = math.radians(lim.roll_rate_max_dps)
-    last_bank = 0.0
-    rows: list[tuple] = []
-    extra_rows: list[dict] = []
-    status, reason = "ok", "duration flown"
-    law_engaged = False
-    cmd_nx = cmd_ny = float("nan")
-    bar = None
-    if progress is not False:
-        from tqdm import tqdm
-        # appears only after 2 s of wall time, and (unless forced) only on a terminal
-        bar = tqdm(total=int(scn.duration_s), unit="sim s", delay=2.0, leave=False,
-                   disable=None if progress is None else False, desc=scn.name or "run")
-    raw = ac.read()
-    loop0 = time.perf_counter()
-    for k in range(n_total + 1):
-        s = ac.state(raw)
-        why = _divergence(s, cfg, raw["wow"])
-        if why:
-            status, reason = "diverged", why
-            break
-        if s.t_s <= WIND_RAMP_S + dt_outer and any(wind_ned):
-            frac = min(1.0, s.t_s / WIND_RAMP_S)
-            for node, w in zip(wind_nodes, wind_ned):
-                node.set_double_value(frac * w / FT)
-        nav = navigate(s)
-        if events.pending:
-            for ev in events.due(s.t_s, s.alt_m):
-                _apply(ev, tg)
-        gout = guidance.update(dt_outer, nav, s) if guidance is not None else None
-        if gout is not None:
-            if gout.bank_rad is not None:
-                tg.bank_rad, tg.heading_rad = gout.bank_rad, None
-            if gout.alt_m is not None:
-                tg.alt_m, tg.vertical = gout.alt_m, True
-            if gout.tas_mps is not None:
-                tg.speed_kind, tg.speed_mps, tg.vertical = "tas", gout.tas_mps, True
-        # lateral: heading hold on the navigation heading, else bank hold
-        if tg.heading_rad is not None:
-            err = _wrap_pi(tg.heading_rad - nav.heading_rad)
-            bank_cmd = max(-bank_max, min(bank_max, cfg.inner_loops.heading_kp * err))
-        else:
-            bank_cmd = tg.bank_rad
-        if tg.heading_rad is not None or gout is not None:
-            # guidance/heading-hold bank commands are rate limited (passenger-comfort roll rate)
-            step = roll_rate * dt_outer
-            bank_cmd = min(max(bank_cmd, last_bank - step), last_bank + step)
-        last_bank = bank_cmd
-        # vertical: the law when an altitude/speed target is active
-        if tg.vertical:
-            alt_cmd = tg.alt_m if tg.alt_m is not None else s.alt_m
-            if tg.alt_m is None:
-                tg.alt_m = s.alt_m
-            if tg.speed_mps is None:
-                tg.speed_kind, tg.speed_mps = "tas", s.tas_mps
-            tas_cmd = (float(cas_to_tas(tg.speed_mps, s.alt_m)) if tg.speed_kind == "cas"
-                       else tg.speed_mps)
-            # the law works in the vertical plane: give it the vertical component n_y cos φ
-            s_v = ac.state(raw, ny=s.ny * math.cos(s.roll_rad))
-            if not law_engaged:
-                law.engage(s_v, alt_cmd, tas_cmd)
-                law_engaged = True
-            cmd_nx, ny_vert = law.update(dt_outer, s_v, alt_cmd, tas_cmd)
-            cmd_ny = ny_vert / max(math.cos(s.roll_rad), 0.5)
-            ac.command(bank_rad=bank_cmd, ny=cmd_ny, nx=cmd_nx)
-        else:
-            law_engaged = False
-            alt_cmd = tas_cmd = float("nan")
-            cmd_ny = tg.ny
-            if tg.throttle is not None:
-                cmd_nx = float("nan")
-                ac.command(bank_rad=bank_cmd, ny=cmd_ny, throttle=tg.throttle)
-            else:
-                cmd_nx = tg.nx if tg.nx is not None else 0.0
-                ac.command(bank_rad=bank_cmd, ny=cmd_ny, nx=cmd_nx)
-        if k % log_every == 0:
-            rows.append(build_row(raw, nav, bank_cmd, tg.heading_rad, cmd_nx, cmd_ny,
-                                  tg.throttle, alt_cmd, tas_cmd))
-            ex = dict(nav.errors)
+        nav_spec = scn.navigation or {}
+        try:
+            source = make_source(nav_spec, seed=int(nav_spec.get("seed", self.seed)))
+        except UserError as exc:
+            where = scn.source_file or scn.name or "scenario"
+            raise type(exc)(f"{where}: {exc}") from None
+        self.navigation = source
+        self.vertical_law = vertical_law or VERTICAL_LAWS[scn.vertical_law](cfg)
+        self.guidance = guidance
+        self.n_frames = max(1, int(round(1.0 / (scn.outer_rate_hz * ac.dt_s))))
+        self.dt_outer_s = self.n_frames * ac.dt_s
+        self.raw_rows: list[list[float]] = []   # JSBSim reads (jsbsim_core._READ order)
+        self.rows: list[tuple] = []              # timeseries.LOG_FIELDS
+        self.extra_rows: list[dict] = []
+        self.status, self.reason = "ok", "duration flown"
+        self.done = False
+        self._loop_wall_s = 0.0
+        self._bar = None
+        if progress is not False:
+            from tqdm import tqdm
+            # appears only after 2 s of wall time, and (unless forced) only on a terminal
+            self._bar = tqdm(total=int(scn.duration_s), unit="sim s", delay=2.0, leave=False,
+                             disable=None if progress is None else False, desc=scn.name or "run")
+        self._steps = self._loop()
+
+    def step(self, n: int = 1) -> bool:
+        """Fly ``n`` outer steps; return False once the flight has ended (status in
+        :attr:`status` / :attr:`reason`)."""
+        if self.done:
+            return False
+        t0 = time.perf_counter()
+        steps = self._steps
+        for _ in range(n):
+            if next(steps, None) is None:
+                self.done = True
+                break
+        self._loop_wall_s += time.perf_counter() - t0
+        if self.done and self._bar is not None:
+            self._bar.close()
+        return not self.done
+
+    def run(self) -> tuple[pd.DataFrame, dict[str, Any]]:
+        """Fly to the end; return :meth:`result`."""
+        while self.step(1 << 30):
+            pass
+        return self.result()
+
+    def _loop(self):
+        """The outer loop as a generator: one ``yield`` per outer step (locals stay fast)."""
+        scn, cfg, ac, guidance = self.scn, self.cfg, self.aircraft, self.guidance
+        law, rows, extra_rows, bar = self.vertical_law, self.rows, self.extra_rows, self._bar
+        raw_rows = self.raw_rows
+        ini = scn.initial
+        kind, spd = ini.speed
+        nav_spec = scn.navigation or {}
+        nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
+        n_outer, dt_outer = self.n_frames, self.dt_outer_s
+        # hold the navigation errors between updates only when navigation runs slower than
+        # guidance
+        navigate = (_NavHold(self.navigation, nav_dt) if nav_dt > dt_outer + 1e-9
+                    else self.navigation.update)
+        tg = _Targets()
+        if scn.hold:
+            tg.alt_m, tg.speed_kind, tg.speed_mps, tg.vertical = ini.altitude_m, kind, spd, True
+        events = _EventQueue(scn.events)
+        log_every = max(1, int(round(1.0 / (scn.log_rate_hz * dt_outer))))
+        n_total = int(math.ceil(scn.duration_s / dt_outer))
+        lim = cfg.limits
+        bank_max = math.radians(lim.bank_max_deg)
+        roll_step = math.radians(lim.roll_rate_max_dps) * dt_outer
+        heading_kp = cfg.inner_loops.heading_kp
+        wind_ned = _wind_ned(scn)
+        wind_on = any(wind_ned)
+        pm = ac.fdm.get_property_manager()
+        wind_nodes = [pm.get_node(f"atmosphere/wind-{c}-fps", False)
+                      for c in ("north", "east", "down")]
+        i_wow = RAW["wow"]
+        last_bank = 0.0
+        law_engaged = False
+        cmd_nx = cmd_ny = nan = float("nan")
+        raw = ac.read_raw()
+        for k in range(n_total + 1):
+            s = ac.state(raw)
+            why = _divergence(s, cfg, raw[i_wow])
+            if why:
+                self.status, self.reason = "diverged", why
+                return
+            if wind_on and s.t_s <= WIND_RAMP_S + dt_outer:
+                frac = min(1.0, s.t_s / WIND_RAMP_S)
+                for node, w in zip(wind_nodes, wind_ned):
+                    node.set_double_value(frac * w / FT)
+            nav = navigate(s)
+            if events.pending:
+                for ev in events.due(s.t_s, s.alt_m):
+                    _apply(ev, tg)
+            gout = guidance.update(dt_outer, nav, s) if guidance is not None else None
             if gout is not None:
-                ex.update(gout.log)
-            extra_rows.append(ex)
-        if gout is not None and gout.done:
-            reason = "guidance complete"
-            break
-        if k == n_total:
-            break
-        if not ac.run(n_outer):
-            status, reason = "diverged", "JSBSim stopped"
-            break
-        raw = ac.read()
-        if bar is not None and k % 200 == 0:
-            bar.n = int(raw["t_s"])
-            bar.refresh()
-    if bar is not None:
-        bar.close()
-    loop_wall = time.perf_counter() - loop0
-    wall = time.perf_counter() - wall0
-    df = pd.DataFrame.from_records(rows, columns=[c for c, _ in COLUMNS])
-    if extra_rows and any(extra_rows):
-        df = pd.concat([df, pd.DataFrame.from_records(extra_rows)], axis=1)
-    flown = float(df["t_s"].iloc[-1]) if len(df) else 0.0
-    summary = {
-        "scenario": scn.name, "aircraft": cfg.name, "jsbsim_model": cfg.jsbsim_model,
-        "status": status, "reason": reason, "seed": seed,
-        "duration_s": round(flown, 3), "wall_time_s": round(wall, 3),
-        "real_time_factor": round(flown / wall, 1) if wall > 0 else None,
-        "loop_wall_time_s": round(loop_wall, 4),
-        "loop_steps_per_s": round(flown / ac.dt_s / loop_wall) if loop_wall > 0 else None,
-        "trim": {"alt_m": trim.alt_m, "tas_mps": round(trim.tas_mps, 3),
-                 "alpha_deg": round(trim.alpha_deg, 3), "pitch_deg": round(trim.pitch_deg, 3),
-                 "throttle": round(trim.throttle, 4), "elevator": round(trim.elevator, 4)},
-        "metrics": _metrics(df),
-    }
-    return df, summary
+                if gout.bank_rad is not None:
+                    tg.bank_rad, tg.heading_rad = gout.bank_rad, None
+                if gout.alt_m is not None:
+                    tg.alt_m, tg.vertical = gout.alt_m, True
+                if gout.tas_mps is not None:
+                    tg.speed_kind, tg.speed_mps, tg.vertical = "tas", gout.tas_mps, True
+            # lateral: heading hold on the navigation heading, else bank hold
+            hdg_cmd = tg.heading_rad
+            if hdg_cmd is not None:
+                err = _wrap_pi(hdg_cmd - nav.heading_rad)
+                bank_cmd = max(-bank_max, min(bank_max, heading_kp * err))
+            else:
+                bank_cmd = tg.bank_rad
+            if hdg_cmd is not None or gout is not None:
+                # guidance/heading-hold bank commands are rate limited (passenger-comfort rate)
+                bank_cmd = min(max(bank_cmd, last_bank - roll_step), last_bank + roll_step)
+            last_bank = bank_cmd
+            # vertical: the law when an altitude/speed target is active
+            if tg.vertical:
+                if tg.alt_m is None:
+                    tg.alt_m = s.alt_m
+                alt_cmd = tg.alt_m
+                if tg.speed_mps is None:
+                    tg.speed_kind, tg.speed_mps = "tas", s.tas_mps
+                tas_cmd = (cas_to_tas_scalar(tg.speed_mps, s.alt_m) if tg.speed_kind == "cas"
+                           else tg.speed_mps)
+                if not law_engaged:
+                    law.engage(s, alt_cmd, tas_cmd)
+                    law_engaged = True
+                # the law works in the vertical plane: it returns the vertical component of n_y
+                cmd_nx, ny_vert = law.update(dt_outer, s, alt_cmd, tas_cmd)
+                cmd_ny = ny_vert / max(math.cos(s.roll_rad), 0.5)
+                ac.command(bank_rad=bank_cmd, ny=cmd_ny, nx=cmd_nx)
+            else:
+                law_engaged = False
+                alt_cmd = tas_cmd = nan
+                cmd_ny = tg.ny
+                if tg.throttle is not None:
+                    cmd_nx = nan
+                    ac.command(bank_rad=bank_cmd, ny=cmd_ny, throttle=tg.throttle)
+                else:
+                    cmd_nx = tg.nx if tg.nx is not None else 0.0
+                    ac.command(bank_rad=bank_cmd, ny=cmd_ny, nx=cmd_nx)
+            if k % log_every == 0:
+                # what is at hand only; converted to the timeseries' units once, at the end
+                raw_rows.append(raw)
+                rows.append((bank_cmd, hdg_cmd, cmd_nx, cmd_ny, tg.throttle, alt_cmd, tas_cmd,
+                             nav.lat_rad, nav.lon_rad, nav.alt_m, nav.heading_rad, nav.roll_rad,
+                             nav.pitch_rad))
+                extra_rows.append(nav.errors if gout is None else {**nav.errors, **gout.log})
+            if gout is not None and gout.done:
+                self.reason = "guidance complete"
+                return
+            if k == n_total:
+                return
+            if not ac.run(n_outer):
+                self.status, self.reason = "diverged", "JSBSim stopped"
+                return
+            raw = ac.read_raw()
+            if bar is not None and k % 200 == 0:
+                bar.n = int(raw[0])
+                bar.refresh()
+            yield k
+
+    def result(self) -> tuple[pd.DataFrame, dict[str, Any]]:
+        """The timeseries (:data:`~fms_testbed.timeseries.COLUMNS`, then navigation-error and
+        guidance columns) and the summary of what has been flown so far."""
+        scn, cfg, ac = self.scn, self.cfg, self.aircraft
+        wall = time.perf_counter() - self._wall0
+        loop_wall = self._loop_wall_s
+        df = build_frame(self.raw_rows, self.rows)
+        if self.extra_rows and any(self.extra_rows):
+            df = pd.concat([df, pd.DataFrame.from_records(self.extra_rows)], axis=1)
+        flown = float(df["t_s"].iloc[-1]) if len(df) else 0.0
+        trim = ac.trim_result
+        summary = {
+            "scenario": scn.name, "aircraft": cfg.name, "jsbsim_model": cfg.jsbsim_model,
+            "status": self.status, "reason": self.reason if self.done else "in flight",
+            "seed": self.seed,
+            "duration_s": round(flown, 3), "wall_time_s": round(wall, 3),
+            "real_time_factor": round(flown / wall, 1) if wall > 0 else None,
+            "loop_wall_time_s": round(loop_wall, 4),
+            "loop_steps_per_s": round(flown / ac.dt_s / loop_wall) if loop_wall > 0 else None,
+            "trim": {"alt_m": trim.alt_m, "tas_mps": round(trim.tas_mps, 3),
+                     "alpha_deg": round(trim.alpha_deg, 3), "pitch_deg": round(trim.pitch_deg, 3),
+                     "throttle": round(trim.throttle, 4), "elevator": round(trim.elevator, 4)},
+            "metrics": _metrics(df),
+        }
+        return df, summary
+
+
+def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = None,
+        guidance: Guidance | None = None, progress: bool | None = None,
+        vertical_law=None) -> tuple[pd.DataFrame, dict[str, Any]]:
+    """Fly a validated scenario and return (timeseries DataFrame, summary dict).
+
+    The parameters are :class:`Flight`'s; this is ``Flight(...).run()``.
+    """
+    return Flight(scn, cfg=cfg, seed=seed, guidance=guidance, progress=progress,
+                  vertical_law=vertical_law).run()
 
 
 def _metrics(df: pd.DataFrame) -> dict[str, float]:
@@ -419,4 +482,4 @@ def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None =
     return RunResult(df=df, summary=summary, out_dir=out)
 
 
-__all__ = ["run_scenario", "fly", "write_outputs", "RunResult", "Guidance", "GuidanceOutput", "FT"]
+__all__ = ["run_scenario", "fly", "Flight", "write_outputs", "RunResult", "Guidance", "GuidanceOutput", "FT"]

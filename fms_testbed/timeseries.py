@@ -7,13 +7,9 @@ and the procedure guidance's (``xtk_m``, ``leg_index`` ...).
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
+import pandas as pd
 
-from .state import NavSolution
-
-D = math.degrees
 
 #: (column, description with unit) — in this order in ``timeseries.parquet``.
 COLUMNS: tuple[tuple[str, str], ...] = (
@@ -63,31 +59,52 @@ COLUMNS: tuple[tuple[str, str], ...] = (
     ("nav_pitch_deg", "navigation-solution pitch, deg"),
 )
 
-_NAN = float("nan")
+#: What the runner logs per row besides the raw JSBSim read, in this order (None = inactive).
+LOG_FIELDS = ("cmd_bank_rad", "cmd_heading_rad", "cmd_nx", "cmd_ny", "cmd_throttle", "cmd_alt_m",
+              "cmd_tas_mps", "nav_lat_rad", "nav_lon_rad", "nav_alt_m", "nav_heading_rad",
+              "nav_roll_rad", "nav_pitch_rad")
 
 
-def _opt(x, f=lambda v: v):
-    return _NAN if x is None else f(x)
+def build_frame(raw_rows: list[list[float]], log_rows: list[tuple]) -> pd.DataFrame:
+    """The timeseries in :data:`COLUMNS` order from the rows the runner logged.
 
+    The flight loop only keeps what it already has (the :meth:`JSBSimAircraft.read_raw` list,
+    JSBSim units, and a tuple of :data:`LOG_FIELDS`); the unit conversions run here, vectorised,
+    once per run (:func:`~fms_testbed.jsbsim_core.raw_to_si`, the twin of the state the laws see).
+    """
+    from .jsbsim_core import raw_to_si
 
-def build_row(raw: dict[str, float], nav: NavSolution, bank_cmd_rad: float,
-              heading_cmd_rad: float | None, cmd_nx: float, cmd_ny: float,
-              cmd_throttle: float | None, cmd_alt_m: float, cmd_tas_mps: float) -> tuple:
-    """Assemble one row in :data:`COLUMNS` order from a raw JSBSim read (SI) and the commands."""
-    m = raw["mass_kg"]
-    return (
-        raw["t_s"], raw["lat_deg"], raw["lon_deg"], raw["alt_m"], raw["tas_mps"], raw["cas_mps"],
-        raw["gs_mps"], raw["vs_mps"], raw["ve"], raw["vn"], -raw["vd"],
-        D(raw["heading_rad"]) % 360.0, D(raw["track_rad"]) % 360.0, D(raw["pitch_rad"]),
-        D(raw["roll_rad"]), D(raw["alpha_rad"]), D(raw["beta_rad"]), D(raw["gamma_rad"]),
-        D(raw["p_rps"]), D(raw["q_rps"]), D(raw["r_rps"]),
-        raw["fx"] / m, raw["fy"] / m, raw["fz"] / m, raw["nx"], raw["ny"], raw["mach"],
-        raw["throttle"], raw["elevator"], raw["aileron"], raw["rudder"],
-        D(bank_cmd_rad), _opt(heading_cmd_rad, lambda v: D(v) % 360.0), cmd_nx, cmd_ny,
-        _opt(cmd_throttle), cmd_alt_m, cmd_tas_mps,
-        D(nav.lat_rad), D(nav.lon_rad), nav.alt_m, D(nav.heading_rad) % 360.0,
-        D(nav.roll_rad), D(nav.pitch_rad),
-    )
+    names = [c for c, _ in COLUMNS]
+    if not raw_rows:
+        return pd.DataFrame({c: pd.Series(dtype=float) for c in names})
+    r = raw_to_si(np.array(raw_rows, dtype=float))
+    lg = pd.DataFrame.from_records(log_rows, columns=LOG_FIELDS).astype(float)
+    deg = np.degrees
+    m = r["mass_kg"]
+    cols = {
+        "t_s": r["t_s"], "lat_deg": r["lat_deg"], "lon_deg": r["lon_deg"], "alt_m": r["alt_m"],
+        "tas_mps": r["tas_mps"], "cas_mps": r["cas_mps"], "gs_mps": r["gs_mps"],
+        "vs_mps": r["vs_mps"], "ve_mps": r["ve"], "vn_mps": r["vn"], "vu_mps": -r["vd"],
+        "heading_deg": deg(r["heading_rad"]) % 360.0, "track_deg": deg(r["track_rad"]) % 360.0,
+        "pitch_deg": deg(r["pitch_rad"]), "roll_deg": deg(r["roll_rad"]),
+        "alpha_deg": deg(r["alpha_rad"]), "beta_deg": deg(r["beta_rad"]),
+        "gamma_deg": deg(r["gamma_rad"]), "p_dps": deg(r["p_rps"]), "q_dps": deg(r["q_rps"]),
+        "r_dps": deg(r["r_rps"]), "fx_mps2": r["fx"] / m, "fy_mps2": r["fy"] / m,
+        "fz_mps2": r["fz"] / m, "nx": r["nx"], "ny": r["ny"], "mach": r["mach"],
+        "throttle": r["throttle"], "elevator": r["elevator"], "aileron": r["aileron"],
+        "rudder": r["rudder"],
+        "cmd_bank_deg": deg(lg["cmd_bank_rad"].to_numpy()),
+        "cmd_heading_deg": deg(lg["cmd_heading_rad"].to_numpy()) % 360.0,
+        "cmd_nx": lg["cmd_nx"].to_numpy(), "cmd_ny": lg["cmd_ny"].to_numpy(),
+        "cmd_throttle": lg["cmd_throttle"].to_numpy(), "cmd_alt_m": lg["cmd_alt_m"].to_numpy(),
+        "cmd_tas_mps": lg["cmd_tas_mps"].to_numpy(),
+        "nav_lat_deg": deg(lg["nav_lat_rad"].to_numpy()),
+        "nav_lon_deg": deg(lg["nav_lon_rad"].to_numpy()), "nav_alt_m": lg["nav_alt_m"].to_numpy(),
+        "nav_heading_deg": deg(lg["nav_heading_rad"].to_numpy()) % 360.0,
+        "nav_roll_deg": deg(lg["nav_roll_rad"].to_numpy()),
+        "nav_pitch_deg": deg(lg["nav_pitch_rad"].to_numpy()),
+    }
+    return pd.DataFrame({c: cols[c] for c in names})
 
 
 def column_doc_markdown() -> str:
@@ -97,4 +114,4 @@ def column_doc_markdown() -> str:
     return "\n".join(lines)
 
 
-__all__ = ["COLUMNS", "build_row", "column_doc_markdown", "np"]
+__all__ = ["COLUMNS", "LOG_FIELDS", "build_frame", "column_doc_markdown"]

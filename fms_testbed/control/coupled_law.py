@@ -318,7 +318,7 @@ class CoupledLaw:
         alt_cmd_m, tas_cmd_mps : targets, m and m/s (unused; part of the protocol)
         """
         self.state = CoupledLawState(nxa_cmd=float(state.nx), engaged=True,
-                                     ny_model=float(state.ny))
+                                     ny_model=float(state.ny) * math.cos(state.roll_rad))
 
     def update(self, dt_s: float, state: AircraftState, alt_cmd_m: float, tas_cmd_mps: float
                ) -> tuple[float, float]:
@@ -330,7 +330,8 @@ class CoupledLaw:
         Parameters
         ----------
         dt_s : step, s
-        state : measured aircraft state (tas_mps, alt_m, gamma_rad, nx, throttle)
+        state : measured aircraft state (tas_mps, alt_m, gamma_rad, nx, throttle; ny and roll_rad
+            for the n_y trim: the law uses the vertical-plane component n_y cos φ)
         alt_cmd_m : altitude target, m;  tas_cmd_mps : true-airspeed target, m/s
         """
         p, st = self.params, self.state
@@ -358,7 +359,9 @@ class CoupledLaw:
             a = min(dt_s / p.ny_model_tau_s, 1.0) if p.ny_model_tau_s > 0 else 1.0
             st.ny_model += a * (ny_law - st.ny_model)
             if p.ny_min < ny < p.ny_max:
-                st.ny_trim += (st.ny_model - float(state.ny)) * dt_s / p.ny_trim_tau_s
+                # measured n_y, vertical-plane component (the law works in the vertical plane)
+                ny_meas = float(state.ny) * math.cos(state.roll_rad)
+                st.ny_trim += (st.ny_model - ny_meas) * dt_s / p.ny_trim_tau_s
                 st.ny_trim = min(max(st.ny_trim, -0.1), 0.1)
 
         if st.protect_mode:

@@ -28,7 +28,7 @@ import logging
 import math
 from dataclasses import dataclass, field
 
-from ..atmosphere import cas_to_tas
+from ..atmosphere import cas_to_tas_scalar
 from ..path.geodesy import direct, inverse
 from ..path.segments import Arc, Line, project
 from ..runner import GuidanceOutput
@@ -513,7 +513,7 @@ class ProcedureGuidance:
         if nav.t_s >= self.next_speed_t:
             lim = self.limits[g_leg] if g_leg < len(self.limits) else None
             lo, hi = cas_band(lim, self.carry_max_cas if self.descent else None)
-            plan = min(float(cas_to_tas(self.cfg.limits.climb_tas_mps, nav.alt_m)),
+            plan = min(cas_to_tas_scalar(self.cfg.limits.climb_tas_mps, nav.alt_m),
                        self._arc_speed_cap(along, gs))  # the planned speed is flown as a CAS
             self.tas_cmd = tas_target_mps(plan, nav.alt_m, lo, hi, self.cfg.limits.cas_min_mps)
             self.next_speed_t = nav.t_s + 1.0

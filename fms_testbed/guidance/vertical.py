@@ -26,7 +26,7 @@ import bisect
 import math
 from dataclasses import dataclass
 
-from ..atmosphere import cas_to_tas
+from ..atmosphere import cas_to_tas_scalar
 
 KT_MPS = 1852.0 / 3600.0
 MIN_CAS_FACTOR = 1.15
@@ -72,10 +72,10 @@ def tas_target_mps(tas_plan_mps: float, alt_m: float, lo_cas_mps: float | None,
     (ISA conversion), never below MIN_CAS_FACTOR × ``cas_min_mps``."""
     v = tas_plan_mps
     if hi_cas_mps is not None:
-        v = min(v, float(cas_to_tas(hi_cas_mps, alt_m)))
+        v = min(v, cas_to_tas_scalar(hi_cas_mps, alt_m))
     if lo_cas_mps is not None:
-        v = max(v, float(cas_to_tas(lo_cas_mps, alt_m)))
-    return max(v, float(cas_to_tas(MIN_CAS_FACTOR * cas_min_mps, alt_m)))
+        v = max(v, cas_to_tas_scalar(lo_cas_mps, alt_m))
+    return max(v, cas_to_tas_scalar(MIN_CAS_FACTOR * cas_min_mps, alt_m))
 
 
 def altitude_lead_s(cfg) -> float:

@@ -1,0 +1,72 @@
+"""Shared timing for the closed-loop benchmarks: a trimmed bare JSBSim instance and a flight
+timed in alternating chunks.
+
+This machine's speed drifts by tens of percent over seconds, so a ratio of two separately timed
+runs swings by ±0.1. Here the bare instance and the closed loop alternate in chunks of 10 s of
+simulated time (1200 frames; the order swaps every chunk) for the whole flight, and the ratio is
+closed-loop frames per second over bare frames per second from the totals: both see the same
+machine.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+from fms_testbed.jsbsim_core import DT_S, FT, KT, bare_fdm
+
+CHUNK_S = 10.0
+
+
+def trimmed_bare_fdm(cfg, alt_m: float, tas_mps: float):
+    """A sanitised JSBSim instance of ``cfg``'s model without the inner loops, trimmed; no
+    Python work per frame is added to it (the denominator of every ratio)."""
+    fdm = bare_fdm(cfg.jsbsim_model)
+    fdm["aero/alpha-max-rad"] = math.radians(cfg.trim.alpha_max_deg)
+    fdm["ic/h-sl-ft"] = alt_m / FT
+    fdm["ic/vt-kts"] = tas_mps / KT
+    fdm["ic/lat-geod-deg"] = 47.0
+    fdm["gear/gear-cmd-norm"] = 0
+    fdm.run_ic()
+    fdm["propulsion/set-running"] = -1
+    try:
+        fdm["simulation/do_simple_trim"] = 1
+    except Exception:  # the timing does not need a perfect trim
+        pass
+    return fdm
+
+
+def interleaved_ratio(flight, cfg, chunk_s: float = CHUNK_S) -> dict:
+    """Fly ``flight`` (a :class:`fms_testbed.runner.Flight`, loaded and trimmed) to its end,
+    alternating with a bare instance of the same aircraft every ``chunk_s`` simulated seconds.
+
+    Returns ``{"ratio", "bare_fps", "closed_fps", "summary", "df"}`` (frames per wall second).
+    """
+    pt = cfg.default_condition
+    bare = trimmed_bare_fdm(cfg, pt.alt_m, pt.tas_mps)
+    run = bare.run
+    steps = max(1, int(round(chunk_s / flight.dt_outer_s)))
+    frames = steps * flight.n_frames
+    fdm = flight.aircraft.fdm
+    t_bare = t_closed = 0.0
+    n_bare = n_closed = 0
+    pc = time.perf_counter
+    alive, i = True, 0
+    while alive:
+        for which in ((0, 1) if i % 2 == 0 else (1, 0)):
+            if which == 0:
+                t0 = pc()
+                for _ in range(frames):
+                    run()
+                t_bare += pc() - t0
+                n_bare += frames
+            elif alive:
+                sim0 = fdm.get_sim_time()
+                t0 = pc()
+                alive = flight.step(steps)
+                t_closed += pc() - t0
+                n_closed += int(round((fdm.get_sim_time() - sim0) / DT_S))
+        i += 1
+    df, summary = flight.result()
+    b, c = n_bare / t_bare, n_closed / t_closed
+    return {"ratio": c / b, "bare_fps": b, "closed_fps": c, "summary": summary, "df": df}
