@@ -8,10 +8,11 @@
 3. Navigation step (F + Picard + factor + propagation + solution) vs 12 bare JSBSim steps
    (one 10 Hz navigation period at 120 Hz) — budget ≈ 70 µs. Medians of 5 interleaved rounds.
 4. Closed loop with SINS injection: JSBSim frames per wall second of a scenario with
-   ``navigation: {source: sins}`` over the bare JSBSim rate — goal ≥ 0.5. Medians of 3
-   alternating rounds (the machine is shared; single runs vary by ±20 %).
+   ``navigation: {source: sins}`` over the bare JSBSim rate — goal ≥ 0.5. Each flight is timed
+   interleaved with a bare instance in 10 s chunks (``interleave.py``; the machine is shared and
+   separate runs vary by ±20 %).
 
-    python bench/bench_sins.py [--mc-duration-s 3600] [-n 1000] [--sim-s 120] [--skip-jsbsim]
+    python bench/bench_sins.py [--mc-duration-s 3600] [-n 1000] [--sim-s 300] [--skip-jsbsim]
 """
 
 from __future__ import annotations
@@ -135,11 +136,21 @@ def bench_nav_step(imu_name: str, with_jsbsim: bool, n: int = 1000, rounds: int 
     return out
 
 
-def bench_closed_loop(sim_s: float, imu_name: str, rounds: int = 3) -> dict:
-    """Median JSBSim frames per wall second over alternating rounds: bare, closed loop with truth
-    navigation, with SINS (matrices every step) and with SINS holding its matrices for 1 s."""
-    from fms_testbed.jsbsim_core import DT_S
-    from fms_testbed.runner import run_scenario
+def bench_closed_loop(sim_s: float, imu_name: str) -> dict:
+    """Closed-loop frames per wall second over bare JSBSim, each timed interleaved with a bare
+    instance (``interleave.py``): truth navigation, SINS (matrices every step), SINS holding its
+    matrices for 1 s."""
+    import sys
+    from pathlib import Path
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    from interleave import interleaved_ratio
+
+    from fms_testbed.aircraft import load_aircraft
+    from fms_testbed.runner import Flight
+    from fms_testbed.scenario import parse_scenario
+
+    cfg = load_aircraft("737")
 
     def closed(nav):
         scn = {"name": "bench-sins", "aircraft": "737", "duration_s": sim_s, "hold": True,
@@ -148,30 +159,14 @@ def bench_closed_loop(sim_s: float, imu_name: str, rounds: int = 3) -> dict:
                "events": [{"t_s": 10, "heading_deg": 180}, {"t_s": 60, "alt_m": 3300.0}]}
         if nav:
             scn["navigation"] = nav
-        t0 = time.perf_counter()
-        res = run_scenario(scn, progress=False)
-        wall = time.perf_counter() - t0
-        assert res.summary["status"] == "ok", res.summary
-        return res.summary["duration_s"] / DT_S / wall
-
-    def bare():
-        fdm = _bare_fdm_trimmed()
-        n = int(sim_s / DT_S)
-        run = fdm.run
-        t0 = time.perf_counter()
-        for _ in range(n):
-            run()
-        return n / (time.perf_counter() - t0)
+        res = interleaved_ratio(Flight(parse_scenario(scn), cfg=cfg, progress=False), cfg)
+        assert res["summary"]["status"] == "ok", res["summary"]
+        return res
 
     sins = {"source": "sins", "imu": imu_name, "seed": 1, "method": "picard", "dt_s": 0.1}
-    runs = {"bare_fps": bare, "closed_truth_fps": lambda: closed(None),
-            "closed_sins_fps": lambda: closed(sins),
-            "closed_sins_hold_fps": lambda: closed({**sins, "matrices_dt_s": 1.0})}
-    res = {k: [] for k in runs}
-    for _ in range(rounds):
-        for k, f in runs.items():
-            res[k].append(f())
-    return {k: statistics.median(v) for k, v in res.items()}
+    closed(sins)  # warm-up: numba compile/cache load
+    return {"truth": closed(None), "sins": closed(sins),
+            "sins_hold": closed({**sins, "matrices_dt_s": 1.0})}
 
 
 def main() -> int:
@@ -179,7 +174,7 @@ def main() -> int:
     ap.add_argument("--imu", default="STIM300")
     ap.add_argument("-n", type=int, default=1000, help="Monte-Carlo realisations")
     ap.add_argument("--mc-duration-s", type=float, default=3600.0)
-    ap.add_argument("--sim-s", type=float, default=120.0, help="closed-loop simulated time, s")
+    ap.add_argument("--sim-s", type=float, default=300.0, help="closed-loop simulated time, s")
     ap.add_argument("--skip-jsbsim", action="store_true")
     args = ap.parse_args()
     imu = load_imu(args.imu)
@@ -204,17 +199,14 @@ def main() -> int:
 
     if not args.skip_jsbsim:
         c = bench_closed_loop(args.sim_s, args.imu)
-        print(f"[4] closed loop, 737, {args.sim_s:g} s simulated, 120 Hz frames per wall second:")
-        print(f"    bare JSBSim {c['bare_fps']:.0f}, closed loop truth nav "
-              f"{c['closed_truth_fps']:.0f}, closed loop SINS {c['closed_sins_fps']:.0f} "
-              "(medians of 3 alternating rounds)")
-        print(f"    ratio SINS closed loop / bare = {c['closed_sins_fps'] / c['bare_fps']:.2f} "
-              f"(goal >= 0.5); SINS / truth closed loop = "
-              f"{c['closed_sins_fps'] / c['closed_truth_fps']:.2f}; truth closed loop / bare = "
-              f"{c['closed_truth_fps'] / c['bare_fps']:.2f}")
-        print(f"    with matrices held 1 s: {c['closed_sins_hold_fps']:.0f} fps, ratio / bare = "
-              f"{c['closed_sins_hold_fps'] / c['bare_fps']:.2f}, / truth closed loop = "
-              f"{c['closed_sins_hold_fps'] / c['closed_truth_fps']:.2f}")
+        t, sn, sh = c["truth"], c["sins"], c["sins_hold"]
+        print(f"[4] closed loop, 737, {args.sim_s:g} s simulated, 120 Hz frames per wall second, "
+              "each interleaved with bare JSBSim in 10 s chunks:")
+        print(f"    truth nav: {t['closed_fps']:.0f} fps, ratio / bare {t['ratio']:.2f}")
+        print(f"    SINS ({args.imu}, matrices every 0.1 s): {sn['closed_fps']:.0f} fps, "
+              f"ratio SINS closed loop / bare = {sn['ratio']:.2f} (goal >= 0.5)")
+        print(f"    SINS with matrices held 1 s: {sh['closed_fps']:.0f} fps, ratio / bare = "
+              f"{sh['ratio']:.2f}")
 
     m = bench_montecarlo(imu, args.n, args.mc_duration_s)
     print(f"[2] Monte-Carlo {args.n} realisations x {args.mc_duration_s:g} s at 10 Hz "
