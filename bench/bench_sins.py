@@ -81,7 +81,7 @@ def _bare_fdm_trimmed():
     from pathlib import Path
 
     sys.path.insert(0, str(Path(__file__).resolve().parent))
-    from bench_closed_loop import trimmed_bare_fdm
+    from interleave import trimmed_bare_fdm
 
     from fms_testbed.aircraft import load_aircraft
 

@@ -10,6 +10,7 @@ reason (non-finite state, ground contact, stall, overspeed) — never a hang or 
 from __future__ import annotations
 
 import json
+from array import array
 import logging
 import math
 import time
@@ -226,7 +227,9 @@ class Flight:
         self.guidance = guidance
         self.n_frames = max(1, int(round(1.0 / (scn.outer_rate_hz * ac.dt_s))))
         self.dt_outer_s = self.n_frames * ac.dt_s
-        self.raw_rows: list[list[float]] = []   # JSBSim reads (jsbsim_core._READ order)
+        # JSBSim reads, row after row in jsbsim_core._READ order: a flat float buffer, so the
+        # log adds no object the garbage collector must walk (lists of floats would)
+        self.raw_log = array("d")
         self.rows: list[tuple] = []              # timeseries.LOG_FIELDS
         self.extra_rows: list[dict] = []
         self.status, self.reason = "ok", "duration flown"
@@ -266,7 +269,8 @@ class Flight:
         """The outer loop as a generator: one ``yield`` per outer step (locals stay fast)."""
         scn, cfg, ac, guidance = self.scn, self.cfg, self.aircraft, self.guidance
         law, rows, extra_rows, bar = self.vertical_law, self.rows, self.extra_rows, self._bar
-        raw_rows = self.raw_rows
+        raw_log = self.raw_log
+        no_errors: dict = {}
         ini = scn.initial
         kind, spd = ini.speed
         nav_spec = scn.navigation or {}
@@ -357,11 +361,14 @@ class Flight:
                     ac.command(bank_rad=bank_cmd, ny=cmd_ny, nx=cmd_nx)
             if k % log_every == 0:
                 # what is at hand only; converted to the timeseries' units once, at the end
-                raw_rows.append(raw)
+                raw_log.extend(raw)
                 rows.append((bank_cmd, hdg_cmd, cmd_nx, cmd_ny, tg.throttle, alt_cmd, tas_cmd,
                              nav.lat_rad, nav.lon_rad, nav.alt_m, nav.heading_rad, nav.roll_rad,
                              nav.pitch_rad))
-                extra_rows.append(nav.errors if gout is None else {**nav.errors, **gout.log})
+                if gout is not None:
+                    extra_rows.append({**nav.errors, **gout.log})
+                else:  # str -> float dicts are not tracked by the GC; an empty one is shared
+                    extra_rows.append(nav.errors or no_errors)
             if gout is not None and gout.done:
                 self.reason = "guidance complete"
                 return
@@ -382,7 +389,7 @@ class Flight:
         scn, cfg, ac = self.scn, self.cfg, self.aircraft
         wall = time.perf_counter() - self._wall0
         loop_wall = self._loop_wall_s
-        df = build_frame(self.raw_rows, self.rows)
+        df = build_frame(self.raw_log, self.rows)
         if self.extra_rows and any(self.extra_rows):
             df = pd.concat([df, pd.DataFrame.from_records(self.extra_rows)], axis=1)
         flown = float(df["t_s"].iloc[-1]) if len(df) else 0.0

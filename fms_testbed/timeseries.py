@@ -65,19 +65,20 @@ LOG_FIELDS = ("cmd_bank_rad", "cmd_heading_rad", "cmd_nx", "cmd_ny", "cmd_thrott
               "nav_roll_rad", "nav_pitch_rad")
 
 
-def build_frame(raw_rows: list[list[float]], log_rows: list[tuple]) -> pd.DataFrame:
+def build_frame(raw_log, log_rows: list[tuple]) -> pd.DataFrame:
     """The timeseries in :data:`COLUMNS` order from the rows the runner logged.
 
-    The flight loop only keeps what it already has (the :meth:`JSBSimAircraft.read_raw` list,
-    JSBSim units, and a tuple of :data:`LOG_FIELDS`); the unit conversions run here, vectorised,
-    once per run (:func:`~fms_testbed.jsbsim_core.raw_to_si`, the twin of the state the laws see).
+    The flight loop only keeps what it already has: the :meth:`JSBSimAircraft.read_raw` values
+    (JSBSim units, appended row after row to a flat float buffer ``raw_log``, or a list of rows)
+    and a tuple of :data:`LOG_FIELDS` per row; the unit conversions run here, vectorised, once per
+    run (:func:`~fms_testbed.jsbsim_core.raw_to_si`, the twin of the state the laws see).
     """
     from .jsbsim_core import raw_to_si
 
     names = [c for c, _ in COLUMNS]
-    if not raw_rows:
+    if not len(raw_log):
         return pd.DataFrame({c: pd.Series(dtype=float) for c in names})
-    r = raw_to_si(np.array(raw_rows, dtype=float))
+    r = raw_to_si(np.asarray(raw_log, dtype=float))
     lg = pd.DataFrame.from_records(log_rows, columns=LOG_FIELDS).astype(float)
     deg = np.degrees
     m = r["mass_kg"]
