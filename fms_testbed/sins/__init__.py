@@ -10,11 +10,17 @@ trapezoid), :mod:`.simulate` (x_k = Φ x + B u + S N with a semidefinite factor)
 imports).
 """
 
-from .discretize import DiscretisationError, discretize, discretize_sins
-from .euler import eps_to_euler_errors, euler_errors_to_eps
-from .model import N_STATES, STATE_NAMES, build_F
-from .presets import load_imu
-from .simulate import IndefiniteCovarianceError, factor_psd, simulate_lti
+from pathlib import Path as _Path
+
+from ._numba_cache import invalidate_if_sources_changed as _invalidate
+
+_invalidate(_Path(__file__).parent)  # before any kernel is loaded from the cache
+
+from .discretize import DiscretisationError, discretize, discretize_sins  # noqa: E402
+from .euler import eps_to_euler_errors, euler_errors_to_eps  # noqa: E402
+from .model import N_STATES, STATE_NAMES, build_F  # noqa: E402
+from .presets import load_imu  # noqa: E402
+from .simulate import IndefiniteCovarianceError, factor_psd, simulate_lti  # noqa: E402
 
 __all__ = ["discretize", "discretize_sins", "DiscretisationError", "factor_psd",
            "simulate_lti", "IndefiniteCovarianceError", "eps_to_euler_errors",

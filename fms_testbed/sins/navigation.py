@@ -196,7 +196,7 @@ class SinsNavigation:
     def solution(self, truth: AircraftState) -> NavSolution:
         """Truth ⊕ the current error state (position, velocity, attitude; errors dict for logs)."""
         x = self.x
-        e, n, u, ve, vn, vu, eps_e, eps_n, eps_u = x[:9].tolist()
+        e, n, u, ve, vn, vu, eps_e, eps_n, eps_u, ba_x, _, _, bg_x, _, bg_z = x[:15].tolist()
         lat0, h0 = truth.lat_rad, truth.alt_m
         s2 = math.sin(lat0) ** 2
         w = 1.0 - E2 * s2                                   # WGS-84 radii (model.earth_radii)
@@ -213,13 +213,10 @@ class SinsNavigation:
             "ve_err_mps": ve, "vn_err_mps": vn, "vu_err_mps": vu,
             "att_err_roll_deg": d_roll * RAD2DEG, "att_err_pitch_deg": d_pitch * RAD2DEG,
             "att_err_heading_deg": d_head * RAD2DEG,
-            "bias_accel_x_ug": float(x[9]) * MPS2_TO_UG,
-            "bias_gyro_x_dph": float(x[12]) * RAD2DPH, "bias_gyro_z_dph": float(x[14]) * RAD2DPH,
+            "bias_accel_x_ug": ba_x * MPS2_TO_UG,
+            "bias_gyro_x_dph": bg_x * RAD2DPH, "bias_gyro_z_dph": bg_z * RAD2DPH,
         }
-        v = truth.v_enu_mps
         return NavSolution(
-            t_s=truth.t_s, lat_rad=lat0 + n / (rm + h0),
-            lon_rad=truth.lon_rad + e / ((rn + h0) * math.cos(lat0)), alt_m=h0 + u,
-            v_enu_mps=np.array([v[0] + ve, v[1] + vn, v[2] + vu]),
-            roll_rad=truth.roll_rad + d_roll, pitch_rad=truth.pitch_rad + d_pitch,
-            heading_rad=(truth.heading_rad + d_head) % (2 * math.pi), errors=errors)
+            truth.t_s, lat0 + n / (rm + h0), truth.lon_rad + e / ((rn + h0) * math.cos(lat0)),
+            h0 + u, truth.v_enu_mps + x[3:6], truth.roll_rad + d_roll,
+            truth.pitch_rad + d_pitch, (truth.heading_rad + d_head) % (2 * math.pi), errors)
