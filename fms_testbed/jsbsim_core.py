@@ -289,6 +289,8 @@ class JSBSimAircraft:
             "fms/ap/bank-engage", "fms/ap/yaw-engage", "fms/ap/ny-engage", "fms/ap/nx-engage",
             "fms/ap/bank-trigger", "fms/ap/yaw-trigger", "fms/ap/ny-trigger",
             "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle")}
+        self._setters = tuple(self._w[k].set_double_value for k in (
+            "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle", "fms/ap/nx-engage"))
         self._write_gains()
 
     # -- properties ------------------------------------------------------------------
@@ -409,17 +411,17 @@ class JSBSimAircraft:
 
         A throttle command disengages the n_x loop; an n_x command engages it.
         """
-        w = self._w
+        set_bank, set_ny, set_nx, set_thr, set_nx_engage = self._setters
         if bank_rad is not None:
-            w["fms/cmd/bank-rad"].set_double_value(bank_rad)
+            set_bank(bank_rad)
         if ny is not None:
-            w["fms/cmd/ny"].set_double_value(ny)
+            set_ny(ny)
         if nx is not None:
-            w["fms/cmd/nx"].set_double_value(nx)
-            w["fms/ap/nx-engage"].set_double_value(1.0)
+            set_nx(nx)
+            set_nx_engage(1.0)
         if throttle is not None:
-            w["fms/cmd/throttle"].set_double_value(throttle)
-            w["fms/ap/nx-engage"].set_double_value(0.0)
+            set_thr(throttle)
+            set_nx_engage(0.0)
 
     # -- stepping and state ----------------------------------------------------------------
     def run(self, n_steps: int = 1) -> bool:

@@ -19,16 +19,16 @@ class NavigationSource(Protocol):
         ...
 
 
+_NO_ERRORS: dict[str, float] = {}  # shared; nobody writes into a solution's errors
+
+
 class TruthNavigation:
     """Navigation solution equal to truth (no navigation-system error)."""
 
     def update(self, truth: AircraftState) -> NavSolution:
         """Return the truth as the navigation solution."""
-        return NavSolution(
-            t_s=truth.t_s, lat_rad=truth.lat_rad, lon_rad=truth.lon_rad, alt_m=truth.alt_m,
-            v_enu_mps=truth.v_enu_mps, roll_rad=truth.roll_rad, pitch_rad=truth.pitch_rad,
-            heading_rad=truth.heading_rad,
-        )
+        return NavSolution(truth.t_s, truth.lat_rad, truth.lon_rad, truth.alt_m, truth.v_enu_mps,
+                           truth.roll_rad, truth.pitch_rad, truth.heading_rad, _NO_ERRORS)
 
 
 def make_source(spec: dict | None, seed: int | None = None) -> NavigationSource:

@@ -127,23 +127,35 @@ def _apply(ev: Event, tg: _Targets) -> None:
         tg.speed_kind, tg.speed_mps, tg.vertical = kind, spd, True
 
 
-def _divergence(s: AircraftState, cfg: AircraftConfig, wow: float) -> str | None:
-    lim = cfg.limits
-    if not math.isfinite(s.alt_m + s.tas_mps + s.roll_rad + s.pitch_rad + s.alpha_rad + s.ny):
-        return "non-finite state (JSBSim diverged)"
-    if s.agl_m < 1.0 or wow > 0.5:
-        return f"ground contact at t={s.t_s:.1f} s"
-    if math.degrees(s.alpha_rad) > lim.stall_alpha_deg:
-        return (f"stall: alpha {math.degrees(s.alpha_rad):.1f} deg > {lim.stall_alpha_deg} deg "
-                f"at t={s.t_s:.1f} s")
-    if s.cas_mps > lim.cas_max_mps * 1.1:
-        return (f"overspeed: CAS {s.cas_mps / 0.514444:.0f} kt > 1.1 x VMO "
-                f"{lim.cas_max_mps / 0.514444:.0f} kt at t={s.t_s:.1f} s")
-    if s.mach > lim.mach_max + 0.05:
-        return f"overspeed: Mach {s.mach:.3f} > MMO + 0.05 at t={s.t_s:.1f} s"
-    if abs(s.roll_rad) > math.radians(75) or abs(s.pitch_rad) > math.radians(45):
-        return f"upset: roll {math.degrees(s.roll_rad):.0f} deg, pitch {math.degrees(s.pitch_rad):.0f} deg"
-    return None
+class _Divergence:
+    """The run-ending checks, with the aircraft's limits converted once (SI, rad)."""
+
+    def __init__(self, cfg: AircraftConfig):
+        lim = cfg.limits
+        self.stall_alpha_deg = lim.stall_alpha_deg
+        self.stall_rad = math.radians(lim.stall_alpha_deg)
+        self.cas_max_mps = lim.cas_max_mps
+        self.mach_max = lim.mach_max
+        self.roll_max_rad, self.pitch_max_rad = math.radians(75), math.radians(45)
+
+    def __call__(self, s: AircraftState, wow: float) -> str | None:
+        """None while the flight is sound, else the reason it must end."""
+        if not math.isfinite(s.alt_m + s.tas_mps + s.roll_rad + s.pitch_rad + s.alpha_rad + s.ny):
+            return "non-finite state (JSBSim diverged)"
+        if s.agl_m < 1.0 or wow > 0.5:
+            return f"ground contact at t={s.t_s:.1f} s"
+        if s.alpha_rad > self.stall_rad:
+            return (f"stall: alpha {math.degrees(s.alpha_rad):.1f} deg > {self.stall_alpha_deg} deg "
+                    f"at t={s.t_s:.1f} s")
+        if s.cas_mps > self.cas_max_mps * 1.1:
+            return (f"overspeed: CAS {s.cas_mps / 0.514444:.0f} kt > 1.1 x VMO "
+                    f"{self.cas_max_mps / 0.514444:.0f} kt at t={s.t_s:.1f} s")
+        if s.mach > self.mach_max + 0.05:
+            return f"overspeed: Mach {s.mach:.3f} > MMO + 0.05 at t={s.t_s:.1f} s"
+        if abs(s.roll_rad) > self.roll_max_rad or abs(s.pitch_rad) > self.pitch_max_rad:
+            return (f"upset: roll {math.degrees(s.roll_rad):.0f} deg, "
+                    f"pitch {math.degrees(s.pitch_rad):.0f} deg")
+        return None
 
 
 class _NavHold:
@@ -296,13 +308,14 @@ class Flight:
         wind_nodes = [pm.get_node(f"atmosphere/wind-{c}-fps", False)
                       for c in ("north", "east", "down")]
         i_wow = RAW["wow"]
+        diverged = _Divergence(cfg)
         last_bank = 0.0
         law_engaged = False
         cmd_nx = cmd_ny = nan = float("nan")
         raw = ac.read_raw()
         for k in range(n_total + 1):
             s = ac.state(raw)
-            why = _divergence(s, cfg, raw[i_wow])
+            why = diverged(s, raw[i_wow])
             if why:
                 self.status, self.reason = "diverged", why
                 return
