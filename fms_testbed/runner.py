@@ -1,7 +1,8 @@
 """Fly a scenario: trim, then the closed loop JSBSim → navigation → guidance/laws → inner loops.
 
-Rates: JSBSim and the inner loops at 120 Hz (inside JSBSim); navigation, guidance, heading hold and
-the vertical law at ``outer_rate_hz`` (default 10 Hz); logging at ``log_rate_hz`` (default 10 Hz).
+Rates: JSBSim at 120 Hz, the inner loops inside it every ``inner_loops.frames_per_update`` frames
+(aircraft file, default 60 Hz); navigation, guidance, heading hold and the vertical law at
+``outer_rate_hz`` (default 10 Hz); logging at ``log_rate_hz`` (default 10 Hz).
 
 A run ends with a status: ``ok`` (duration flown or guidance finished) or ``diverged`` with a
 reason (non-finite state, ground contact, stall, overspeed) — never a hang or a bare traceback.
@@ -10,9 +11,9 @@ reason (non-finite state, ground contact, stall, overspeed) — never a hang or 
 from __future__ import annotations
 
 import json
-from array import array
 import logging
 import math
+from array import array
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
