@@ -81,7 +81,10 @@ def plot_time_histories(df: pd.DataFrame, summary: dict, path: Path) -> Path:
     ax2.plot(t, df["vs_mps"], color="tab:gray", lw=0.8, label="vertical speed")
     ax2.set_ylabel("vertical speed, m/s", color="tab:gray")
     ax.set_ylabel("speed, km/h")
-    ax.legend(fontsize=8, loc="upper left")
+    # one legend for both axes, on the twin axis so the vertical-speed curve cannot cross it
+    h1, l1 = ax.get_legend_handles_labels()
+    h2, l2 = ax2.get_legend_handles_labels()
+    ax2.legend(h1 + h2, l1 + l2, fontsize=8, loc="best", framealpha=0.9)
     ax = axs[2]
     ax.plot(t, df["roll_deg"], label="roll")
     ax.plot(t, df["cmd_bank_deg"], "--", label="bank command")
