@@ -39,6 +39,8 @@ def _write(tmp_path, mutate):
     (lambda r: r["inner_loops"]["ny"].update(kq=1.0), "inner_loops.ny.kq"),
     (lambda r: r["limits"].update(cas_min_mps="fast"), "limits.cas_min_mps"),
     (lambda r: r.pop("jsbsim_model"), "jsbsim_model"),
+    (lambda r: r["inner_loops"].update(frames_per_update=0), "inner_loops.frames_per_update"),
+    (lambda r: r["inner_loops"].update(frames_per_update=1.5), "inner_loops.frames_per_update"),
 ])
 def test_bad_config_names_file_and_field(tmp_path, mutate, field):
     p = _write(tmp_path, mutate)
