@@ -75,3 +75,26 @@ def test_star_descent_never_climbs_after_its_last_constraint(tmp_path):
     alt = p.profile.alt_m
     assert all(b <= a + 1e-6 for a, b in zip(alt[:-1], alt[1:])), alt
     assert alt[2] == pytest.approx(9000 * FT) and alt[-1] == pytest.approx(9000 * FT)
+
+
+def test_a_flight_climb_top_replaces_the_transition_altitude_level_off():
+    """plan_profile(climb_top_m=...) levels a SID at the flight's climb top (raised to a higher
+    climb constraint), where the database check levels at 18,000 ft; 'at or above' windows
+    below the top no longer make the plan level at them."""
+    import yaml
+
+    from fms_testbed.arinc424.profile import plan_profile
+    from fms_testbed.fly import prepare
+    from fms_testbed.paths import scenarios_dir
+
+    raw = yaml.safe_load((scenarios_dir() / "demo-sid.yaml").read_text())
+    _, spec, fp, _ = prepare(raw, "demo-sid.yaml")
+    path = fp.path
+    grad = 0.07
+    check = plan_profile(path, grad, path.legs[0].start.alt_m)
+    flight = plan_profile(path, grad, path.legs[0].start.alt_m, climb_top_m=4572.0)
+    assert max(check.alt_m) == pytest.approx(18000 * 0.3048)
+    assert max(flight.alt_m) == pytest.approx(4572.0)
+    assert all(b >= a - 1e-9 for a, b in zip(flight.alt_m, flight.alt_m[1:]))   # climbs only
+    assert fp.path.profile is not None and max(fp.path.profile.alt_m) == pytest.approx(
+        spec.climb_top_ft * 0.3048)

@@ -89,7 +89,8 @@ def leg_end_distances(path: ProcedurePath) -> np.ndarray:
 
 
 def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
-                 descent_angle_deg: float = 3.0) -> VerticalProfile:
+                 descent_angle_deg: float = 3.0, climb_top_m: float | None = None
+                 ) -> VerticalProfile:
     """Plan the vertical profile of a built path.
 
     Parameters
@@ -98,6 +99,10 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     climb_gradient : planned climb gradient (rise over run) for climb phases
     start_alt_m : altitude at the path start, m
     descent_angle_deg : default descent path angle where no vertical angle is coded, deg
+    climb_top_m : where a climb levels off, m (raised to the highest climb constraint ahead);
+        None: the highest climb constraint ahead, else the coded transition altitude, else
+        18,000 ft (the database check). A flight passes its own climb top so that the planned
+        profile and the flown climb level at the same altitude.
     """
     n = len(path.legs)
     ends = leg_end_distances(path)
@@ -168,7 +173,10 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
                 top = max(top, hi_at[k])
             elif lo_at[k] is not None:
                 top = max(top, lo_at[k])
-        level = top if np.isfinite(top) else (trans if trans else 18000 * 0.3048)
+        if climb_top_m is not None:
+            level = max(top, climb_top_m)
+        else:
+            level = top if np.isfinite(top) else (trans if trans else 18000 * 0.3048)
         cap[k] = min(run, level)
     for k in range(1, n + 1):
         if climb[k]:

@@ -211,7 +211,8 @@ def _finish(path, seq, spec, cfg, perf, params, offset: int) -> FlyablePath:
     checked = check_path(path, perf, params)
     if checked.legs:
         grad = perf.climb_gradient_at(perf.tas_plan_mps)
-        prof = plan_profile(checked, grad, checked.legs[0].start.alt_m)
+        prof = plan_profile(checked, grad, checked.legs[0].start.alt_m,
+                            climb_top_m=spec.climb_top_ft * FT_M)
         checked = replace(checked, profile=prof)
     return FlyablePath(checked, seq, offset, _rnp(seq, spec, 0))
 
