@@ -41,6 +41,7 @@ SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s"
 RAD2DPH = 180.0 / math.pi * 3600.0
 RAD2DEG = 180.0 / math.pi
 MPS2_TO_UG = 1e6 / G0_MPS2
+NOISE_BLOCK = 256   # navigation steps of process noise drawn at once
 
 
 @njit(cache=True)
@@ -96,6 +97,10 @@ class SinsNavigation:
         self.seed = int(seed)
         self.rng = np.random.default_rng(self.seed)
         self._z0 = np.sqrt(imu.p0_var) * self.rng.standard_normal(imu.p0_var.size)
+        # process noise drawn NOISE_BLOCK steps at a time: numpy's Generator fills a block in
+        # the order of successive draws, so the numbers are those of one draw per step
+        self._noise = np.empty((0, imu.p0_var.size))
+        self._noise_i = 0
         self.x = self._z0.copy()          # mapped through the alignment at the first update
         self._prev: AircraftState | None = None
         self._gains: tuple[float, float] | None = None       # baro gains, set at the first step
@@ -137,7 +142,11 @@ class SinsNavigation:
         return cls(imu, seed=sd, opts=opts, dt_s=dt_s, matrices_dt_s=matrices_dt_s)
 
     def _propagate(self, prev: AircraftState, dt: float) -> None:
-        noise = self.rng.standard_normal(self.x.size)
+        if self._noise_i >= len(self._noise):
+            self._noise = self.rng.standard_normal((NOISE_BLOCK, self.x.size))
+            self._noise_i = 0
+        noise = self._noise[self._noise_i]
+        self._noise_i += 1
         held = self._held
         if (held is not None and abs(held[1] - dt) <= 1e-6 * dt
                 and prev.t_s - held[0] < self.matrices_dt_s - 1e-9):
