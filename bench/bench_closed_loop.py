@@ -1,7 +1,7 @@
 """Closed-loop speed over bare JSBSim speed, same aircraft, same process (issue 2 goal >= 0.7).
 
 Bare: ``fdm.run()`` on the sanitised model at 120 Hz, trimmed, controls untouched, no Python
-work per frame. Closed loop: the testbed's :class:`~fms_testbed.runner.Flight` flying a scenario
+work per frame. Closed loop: the testbed's :class:`~fms_testbed.loop.flight.Flight` flying a scenario
 (turns, a level change) with every inner loop active (JSBSim system), heading hold and the coupled
 law in Python at the default outer rate (10 Hz), logging at 10 Hz.
 
@@ -24,10 +24,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from interleave import CHUNK_S, interleaved_ratio  # noqa: E402
 
-from fms_testbed.aircraft import load_aircraft  # noqa: E402
-from fms_testbed.jsbsim_core import DT_S  # noqa: E402
-from fms_testbed.runner import Flight, run_scenario  # noqa: E402
-from fms_testbed.scenario import parse_scenario  # noqa: E402
+from fms_testbed.config.aircraft import load_aircraft  # noqa: E402
+from fms_testbed.sim.jsbsim_core import DT_S  # noqa: E402
+from fms_testbed.loop.flight import Flight  # noqa: E402
+from fms_testbed.run import run_scenario  # noqa: E402
+from fms_testbed.config.scenario import parse_scenario  # noqa: E402
 
 def bench_scenario(aircraft: str, alt_m: float, tas_mps: float, sim_s: float) -> dict:
     """The benchmark flight: hold, a heading change, a 300 m climb, a heading change back."""

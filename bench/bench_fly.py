@@ -23,18 +23,18 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from interleave import interleaved_ratio  # noqa: E402
 
-from fms_testbed.aircraft import load_aircraft  # noqa: E402
-from fms_testbed.paths import scenarios_dir  # noqa: E402
+from fms_testbed.config.aircraft import load_aircraft  # noqa: E402
+from fms_testbed.data import scenarios_dir  # noqa: E402
 
 
 def procedure_ratio(sim_s: float, rate_hz: float) -> tuple[dict, float, float]:
     """(interleaved timing of the procedure flight, path build time s, µs per guidance call)."""
     import yaml
 
-    from fms_testbed.fly import prepare, runner_log_every
+    from fms_testbed.loop.procedure import prepare, runner_log_every
     from fms_testbed.guidance.fms import ProcedureGuidance
     from fms_testbed.guidance.vertical import procedure_law
-    from fms_testbed.runner import Flight
+    from fms_testbed.loop.flight import Flight
 
     raw = yaml.safe_load((scenarios_dir() / "demo-sid.yaml").read_text())
     raw["duration_s"] = sim_s
@@ -64,8 +64,8 @@ def procedure_ratio(sim_s: float, rate_hz: float) -> tuple[dict, float, float]:
 def runner_only_ratio(sim_s: float, rate_hz: float) -> dict:
     """The runner alone at the same rate (coupled law holding the trimmed state, no guidance),
     interleaved: the share of the slowdown that is not guidance."""
-    from fms_testbed.runner import Flight
-    from fms_testbed.scenario import parse_scenario
+    from fms_testbed.loop.flight import Flight
+    from fms_testbed.config.scenario import parse_scenario
 
     cfg = load_aircraft("737")
     scn = {"name": "bench", "aircraft": "737", "duration_s": sim_s, "hold": True,

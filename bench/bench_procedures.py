@@ -13,8 +13,8 @@ import argparse
 import time
 from pathlib import Path
 
-from fms_testbed.arinc424.check import check_airport, perf_for
-from fms_testbed.arinc424.database import load_database
+from fms_testbed.evaluation.check import check_airport, perf_for
+from fms_testbed.procedures.database import load_database
 
 DEFAULT = Path(__file__).resolve().parents[1].parent / "shared/data/cifp/FAACIFP18_230126"
 

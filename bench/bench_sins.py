@@ -23,10 +23,10 @@ import time
 
 import numpy as np
 
-from fms_testbed.sins.analysis import SinsOptions, montecarlo_run, system_matrix
-from fms_testbed.sins.discretize import discretize, discretize_sins, picard_order_used
-from fms_testbed.sins.presets import load_imu
-from fms_testbed.sins.trajectory import straight_level
+from fms_testbed.sensors.sins.analysis import SinsOptions, montecarlo_run, system_matrix
+from fms_testbed.sensors.sins.discretize import discretize, discretize_sins, picard_order_used
+from fms_testbed.sensors.sins.presets import load_imu
+from fms_testbed.sensors.sins.trajectory import straight_level
 
 
 def _flight_F(imu):
@@ -44,7 +44,7 @@ def _per_call_us(fn, n):
 
 def bench_discretisation(imu, rounds: int = 7, n: int = 300) -> dict:
     """Median µs per call of each method, interleaved rounds, plus accuracy against Van Loan."""
-    from fms_testbed.sins._blas import single_thread_blas
+    from fms_testbed.sensors.sins._blas import single_thread_blas
 
     F = _flight_F(imu)
     q = imu.q_psd
@@ -83,13 +83,13 @@ def _bare_fdm_trimmed():
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from interleave import trimmed_bare_fdm
 
-    from fms_testbed.aircraft import load_aircraft
+    from fms_testbed.config.aircraft import load_aircraft
 
     return trimmed_bare_fdm(load_aircraft("737"), 3000.0, 120.0)
 
 
 def _states(n: int):
-    from fms_testbed.state import AircraftState
+    from fms_testbed.core.state import AircraftState
 
     tr = straight_level(n * 0.1 + 1, 0.1, speed_mps=200.0, heading_deg=30.0)
     f = float        # JSBSim reads give Python floats; numpy scalars would slow the maths
@@ -105,7 +105,7 @@ def _states(n: int):
 
 def bench_nav_step(imu_name: str, with_jsbsim: bool, n: int = 1000, rounds: int = 5) -> dict:
     """Median (over interleaved rounds) µs per SinsNavigation.update and per 12 JSBSim steps."""
-    from fms_testbed.sins.navigation import SinsNavigation
+    from fms_testbed.navigation.sins import SinsNavigation
 
     states = _states(n)
     variants = {"picard": {"method": "picard"}, "vanloan": {"method": "vanloan"},
@@ -146,9 +146,9 @@ def bench_closed_loop(sim_s: float, imu_name: str) -> dict:
     sys.path.insert(0, str(Path(__file__).resolve().parent))
     from interleave import interleaved_ratio
 
-    from fms_testbed.aircraft import load_aircraft
-    from fms_testbed.runner import Flight
-    from fms_testbed.scenario import parse_scenario
+    from fms_testbed.config.aircraft import load_aircraft
+    from fms_testbed.loop.flight import Flight
+    from fms_testbed.config.scenario import parse_scenario
 
     cfg = load_aircraft("737")
 

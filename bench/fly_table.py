@@ -101,9 +101,10 @@ def main() -> None:
     ap.add_argument("--out", default="results/fly_table", help="folder for table.json")
     args = ap.parse_args()
     logging.basicConfig(level=logging.WARNING)
-    from fms_testbed.arinc424.database import load_database
-    from fms_testbed.errors import UserError
-    from fms_testbed.fly import fly_procedure, prepare
+    from fms_testbed.procedures.database import load_database
+    from fms_testbed.core.errors import UserError
+    from fms_testbed.loop.procedure import prepare
+from fms_testbed.run import fly_procedure
 
     db = load_database(args.db)
     specs = [s for a in AIRPORTS for s in pick(db, a)][:args.max]

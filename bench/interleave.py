@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 import time
 
-from fms_testbed.jsbsim_core import DT_S, FT, KT, bare_fdm
+from fms_testbed.sim.jsbsim_core import DT_S, FT, KT, bare_fdm
 
 CHUNK_S = 10.0
 
@@ -37,7 +37,7 @@ def trimmed_bare_fdm(cfg, alt_m: float, tas_mps: float):
 
 
 def interleaved_ratio(flight, cfg, chunk_s: float = CHUNK_S) -> dict:
-    """Fly ``flight`` (a :class:`fms_testbed.runner.Flight`, loaded and trimmed) to its end,
+    """Fly ``flight`` (a :class:`fms_testbed.loop.flight.Flight`, loaded and trimmed) to its end,
     alternating with a bare instance of the same aircraft every ``chunk_s`` simulated seconds.
 
     Returns ``{"ratio", "bare_fps", "closed_fps", "summary", "df"}`` (frames per wall second).

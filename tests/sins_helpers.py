@@ -2,8 +2,8 @@
 
 import numpy as np
 
-from fms_testbed.sins.analysis import SinsOptions, system_matrix
-from fms_testbed.sins.presets import load_imu
+from fms_testbed.sensors.sins.analysis import SinsOptions, system_matrix
+from fms_testbed.sensors.sins.presets import load_imu
 
 
 def flight_F(imu_name: str = "STIM300", vertical: str = "free"):

@@ -5,9 +5,9 @@ from __future__ import annotations
 import pytest
 import yaml
 
-from fms_testbed.aircraft import list_aircraft, load_aircraft, load_aircraft_file
-from fms_testbed.errors import ConfigError
-from fms_testbed.paths import aircraft_dir
+from fms_testbed.config.aircraft import list_aircraft, load_aircraft, load_aircraft_file
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.data import aircraft_dir
 
 SHIPPED = list_aircraft()
 

@@ -7,12 +7,12 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from fms_testbed.arinc424.check import check_database, invariants, perf_for
-from fms_testbed.arinc424.database import load_database
-from fms_testbed.arinc424.geojson import to_feature_collection
-from fms_testbed.arinc424.legrecord import PATH_TERMINATORS
-from fms_testbed.arinc424.monitor import check_path
-from fms_testbed.arinc424.segmentation import build_sequence
+from fms_testbed.evaluation.check import check_database, invariants, perf_for
+from fms_testbed.procedures.database import load_database
+from fms_testbed.viz.geojson import to_feature_collection
+from fms_testbed.procedures.legrecord import PATH_TERMINATORS
+from fms_testbed.path.monitor import check_path
+from fms_testbed.path.segmentation import build_sequence
 from fms_testbed.cli import main
 
 CIFP = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "cifp" / "FAACIFP18_230126"

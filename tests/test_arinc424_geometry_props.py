@@ -5,13 +5,14 @@ anticipation), RF radius and turn direction as coded, fly-by turns turn the shor
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from fms_testbed.arinc424.check import invariants
-from fms_testbed.arinc424.database import load_database
-from fms_testbed.arinc424.monitor import check_path
-from fms_testbed.arinc424.segmentation import build_sequence
-from fms_testbed.arinc424.synth import (airport_record, leg_record, offset, waypoint_record,
+from fms_testbed.evaluation.check import invariants
+from fms_testbed.procedures.database import load_database
+from fms_testbed.path.monitor import check_path
+from fms_testbed.path.segmentation import build_sequence
+from fms_testbed.procedures.synth import (airport_record, leg_record, offset, waypoint_record,
                                         write_file)
-from fms_testbed.path import Arc, inverse, wrap180
+from fms_testbed.core.segments import Arc
+from fms_testbed.core.geodesy import inverse, wrap180
 from tests.test_arinc424_world import PARAMS, PERF
 
 SETTINGS = settings(max_examples=40, deadline=None,

@@ -4,13 +4,14 @@ import math
 
 import pytest
 
-from fms_testbed.arinc424.construct import _foot
-from fms_testbed.arinc424.legs import LEG_TYPES
-from fms_testbed.arinc424.legrecord import PATH_TERMINATORS
-from fms_testbed.arinc424.model import isa_tas_mps, turn_radius_m
-from fms_testbed.arinc424.synth import leg_record as L
-from fms_testbed.arinc424.synth import offset, waypoint_record
-from fms_testbed.path import Arc, gravity_mps2, inverse
+from fms_testbed.legs.construct import _foot
+from fms_testbed.legs.types import LEG_TYPES
+from fms_testbed.procedures.legrecord import PATH_TERMINATORS
+from fms_testbed.legs.model import isa_tas_mps, turn_radius_m
+from fms_testbed.procedures.synth import leg_record as L
+from fms_testbed.procedures.synth import offset, waypoint_record
+from fms_testbed.core.segments import Arc
+from fms_testbed.core.geodesy import gravity_mps2, inverse
 from tests.test_arinc424_world import APT, PARAMS, PERF, build, world
 
 FT = 0.3048
@@ -269,7 +270,7 @@ def test_fix_leg_reached_from_elsewhere_turns_the_coded_way_to_its_fix(tmp_path)
                              alt1_ft=9000)])
     first = [s for s in arcs(p, "turn") if s.leg_index == 1][0].geom
     assert first.turn == "L"
-    from fms_testbed.arinc424.check import leg_turn_mismatches
+    from fms_testbed.evaluation.check import leg_turn_mismatches
     assert leg_turn_mismatches(p) == 0
 
 

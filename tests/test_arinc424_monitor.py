@@ -5,8 +5,8 @@ import dataclasses
 
 import pytest
 
-from fms_testbed.arinc424.synth import leg_record as L
-from fms_testbed.arinc424.synth import offset, waypoint_record
+from fms_testbed.procedures.synth import leg_record as L
+from fms_testbed.procedures.synth import offset, waypoint_record
 from tests.test_arinc424_world import PERF, build, world
 
 NM = 1852.0

@@ -6,11 +6,11 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fms_testbed.arinc424.database import load_database
-from fms_testbed.arinc424.legrecord import parse_leg
-from fms_testbed.arinc424.records import RecordError, parse_lat
-from fms_testbed.errors import UserError
-from fms_testbed.paths import procedures_dir
+from fms_testbed.procedures.database import load_database
+from fms_testbed.procedures.legrecord import parse_leg
+from fms_testbed.procedures.records import RecordError, parse_lat
+from fms_testbed.core.errors import UserError
+from fms_testbed.data import procedures_dir
 
 EXCERPT = procedures_dir() / "cifp_excerpt.dat"
 # Real records from the FAA CIFP 2301 (public domain).

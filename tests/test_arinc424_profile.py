@@ -5,9 +5,9 @@ import math
 
 import pytest
 
-from fms_testbed.arinc424.profile import window
-from fms_testbed.arinc424.synth import leg_record as L
-from fms_testbed.arinc424.synth import offset, waypoint_record
+from fms_testbed.path.profile import window
+from fms_testbed.procedures.synth import leg_record as L
+from fms_testbed.procedures.synth import offset, waypoint_record
 from tests.test_arinc424_world import APT, PERF, build, world
 
 FT = 0.3048
@@ -83,9 +83,9 @@ def test_a_flight_climb_top_replaces_the_transition_altitude_level_off():
     below the top no longer make the plan level at them."""
     import yaml
 
-    from fms_testbed.arinc424.profile import plan_profile
-    from fms_testbed.fly import prepare
-    from fms_testbed.paths import scenarios_dir
+    from fms_testbed.path.profile import plan_profile
+    from fms_testbed.loop.procedure import prepare
+    from fms_testbed.data import scenarios_dir
 
     raw = yaml.safe_load((scenarios_dir() / "demo-sid.yaml").read_text())
     _, spec, fp, _ = prepare(raw, "demo-sid.yaml")

@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from fms_testbed.arinc424.database import load_database
-from fms_testbed.arinc424.model import BuildParams, Performance
-from fms_testbed.arinc424.monitor import check_path
-from fms_testbed.arinc424.segmentation import build_sequence
-from fms_testbed.arinc424.synth import (airport_record, offset, runway_record, vor_record,
+from fms_testbed.procedures.database import load_database
+from fms_testbed.legs.model import BuildParams, Performance
+from fms_testbed.path.monitor import check_path
+from fms_testbed.path.segmentation import build_sequence
+from fms_testbed.procedures.synth import (airport_record, offset, runway_record, vor_record,
                                         waypoint_record, write_file)
 
 APT = (50.0, 10.0)

@@ -2,7 +2,7 @@
 
 import pytest
 
-from fms_testbed.atmosphere import cas_to_tas, isa, tas_to_cas
+from fms_testbed.core.atmosphere import cas_to_tas, isa, tas_to_cas
 
 
 def test_isa_table_values():

@@ -10,11 +10,11 @@ import math
 
 import pytest
 
-from fms_testbed.aircraft import list_aircraft, load_aircraft
-from fms_testbed.control.compare import pure_second_order_settling_s
+from fms_testbed.config.aircraft import list_aircraft, load_aircraft
+from fms_testbed.evaluation.law_comparison import pure_second_order_settling_s
 from fms_testbed.control.coupled_law import params_from_config
 from fms_testbed.control.metrics import step_metrics
-from fms_testbed.runner import run_scenario
+from fms_testbed.run import run_scenario
 
 def _overshoot_pct(xi: float) -> float:
     """Overshoot of the pure second order, % (0 for ξ ≥ 1)."""
@@ -92,7 +92,7 @@ def _steep_descent(protect: bool):
     scn = {"name": "steep-descent", "aircraft": "737", "duration_s": 200.0, "hold": True,
            "initial": {"alt_m": 5000.0, "tas_kmh": 450.0, "lat_deg": 47.0, "heading_deg": 90.0},
            "events": [{"t_s": 5, "alt_m": 3000.0}]}
-    r = run_scenario(scn, plots=False, overrides={"vertical_law_instance": CoupledLaw(params=p)})
+    r = run_scenario(scn, plots=False, vertical_law=CoupledLaw(params=p))
     assert r.summary["status"] == "ok", r.summary["reason"]
     return r.df
 

@@ -9,11 +9,11 @@ import pandas as pd
 import pytest
 import yaml
 
-from fms_testbed.aircraft import AircraftConfig, CoupledLawGains, load_aircraft_file
+from fms_testbed.config.aircraft import AircraftConfig, CoupledLawGains, load_aircraft_file
 from fms_testbed.cli import main
 from fms_testbed.control.coupled_law import CoupledLawParams
-from fms_testbed.control.tuning import gains_yaml, write_gains_to_config
-from fms_testbed.paths import aircraft_dir, scenarios_dir
+from fms_testbed.evaluation.law_tuning import gains_yaml, write_gains_to_config
+from fms_testbed.data import aircraft_dir, scenarios_dir
 
 
 def test_compare_prints_the_table_checks_goals_and_writes_plots(tmp_path, capsys):

@@ -8,13 +8,13 @@ import inspect
 
 import pytest
 
-MODULES = ["coupled_law", "baselines", "pointmass", "linear", "metrics", "tuning", "compare",
-           "plots"]
+MODULES = ["control.coupled_law", "control.baselines", "control.pointmass", "control.linear",
+           "control.metrics", "evaluation.law_tuning", "evaluation.law_comparison", "viz.control"]
 
 
 @pytest.mark.parametrize("name", MODULES)
 def test_public_functions_document_every_parameter(name):
-    mod = importlib.import_module(f"fms_testbed.control.{name}")
+    mod = importlib.import_module(f"fms_testbed.{name}")
     missing = []
     for fname, obj in vars(mod).items():
         if fname.startswith("_") or not callable(obj) or getattr(obj, "__module__", "") != mod.__name__:

@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fms_testbed.aircraft import load_aircraft
+from fms_testbed.config.aircraft import load_aircraft
 from fms_testbed.control import VERTICAL_LAWS, CoupledLaw, CoupledLawParams
 from fms_testbed.control.coupled_law import gravity_ratio, params_from_config
 from fms_testbed.control.pointmass import (CommandEvent, PointMassParams, make_state,

@@ -7,10 +7,10 @@ import json
 import pytest
 
 from fms_testbed.cli import main
-from fms_testbed.cli_fly import parse_wind
-from fms_testbed.errors import ConfigError, UserError
-from fms_testbed.fly import prepare
-from fms_testbed.guidance.procedure import parse_procedure
+from fms_testbed.cli.common import parse_wind
+from fms_testbed.core.errors import ConfigError, UserError
+from fms_testbed.loop.procedure import prepare
+from fms_testbed.path.plan import parse_procedure
 
 
 def test_fly_command_writes_summary_timeseries_and_plots(tmp_path, capsys):
@@ -77,7 +77,7 @@ def test_scenario_file_with_wind_flies_the_ground_track(tmp_path):
 def test_sins_navigation_errors_show_in_tse_and_break_rnp_containment(tmp_path):
     """Guidance flies the navigation solution: FTE stays small while TSE follows NSE, and a
     consumer-grade IMU breaks RNP 0.3 containment on this 7-minute approach."""
-    from fms_testbed.fly import fly_procedure
+    from fms_testbed.run import fly_procedure
 
     raw = {"aircraft": "737", "procedure": {"airport": "KBFI", "procedure": "H14RZ",
                                             "transition": "ZUVEN"},
@@ -98,8 +98,8 @@ def test_sins_navigation_errors_show_in_tse_and_break_rnp_containment(tmp_path):
 def test_every_shipped_procedure_scenario_validates_and_builds():
     import yaml
 
-    from fms_testbed.fly import load_procedure_scenario
-    from fms_testbed.paths import scenarios_dir
+    from fms_testbed.loop.procedure import load_procedure_scenario
+    from fms_testbed.data import scenarios_dir
 
     files = [p for p in sorted(scenarios_dir().glob("*.yaml"))
              if "procedure" in (yaml.safe_load(p.read_text()) or {})]

@@ -11,8 +11,9 @@ import math
 import numpy as np
 import pytest
 
-from fms_testbed.arinc424.database import load_database
-from fms_testbed.fly import fly_procedure, prepare
+from fms_testbed.procedures.database import load_database
+from fms_testbed.loop.procedure import prepare
+from fms_testbed.run import fly_procedure
 
 NM = 1852.0
 
@@ -158,7 +159,7 @@ def test_an_impossible_speed_ends_the_flight_with_a_clear_status(db, tmp_path):
     the reason — no hang, no exception."""
     import yaml
 
-    from fms_testbed.paths import aircraft_dir
+    from fms_testbed.data import aircraft_dir
 
     raw = yaml.safe_load((aircraft_dir() / "737.yaml").read_text())
     raw["name"] = "737-slow"
@@ -179,7 +180,7 @@ def test_an_impossible_speed_ends_the_flight_with_a_clear_status(db, tmp_path):
 def test_fly_over_fix_is_overflown_not_cut(db):
     """DEEZZ5 RW31L: YNKEE is a fly-over fix (waypoint description 'Y'): the aircraft passes
     over it, unlike a fly-by fix whose corner is cut by the turn anticipation."""
-    from fms_testbed.flight_errors import _dist_m
+    from fms_testbed.evaluation.flight_errors import _dist_m
 
     res, fp = flown(db, "KJFK", "DEEZZ5", runway="31L", transition="CANDR")
     df = res.df
@@ -211,7 +212,7 @@ def test_df_after_the_end_of_vectors_turns_from_that_point_to_the_fix(db):
 def test_vr_leg_ends_when_the_radial_is_crossed(db):
     """KDLS DALLS1 RW13 starts with VR (heading to a radial): the leg ends in flight when the
     aircraft's bearing from the navaid crosses the coded radial."""
-    from fms_testbed.path import inverse
+    from fms_testbed.core.geodesy import inverse
 
     res, fp = flown(db, "KDLS", "DALLS1", runway="13")
     t = fp.path.legs[0].termination
@@ -240,7 +241,7 @@ def test_ha_hold_is_left_over_the_fix_once_the_altitude_is_reached(db):
     """KENV ENV1 RW08 ends with HA at BVL (hold to 9000 ft): the aircraft climbs faster than the
     plan's gradient, so it leaves the hold over BVL at the end of the first circuit completed
     at the altitude instead of flying every planned circuit."""
-    from fms_testbed.flight_errors import _dist_m
+    from fms_testbed.evaluation.flight_errors import _dist_m
 
     res, fp = flown(db, "KENV", "ENV1", runway="08")
     _completed(res)

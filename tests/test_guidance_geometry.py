@@ -8,7 +8,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fms_testbed.guidance.geometry import CHUNK_M, local_pieces
-from fms_testbed.path import Arc, Line, direct, inverse, project
+from fms_testbed.core.segments import Arc, Line, project
+from fms_testbed.core.geodesy import direct, inverse
 
 
 def _piece_for(pieces, lat, lon):

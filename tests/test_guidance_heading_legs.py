@@ -10,10 +10,10 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from fms_testbed.aircraft import load_aircraft
-from fms_testbed.fly import prepare
+from fms_testbed.config.aircraft import load_aircraft
+from fms_testbed.loop.procedure import prepare
 from fms_testbed.guidance.fms import ProcedureGuidance
-from fms_testbed.path import direct
+from fms_testbed.core.geodesy import direct
 
 
 def _nav(lat, lon, alt, heading_deg, track_deg, gs=118.0, t=1.0):

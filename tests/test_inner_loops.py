@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from fms_testbed.aircraft import list_aircraft, load_aircraft
-from fms_testbed.inner_steps import check_aircraft, specs_for, step_metrics
+from fms_testbed.config.aircraft import list_aircraft, load_aircraft
+from fms_testbed.sim.inner_steps import check_aircraft, specs_for, step_metrics
 
 
 @pytest.mark.parametrize("name", list_aircraft())
@@ -45,8 +45,8 @@ def test_inner_loops_at_60_hz_track_like_120_hz(loop):
     """The default 60 Hz update (JSBSim channel execrate 2) gives the 120 Hz step response: a
     PID or rate limit stepping with the frame time instead of the channel's would not (the n_y and
     n_x loops integrate with ki > 0 on the 737)."""
-    from fms_testbed.inner_steps import step_response
-    from fms_testbed.jsbsim_core import JSBSimAircraft
+    from fms_testbed.sim.inner_steps import step_response
+    from fms_testbed.sim.jsbsim_core import JSBSimAircraft
 
     cfg = load_aircraft("737")
     assert cfg.inner_loops.frames_per_update == 2
@@ -64,8 +64,8 @@ def test_inner_loops_at_60_hz_track_like_120_hz(loop):
 def test_doubling_the_pid_step_would_be_caught():
     """Counter-check of the test above: halving ki (what a wrong integrator step does) moves the
     n_x response by more than the 5 % tolerance."""
-    from fms_testbed.inner_steps import replace_gains, step_response
-    from fms_testbed.jsbsim_core import JSBSimAircraft
+    from fms_testbed.sim.inner_steps import replace_gains, step_response
+    from fms_testbed.sim.jsbsim_core import JSBSimAircraft
 
     cfg = load_aircraft("737")
     spec = next(s for s in specs_for(cfg) if s.loop == "nx")

@@ -5,7 +5,7 @@ from geographiclib.geodesic import Geodesic
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fms_testbed.path import direct, gravity_mps2, inverse
+from fms_testbed.core.geodesy import direct, gravity_mps2, inverse
 
 G = Geodesic.WGS84
 

@@ -7,7 +7,8 @@ from geographiclib.geodesic import Geodesic
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fms_testbed.path import Arc, Line, direct, inverse, project, turn_angle_deg
+from fms_testbed.core.segments import Arc, Line, project, turn_angle_deg
+from fms_testbed.core.geodesy import direct, inverse
 
 G = Geodesic.WGS84
 

@@ -9,8 +9,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from fms_testbed.runner import run_scenario
-from fms_testbed.timeseries import COLUMNS
+from fms_testbed.run import run_scenario
+from fms_testbed.core.timeseries import COLUMNS
 
 BASE = {"aircraft": "737", "initial": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 3000,
                                         "tas_kmh": 400, "heading_deg": 90}}
@@ -91,14 +91,14 @@ def test_ground_contact_is_a_divergence():
 def test_cas_target_converted_with_altitude():
     scn = {**BASE, "duration_s": 5, "hold": True, "events": [{"t_s": 1, "cas_kt": 200}]}
     df = run_scenario(scn).df
-    from fms_testbed.atmosphere import cas_to_tas
+    from fms_testbed.core.atmosphere import cas_to_tas
     last = df.iloc[-1]
     assert last["cmd_tas_mps"] == pytest.approx(float(cas_to_tas(200 * 0.514444, last["alt_m"])), rel=1e-4)
 
 
 def test_steady_wind_is_ramped_in_and_then_held():
     """JSBSim trims in calm air; the scenario's wind then ramps in over 20 s and stays."""
-    from fms_testbed.runner import WIND_RAMP_S
+    from fms_testbed.loop.flight import WIND_RAMP_S
 
     scn = {**BASE, "duration_s": 90, "hold": True, "wind": {"from_deg": 0, "speed_kt": 30},
            "events": [{"t_s": 1, "heading_deg": 90}]}
@@ -114,8 +114,8 @@ def test_steady_wind_is_ramped_in_and_then_held():
 def test_flight_stepped_in_pieces_equals_one_run():
     """Flight.step(n) in uneven pieces flies exactly what run() flies (same seed, same rows), and
     result() mid-flight reports what has been flown so far."""
-    from fms_testbed.runner import Flight
-    from fms_testbed.scenario import parse_scenario
+    from fms_testbed.loop.flight import Flight
+    from fms_testbed.config.scenario import parse_scenario
 
     scn = parse_scenario({**BASE, "name": "steps", "duration_s": 40, "hold": True,
                           "events": [{"t_s": 5, "heading_deg": 120}, {"t_s": 10, "alt_m": 3100}]})
@@ -136,9 +136,9 @@ def test_flight_stepped_in_pieces_equals_one_run():
 def test_logged_columns_match_the_state_the_laws_see():
     """The vectorised conversion of the logged raw reads (timeseries.build_frame) gives the same
     values as the per-step AircraftState (jsbsim_core.state): one contract, two code paths."""
-    from fms_testbed.jsbsim_core import _READ, _STATE_ORDER, raw_to_si
-    from fms_testbed.runner import Flight
-    from fms_testbed.scenario import parse_scenario
+    from fms_testbed.sim.jsbsim_core import _READ, _STATE_ORDER, raw_to_si
+    from fms_testbed.loop.flight import Flight
+    from fms_testbed.config.scenario import parse_scenario
 
     assert tuple(_READ)[:len(_STATE_ORDER)] == _STATE_ORDER  # state() unpacks in this order
     f = Flight(parse_scenario({**BASE, "name": "c", "duration_s": 20,

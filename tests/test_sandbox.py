@@ -8,9 +8,9 @@ from pathlib import Path
 
 import jsbsim
 
-from fms_testbed import jsbsim_core
-from fms_testbed.aircraft import load_aircraft
-from fms_testbed.runner import run_scenario
+from fms_testbed.sim import jsbsim_core
+from fms_testbed.config.aircraft import load_aircraft
+from fms_testbed.run import run_scenario
 
 
 def _sockets() -> set[str]:

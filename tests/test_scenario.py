@@ -9,9 +9,9 @@ import textwrap
 
 import pytest
 
-from fms_testbed.errors import ConfigError
-from fms_testbed.paths import scenarios_dir
-from fms_testbed.scenario import KMH, load_scenario
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.data import scenarios_dir
+from fms_testbed.config.scenario import KMH, load_scenario
 
 GOOD = """\
 aircraft: "737"
@@ -84,7 +84,7 @@ def test_shipped_scenarios_validate(path):
     import yaml
 
     if "procedure" in yaml.safe_load(path.read_text()):
-        from fms_testbed.fly import load_procedure_scenario
+        from fms_testbed.loop.procedure import load_procedure_scenario
 
         scn, spec, fp, db = load_procedure_scenario(path)
         assert fp.path.segments

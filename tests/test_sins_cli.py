@@ -7,10 +7,10 @@ import pandas as pd
 import pytest
 
 from fms_testbed.cli import main
-from fms_testbed.errors import UserError
-from fms_testbed.sins.analysis import SinsOptions, covariance_run, horizontal_radius, montecarlo_run
-from fms_testbed.sins.presets import load_imu
-from fms_testbed.sins.trajectory import REQUIRED_COLUMNS, from_dataframe, straight_level
+from fms_testbed.core.errors import UserError
+from fms_testbed.sensors.sins.analysis import SinsOptions, covariance_run, horizontal_radius, montecarlo_run
+from fms_testbed.sensors.sins.presets import load_imu
+from fms_testbed.sensors.sins.trajectory import REQUIRED_COLUMNS, from_dataframe, straight_level
 
 
 def _write_run_dir(tmp_path, drop=()):
@@ -70,7 +70,7 @@ def test_ins_user_errors_exit_2_with_one_line(tmp_path, capsys, args, match):
 def test_missing_columns_are_named(tmp_path):
     run = _write_run_dir(tmp_path, drop=("fx_mps2", "p_dps"))
     with pytest.raises(UserError, match="p_dps, fx_mps2"):
-        from fms_testbed.sins.trajectory import from_run_dir
+        from fms_testbed.sensors.sins.trajectory import from_run_dir
         from_run_dir(run)
 
 

@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from fms_testbed.sins.discretize import (DiscretisationError, discretize, discretize_sins,
+from fms_testbed.sensors.sins.discretize import (DiscretisationError, discretize, discretize_sins,
                                          picard_order_used)
-from fms_testbed.sins.simulate import IndefiniteCovarianceError, factor_psd
+from fms_testbed.sensors.sins.simulate import IndefiniteCovarianceError, factor_psd
 from sins_helpers import flight_F
 
 
@@ -138,7 +138,7 @@ def test_bad_arguments_raise_user_errors():
 
 
 def test_discretize_is_exported_as_a_package_function():
-    import fms_testbed.sins as sins
+    import fms_testbed.sensors.sins as sins
     phi, qk = sins.discretize(np.zeros((1, 1)), np.eye(1), 0.1)
     assert phi[0, 0] == 1.0 and qk[0, 0] == pytest.approx(0.1)
 

@@ -7,8 +7,8 @@ import scipy.linalg
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fms_testbed.sins.euler import euler_errors_to_eps, euler_from_dcm_enu, eps_to_euler_errors
-from fms_testbed.sins.model import dcm_body_to_enu
+from fms_testbed.sensors.sins.euler import euler_errors_to_eps, euler_from_dcm_enu, eps_to_euler_errors
+from fms_testbed.sensors.sins.model import dcm_body_to_enu
 
 
 def _skew(v):

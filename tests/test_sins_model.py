@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import scipy.linalg
 
-from fms_testbed.sins.discretize import discretize
-from fms_testbed.sins.model import (A_M, baro_gains, build_F, dcm_body_to_enu, earth_radii, gravity_up,
+from fms_testbed.sensors.sins.discretize import discretize
+from fms_testbed.sensors.sins.model import (A_M, baro_gains, build_F, dcm_body_to_enu, earth_radii, gravity_up,
                                     mechanisation_rates)
 
 LAT, ALT = 0.82, 3000.0
@@ -193,8 +193,8 @@ def test_white_noise_growth_matches_short_time_formulas():
 
 
 def test_stationary_alignment_nulls_level_and_gyrocompass_rates():
-    from fms_testbed.sins.model import alignment_map, earth_rate_enu
-    from fms_testbed.sins.presets import load_imu
+    from fms_testbed.sensors.sins.model import alignment_map, earth_rate_enu
+    from fms_testbed.sensors.sins.presets import load_imu
 
     imu = load_imu("STIM300")
     lat, c = 0.8, dcm_body_to_enu(0.02, 0.05, 1.2)
@@ -210,7 +210,7 @@ def test_stationary_alignment_nulls_level_and_gyrocompass_rates():
 
 
 def test_aligned_stationary_ins_has_no_bias_schuler_bowl():
-    from fms_testbed.sins.model import alignment_map
+    from fms_testbed.sensors.sins.model import alignment_map
     F, c, g = _stationary_F()
     x0 = np.zeros(33)
     x0[9] = 9.80665e-3                                        # 1 mg east accelerometer bias
@@ -220,8 +220,8 @@ def test_aligned_stationary_ins_has_no_bias_schuler_bowl():
 
 
 def test_noise_mapped_through_G_gives_the_constant_diagonal_Q_of_eq_6_9():
-    from fms_testbed.sins.model import noise_input_matrix
-    from fms_testbed.sins.presets import load_imu
+    from fms_testbed.sensors.sins.model import noise_input_matrix
+    from fms_testbed.sensors.sins.presets import load_imu
 
     q1 = load_imu("STIM300").q_psd                             # densities of η (eq. 6.9 order)
     G = noise_input_matrix(C)

@@ -5,12 +5,12 @@ import math
 import numpy as np
 import pytest
 
-from fms_testbed.errors import ConfigError
+from fms_testbed.core.errors import ConfigError
 from fms_testbed.navigation import make_source
-from fms_testbed.sins.model import earth_radii
-from fms_testbed.sins.navigation import SinsNavigation
-from fms_testbed.sins.trajectory import straight_level
-from fms_testbed.state import AircraftState
+from fms_testbed.sensors.sins.model import earth_radii
+from fms_testbed.navigation.sins import SinsNavigation
+from fms_testbed.sensors.sins.trajectory import straight_level
+from fms_testbed.core.state import AircraftState
 
 
 def _states(duration_s=20.0):
@@ -98,7 +98,7 @@ def test_inline_imu_parameters_are_accepted():
 def test_bad_navigation_blocks_raise_config_errors(spec, match):
     with pytest.raises(Exception, match=match) as e:
         SinsNavigation.from_spec(spec)
-    from fms_testbed.errors import UserError
+    from fms_testbed.core.errors import UserError
     assert isinstance(e.value, UserError)
 
 
@@ -108,7 +108,7 @@ def test_config_error_type_for_unknown_key():
 
 
 def test_euler_errors_in_the_solution_follow_eq_6_10():
-    from fms_testbed.sins.euler import eps_to_euler_errors
+    from fms_testbed.sensors.sins.euler import eps_to_euler_errors
     states = _states(5.0)
     nav = SinsNavigation.from_spec({"source": "sins", "imu": "STIM300", "seed": 4})
     for s in states:
@@ -131,8 +131,8 @@ def test_held_matrices_match_per_step_matrices_on_steady_flight():
 
 
 def test_navigation_realisations_have_the_covariance_of_the_analysis():
-    from fms_testbed.sins.analysis import SinsOptions, covariance_run
-    from fms_testbed.sins.presets import load_imu
+    from fms_testbed.sensors.sins.analysis import SinsOptions, covariance_run
+    from fms_testbed.sensors.sins.presets import load_imu
 
     duration, n_seeds = 10.0, 300
     states = _states(duration)

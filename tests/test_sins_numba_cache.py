@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from fms_testbed.sins._numba_cache import _STAMP, invalidate_if_sources_changed
+from fms_testbed.sensors.sins._numba_cache import _STAMP, invalidate_if_sources_changed
 
 
 def test_cache_cleared_when_a_source_changes_and_kept_otherwise(tmp_path):

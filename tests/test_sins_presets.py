@@ -4,8 +4,8 @@ import math
 
 import pytest
 
-from fms_testbed.errors import ConfigError
-from fms_testbed.sins.presets import list_presets, load_imu, load_imu_spec
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.sensors.sins.presets import list_presets, load_imu, load_imu_spec
 
 DEG_H = math.pi / 180 / 3600
 

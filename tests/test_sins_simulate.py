@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from fms_testbed.sins.discretize import discretize
-from fms_testbed.sins.simulate import IndefiniteCovarianceError, factor_psd, simulate_lti
+from fms_testbed.sensors.sins.discretize import discretize
+from fms_testbed.sensors.sins.simulate import IndefiniteCovarianceError, factor_psd, simulate_lti
 from sins_helpers import flight_F
 
 
@@ -59,7 +59,7 @@ def test_simulation_is_reproducible_from_its_seed():
 
 
 def test_step_applies_the_discrete_input_matrix():
-    from fms_testbed.sins.simulate import step
+    from fms_testbed.sensors.sins.simulate import step
 
     F = np.array([[0.0, 1.0], [0.0, 0.0]])
     phi, qk, bk = discretize(F, np.zeros((2, 2)), 0.5, B=np.array([[0.0], [1.0]]))

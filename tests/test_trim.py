@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
-from fms_testbed.aircraft import list_aircraft, load_aircraft
-from fms_testbed.errors import TrimError
-from fms_testbed.jsbsim_core import JSBSimAircraft
+from fms_testbed.config.aircraft import list_aircraft, load_aircraft
+from fms_testbed.core.errors import TrimError
+from fms_testbed.sim.jsbsim_core import JSBSimAircraft
 
 CASES = [(n, i) for n in list_aircraft() for i in range(len(load_aircraft(n).envelope))]
 

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 from typing import Protocol
 
-from ..state import AircraftState
-from .baselines import SeparateChannelsLaw, TecsLaw
-from .coupled_law import CoupledLaw, CoupledLawParams, params_from_config
+from fms_testbed.core.state import AircraftState
+from fms_testbed.control.baselines import SeparateChannelsLaw, TecsLaw
+from fms_testbed.control.coupled_law import CoupledLaw, CoupledLawParams, params_from_config
 
 
 class VerticalLaw(Protocol):
@@ -32,5 +32,21 @@ VERTICAL_LAWS: dict[str, type] = {
     "tecs": TecsLaw,
 }
 
-__all__ = ["VERTICAL_LAWS", "VerticalLaw", "CoupledLaw", "CoupledLawParams", "SeparateChannelsLaw",
+LAW_CLIMB_FRACTION = 1.0
+"""The coupled law's level-change rate is set to this fraction of the aircraft's sustained
+climb rate (above the planned rate, so the law can catch up with the plan)."""
+
+
+def procedure_law(cfg):
+    """The coupled law for procedure flights: the aircraft's tuning with the level-change
+    altitude-error limit raised so that its climb rate ``dH_limit / (2 ξ_H T_H)`` is
+    LAW_CLIMB_FRACTION × ``limits.climb_rate_max_mps`` (never below the configured limit)."""
+    g = cfg.coupled_law
+    dh = max(g.dH_limit_m, LAW_CLIMB_FRACTION * cfg.limits.climb_rate_max_mps
+             * 2.0 * g.xi_H * g.T_H_s)
+    return CoupledLaw(params=params_from_config(cfg, dH_limit_m=dh))
+
+
+
+__all__ = ["procedure_law", "LAW_CLIMB_FRACTION", "VERTICAL_LAWS", "VerticalLaw", "CoupledLaw", "CoupledLawParams", "SeparateChannelsLaw",
            "TecsLaw", "params_from_config"]

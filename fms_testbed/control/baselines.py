@@ -30,9 +30,9 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..aircraft import AircraftConfig
-from ..state import AircraftState
-from .coupled_law import (G_MPS2, CoupledLawParams, altitude_channel_ny, clip_altitude_error,
+from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.core.state import AircraftState
+from fms_testbed.control.coupled_law import (G_MPS2, CoupledLawParams, altitude_channel_ny, clip_altitude_error,
                           gravity_ratio, params_from_config)
 
 

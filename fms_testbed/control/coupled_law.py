@@ -44,8 +44,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from ..aircraft import AircraftConfig
-from ..state import AircraftState
+from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.core.state import AircraftState
 
 G_MPS2 = 9.80665
 """Standard gravity, m/s²."""
@@ -129,7 +129,7 @@ def params_from_config(cfg: AircraftConfig, **overrides) -> CoupledLawParams:
     """
     gains = cfg.coupled_law
     if gains is None:
-        from ..errors import ConfigError
+        from fms_testbed.core.errors import ConfigError
 
         raise ConfigError(f"{cfg.source_file or cfg.name}: no 'coupled_law' block (T_V_s, xi_V, "
                           "T_H_s, xi_H) — run `fms-testbed tune` or add one")

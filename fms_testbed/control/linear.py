@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
-from .coupled_law import G_MPS2, CoupledLawParams
+from fms_testbed.control.coupled_law import G_MPS2, CoupledLawParams
 
 OUTPUTS = ("V", "H", "theta", "nxa")
 """Closed-loop outputs: airspeed (m/s), altitude (m), flight-path angle (rad), n_xa command (g)."""

@@ -19,8 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from ..state import AircraftState
-from .coupled_law import G_MPS2, gravity_ratio
+from fms_testbed.core.state import AircraftState
+from fms_testbed.control.coupled_law import G_MPS2, gravity_ratio
 
 _ZERO3 = np.zeros(3)
 

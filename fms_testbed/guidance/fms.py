@@ -16,7 +16,7 @@ Every outer step (10 Hz by default) it
    holds the coded heading instead and lets the wind drift the track), and altitude/TAS
    targets from :mod:`.vertical`;
 5. logs ``xtk_m`` (true cross-track, TSE), ``nav_xtk_m`` (FTE), ``leg_index``, ``leg_code`` and
-   the other per-step quantities :mod:`fms_testbed.flight_errors` needs.
+   the other per-step quantities :mod:`fms_testbed.evaluation.flight_errors` needs.
 
 Truth is used only for logging, never for control.
 """
@@ -28,14 +28,14 @@ import logging
 import math
 from dataclasses import dataclass, field
 
-from ..atmosphere import cas_to_tas_scalar
-from ..path.geodesy import direct, inverse
-from ..path.segments import Arc, Line, project
-from ..runner import GuidanceOutput
-from .geometry import LocalPiece, local_pieces, radii_m
-from .lateral import LateralGains, anticipation_m, bank_command_rad
-from .procedure import FlyablePath, rebuild_from
-from .vertical import (BLEND_S, altitude_lead_s, blended_profile, cas_band, climb_targets,
+from fms_testbed.core.atmosphere import cas_to_tas_scalar
+from fms_testbed.core.geodesy import direct, inverse
+from fms_testbed.core.segments import Arc, Line, project
+from fms_testbed.core.contracts import GuidanceOutput
+from fms_testbed.guidance.geometry import LocalPiece, local_pieces, radii_m
+from fms_testbed.guidance.lateral import LateralGains, anticipation_m, bank_command_rad
+from fms_testbed.path.plan import FlyablePath, rebuild_from
+from fms_testbed.guidance.vertical import (BLEND_S, altitude_lead_s, blended_profile, cas_band, climb_targets,
                        leg_speed_limits, profile_nodes_at_fixes, tas_target_mps)
 
 log = logging.getLogger(__name__)
@@ -101,7 +101,7 @@ def _pde(db, fp: FlyablePath, seg, prev_leg) -> float:
         return max(abs(inverse(c.lat_deg, c.lon_deg, *p)[0] - lg.record.arc_radius_m)
                    for p in pts)
     if lg.path_term == "CF" and isinstance(g, Line) and lg.record.course_deg is not None:
-        from ..path.geodesy import direct
+        from fms_testbed.core.geodesy import direct
         coded = (lg.record.course_deg if lg.record.course_true else
                  lg.record.course_deg + _magvar(db, fp, lg))
         back = direct(t.lat_deg, t.lon_deg, coded + 180.0, max(g.length_m(), 1000.0))
@@ -127,8 +127,8 @@ def smooth_connectors(segs, tas_mps: float, bank_deg: float = 20.0) -> list:
     (connectors: MIN_CONNECTOR_M) are dropped; other segments unchanged."""
     from dataclasses import replace as _replace
 
-    from ..arinc424.construct import direct_to_arc
-    from ..path.geodesy import wrap180
+    from fms_testbed.legs.construct import direct_to_arc
+    from fms_testbed.core.geodesy import wrap180
 
     r = tas_mps * tas_mps / (9.80665 * math.tan(math.radians(bank_deg)))
     lead_m = anticipation_m(tas_mps, math.radians(bank_deg), LateralGains())

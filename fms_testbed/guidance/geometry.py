@@ -1,13 +1,13 @@
 """Precomputed local-plane geometry of a built path, for cross-track at the outer rate without geodesy.
 
-Each :class:`~fms_testbed.path.Line` is cut into chunks of at most :data:`CHUNK_M` metres; each
-chunk and each :class:`~fms_testbed.path.Arc` gets a local tangent plane about an origin (chunk
+Each :class:`~fms_testbed.core.segments.Line` is cut into chunks of at most :data:`CHUNK_M` metres; each
+chunk and each :class:`~fms_testbed.core.segments.Arc` gets a local tangent plane about an origin (chunk
 start or arc centre) with the meridian and prime-vertical radii of curvature at that origin.
 A position maps to the plane with the mid-latitude equirectangular approximation
 
     x = Δλ · N₀ cos φ_m,    y = Δφ · M₀,    φ_m = (φ + φ₀)/2
 
-whose distance error is third order (cross-track within 1 m of :func:`fms_testbed.path.project`
+whose distance error is third order (cross-track within 1 m of :func:`fms_testbed.core.segments.project`
 within 1.5 km of 4 km line chunks and RF arcs up to 18.5 km radius (latitudes to 70°), along-track within 0.2 % of an arc's
 length, track within 0.15°: ``tests/test_guidance_geometry.py`` checks it). A line chunk is then the straight line
 between its projected ends; an arc is a circle about the origin. Sign convention as in
@@ -19,7 +19,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from ..path.segments import Arc, Line
+from fms_testbed.core.segments import Arc, Line
 
 _A_M = 6378137.0
 _E2 = 6.69437999014e-3

@@ -26,7 +26,7 @@ import bisect
 import math
 from dataclasses import dataclass
 
-from ..atmosphere import cas_to_tas_scalar
+from fms_testbed.core.atmosphere import cas_to_tas_scalar
 
 KT_MPS = 1852.0 / 3600.0
 MIN_CAS_FACTOR = 1.15
@@ -82,23 +82,6 @@ def altitude_lead_s(cfg) -> float:
     """Read-ahead time of the altitude plan, 2 ξ_H T_H of the aircraft's coupled law, s."""
     g = cfg.coupled_law
     return 2.0 * g.xi_H * g.T_H_s if g is not None else 10.0
-
-
-LAW_CLIMB_FRACTION = 1.0
-"""The coupled law's level-change rate is set to this fraction of the aircraft's sustained
-climb rate (above the planned rate, so the law can catch up with the plan)."""
-
-
-def procedure_law(cfg):
-    """The coupled law for procedure flights: the aircraft's tuning with the level-change
-    altitude-error limit raised so that its climb rate ``dH_limit / (2 ξ_H T_H)`` is
-    LAW_CLIMB_FRACTION × ``limits.climb_rate_max_mps`` (never below the configured limit)."""
-    from ..control import CoupledLaw, params_from_config
-
-    g = cfg.coupled_law
-    dh = max(g.dH_limit_m, LAW_CLIMB_FRACTION * cfg.limits.climb_rate_max_mps
-             * 2.0 * g.xi_H * g.T_H_s)
-    return CoupledLaw(params=params_from_config(cfg, dH_limit_m=dh))
 
 
 BLEND_S = 6.0

@@ -1,0 +1,102 @@
+"""What several commands share: the scenario overrides (``--wind``, ``--nav``, ``--imu``,
+``--aircraft``, ``--rnp``, ``--seed``), given and applied the same way in every command, and the
+printed summary of a flight."""
+
+from __future__ import annotations
+
+import re
+
+from fms_testbed.core.errors import UserError
+
+WIND_HELP = ("steady wind FROM_DEG/SPEED_KT (deg true it blows from / kt), e.g. 270/20; "
+             "a unit suffix selects another speed unit: 270/10mps, 270/36kmh")
+_WIND_UNITS = {"": "speed_kt", "kt": "speed_kt", "mps": "speed_mps", "kmh": None}
+
+
+def parse_wind(text: str) -> dict:
+    """``FROM_DEG/SPEED[kt|mps|kmh]`` → the scenario's ``wind`` mapping (speed in kt by default).
+
+    Raises
+    ------
+    UserError : the text is not of that form, or the direction/speed is out of range
+    """
+    m = re.fullmatch(r"\s*(\d+(?:\.\d*)?)\s*/\s*(\d+(?:\.\d*)?)\s*(kt|mps|kmh)?\s*", text or "")
+    if not m:
+        raise UserError(f"--wind {text!r}: expected FROM_DEG/SPEED_KT, e.g. 270/20 "
+                        "(deg true from / kt; or 270/10mps, 270/36kmh)")
+    d, s, unit = float(m.group(1)), float(m.group(2)), m.group(3) or ""
+    kt = s if unit in ("", "kt") else s * 3600.0 / 1852.0 if unit == "mps" else s / 1.852
+    if d > 360 or kt > 200:
+        raise UserError(f"--wind {text!r}: direction must be 0-360 deg and speed ≤ 200 kt")
+    if unit == "kmh":
+        return {"from_deg": d, "speed_kt": round(kt, 6)}
+    return {"from_deg": d, _WIND_UNITS[unit]: s}
+
+
+def add_override_options(p, aircraft_default: str | None = None) -> None:
+    """Add the scenario overrides to a command's parser (the same options in ``run`` and ``fly``)."""
+    p.add_argument("--aircraft", default=aircraft_default,
+                   help="aircraft name or YAML file" + (f" (default {aircraft_default})"
+                                                        if aircraft_default else
+                                                        " (overrides the scenario's)"))
+    p.add_argument("--wind", help=WIND_HELP)
+    p.add_argument("--nav", choices=("truth", "sins"), help="navigation source guidance flies on")
+    p.add_argument("--imu", help="IMU preset of the SINS (with --nav sins)")
+    p.add_argument("--rnp", type=float, help="RNP, NM, where the procedure's records code none")
+    p.add_argument("--seed", type=int, default=0,
+                   help="seed for turbulence and sensor errors (default 0; a scenario's "
+                        "navigation.seed seeds the navigation errors instead)")
+
+
+def overrides_from_args(args) -> dict:
+    """The scenario overrides the command-line options give (only the options that were set)."""
+    out: dict = {}
+    if getattr(args, "aircraft", None):
+        out["aircraft"] = args.aircraft
+    if getattr(args, "wind", None):
+        out["wind"] = parse_wind(args.wind)
+    nav, imu = getattr(args, "nav", None), getattr(args, "imu", None)
+    if nav == "sins":
+        if not imu:
+            raise UserError("--nav sins needs --imu PRESET")
+        out["navigation"] = {"source": "sins", "imu": imu}
+    elif imu:
+        raise UserError("--imu is only used with --nav sins")
+    elif nav == "truth":
+        out["navigation"] = {"source": "truth"}
+    if getattr(args, "rnp", None) is not None:
+        out["procedure"] = {"rnp_nm": args.rnp}
+    return out
+
+
+def print_results(res) -> None:
+    """One line per result group: status; for procedure flights errors, RNP, constraints and
+    sequencing; where the outputs are."""
+    s = res.summary
+    p = s.get("procedure")
+    if p is None:
+        print(f"{s['scenario']}: {s['status']} ({s['reason']}), {s['duration_s']:.0f} s flown in "
+              f"{s['wall_time_s']:.1f} s wall ({s['real_time_factor']}x real time)")
+    else:
+        print(f"{p['name']} ({p['type']}, {len(p['legs'])} legs, {p['length_nm']} NM, monitor "
+              f"{p['monitor_status']}): {s['status']} ({s['reason']}), {s['duration_s']:.0f} s "
+              f"flown in {s['wall_time_s']:.1f} s wall")
+        e = s.get("errors", {})
+        if e:
+            f, t, n = e["fte"], e["tse"], e["nse"]
+            print(f"  FTE95 {f['all']['p95_m']} m (straight {f['straight']['p95_m']} m), FTE max "
+                  f"{f['all']['max_m']} m; TSE95 {t['all']['p95_m']} m; NSE95 "
+                  f"{n['all']['p95_m']} m")
+            r = s["rnp"]
+            print(f"  RNP {r['min_rnp_nm']} NM: "
+                  f"{'contained' if r['contained'] else 'NOT contained'}"
+                  + (f" (legs {r['legs_not_contained']})" if r["legs_not_contained"] else ""))
+        bad = [c for c in s.get("constraints", []) if c.get("ok") is False]
+        print(f"  constraints: {len(s.get('constraints', []))} checked, {len(bad)} missed"
+              + "".join(f"; leg {c['leg']} {c['fix']}: {c.get('why')}" for c in bad))
+        q = s.get("sequencing", {})
+        print(f"  sequencing: {q.get('legs_entered')}/{q.get('legs')} legs entered, skipped "
+              f"{q.get('skipped')}, repeated {q.get('repeated')}")
+    if res.out_dir is not None:
+        print(f"  outputs in {res.out_dir}: "
+              + ", ".join(["timeseries.parquet", "summary.json"] + s.get("plots", [])))

@@ -1,0 +1,180 @@
+"""Aircraft configuration: one readable YAML file per aircraft under ``aircraft/``.
+
+A file names the JSBSim model and holds the aircraft's limits (speed range, bank, load factors,
+climb capability), its trim bounds, the envelope points it is tested at, and the tuning of the
+inner loops and the coupled law. Tuning is frozen data; controller state lives elsewhere.
+
+All quantities are SI with the unit in the key (``_mps``, ``_m``, ``_deg``, ``_s``) except load
+factors (g, dimensionless) and normalised controls. Adding an aircraft means adding one file.
+"""
+
+from __future__ import annotations
+
+from functools import lru_cache
+from pathlib import Path
+from typing import Annotated
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.data import aircraft_dir
+from fms_testbed.config.yamlfile import read_mapping, validation_message
+
+Pos = Annotated[float, Field(gt=0)]
+NonNeg = Annotated[float, Field(ge=0)]
+
+
+class _Frozen(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Limits(_Frozen):
+    """Operating limits used by trim checks, divergence detection, guidance and the monitor."""
+
+    cas_min_mps: Pos = Field(description="minimum clean operating CAS (stall margin included), m/s")
+    cas_max_mps: Pos = Field(description="maximum operating CAS (VMO), m/s")
+    mach_max: Annotated[float, Field(gt=0, lt=3)] = Field(description="maximum operating Mach (MMO)")
+    alt_max_m: Pos = Field(description="service ceiling, m")
+    bank_max_deg: Annotated[float, Field(gt=0, le=45)] = Field(description="max bank in guidance, deg")
+    roll_rate_max_dps: Annotated[float, Field(gt=0, le=60)] = Field(
+        5.0, description="rate limit on the bank command from heading hold/guidance, deg/s")
+    ny_min: Annotated[float, Field(ge=-1, le=1)] = Field(description="min normal load factor, g")
+    ny_max: Annotated[float, Field(ge=1, le=4)] = Field(description="max normal load factor, g")
+    stall_alpha_deg: Pos = Field(description="alpha at which the run is declared stalled, deg")
+    climb_rate_max_mps: Pos = Field(description="max sustained climb rate near sea level, m/s")
+    climb_gradient_max: Annotated[float, Field(gt=0, lt=0.5)] = Field(
+        description="max climb gradient (rise over run) at the planned speed, dimensionless")
+    descent_rate_max_mps: Pos = Field(description="max planned descent rate, m/s")
+    climb_tas_mps: Pos = Field(
+        description="planned terminal-area speed for path building and guidance, m/s: the TAS "
+                    "at sea level, flown as that CAS at altitude")
+
+    @model_validator(mode="after")
+    def _order(self):
+        if self.cas_min_mps >= self.cas_max_mps:
+            raise ValueError("cas_min_mps must be below cas_max_mps")
+        if self.ny_min >= self.ny_max:
+            raise ValueError("ny_min must be below ny_max")
+        return self
+
+
+class TrimSettings(_Frozen):
+    """Trim bounds: JSBSim's alpha search is bounded to avoid trimming past the lift peak."""
+
+    alpha_max_deg: Annotated[float, Field(gt=0, le=30)] = Field(description="upper alpha bound, deg")
+    alpha_min_deg: Annotated[float, Field(ge=-10, le=0)] = -4.0
+
+
+class EnvelopePoint(_Frozen):
+    """A condition the aircraft is trimmed and tested at."""
+
+    alt_m: Annotated[float, Field(ge=0, le=20000)]
+    tas_mps: Pos
+
+
+class PIDGains(_Frozen):
+    """Proportional/integral/derivative gains of one inner loop (units depend on the loop)."""
+
+    kp: float
+    ki: NonNeg = 0.0
+    kd: float = 0.0
+    kff: float = Field(0.0, description="feed-forward of the command's deviation from trim "
+                                        "(n_y - 1, n_x), control units per g")
+
+
+class InnerLoopGains(_Frozen):
+    """Inner-loop tuning (run inside JSBSim as ``<system>`` components every
+    ``frames_per_update`` JSBSim frames: 60 Hz by default at JSBSim's 120 Hz).
+
+    * bank: aileron (norm) per rad of bank error; kd per rad/s of roll rate
+    * yaw: rudder (norm) per rad of sideslip (kp) and per rad/s of yaw rate (kd)
+    * ny: elevator (norm) per g of normal-load-factor error; kd per rad/s of pitch rate
+    * nx: throttle (norm) per g of tangential-load-factor error
+    * heading: bank command (rad) per rad of heading error (outer loop, Python)
+    """
+
+    bank: PIDGains
+    yaw: PIDGains
+    ny: PIDGains
+    nx: PIDGains
+    heading_kp: Pos = Field(description="bank command per heading error, rad/rad")
+    heading_ki: NonNeg = 0.0
+    elevator_rate_max_ps: Pos = Field(1.5, description="elevator command rate limit, norm/s")
+    throttle_min: Annotated[float, Field(ge=0, le=1)] = 0.0
+    throttle_max: Annotated[float, Field(ge=0, le=1.0)] = 1.0
+    frames_per_update: Annotated[int, Field(ge=1, le=4)] = Field(
+        2, description="inner loops run every N JSBSim frames (JSBSim channel execrate): "
+                       "1 = 120 Hz, 2 = 60 Hz (a flight-control computer's rate; half the cost)")
+
+
+class InnerLoopSpec(_Frozen):
+    """Step-response specification the inner loops must meet on this aircraft (tests check it).
+
+    Settling: last time outside ±5 % of the step around the target; overshoot in % of the step.
+    """
+
+    bank_step_deg: Pos = 25.0
+    bank_settle_max_s: Pos = 6.0
+    ny_step: Pos = Field(0.1, description="n_y step size, g (flown up and down)")
+    ny_settle_max_s: Pos = 2.0
+    nx_step: Pos = Field(0.05, description="n_x step size, g (flown up and down)")
+    nx_settle_max_s: Pos = 1.5
+    overshoot_max_pct: Pos = 10.0
+    nx_overshoot_max_pct: Pos = 10.0
+
+
+class CoupledLawGains(_Frozen):
+    """Multi-coupled thrust/elevator law tuning (Kulikov et al., eq. 2 and 5)."""
+
+    T_V_s: Pos = Field(description="speed-channel time constant, s")
+    xi_V: Pos = Field(description="speed-channel damping ratio")
+    T_H_s: Pos = Field(description="altitude-channel time constant, s")
+    xi_H: Pos = Field(description="altitude-channel damping ratio")
+    dH_limit_m: Pos = Field(100.0, description="altitude-error limit (level-change mode), m")
+
+
+class AircraftConfig(_Frozen):
+    """One aircraft: the JSBSim model plus everything the testbed needs to fly it."""
+
+    name: str
+    description: str = ""
+    jsbsim_model: str = Field(description="model folder name in the jsbsim wheel's aircraft/")
+    category: str = Field(description="narrow-body | business-jet | light")
+    limits: Limits
+    trim: TrimSettings
+    envelope: list[EnvelopePoint] = Field(min_length=1)
+    default_condition: EnvelopePoint
+    inner_loops: InnerLoopGains
+    inner_spec: InnerLoopSpec = Field(default_factory=InnerLoopSpec)
+    coupled_law: CoupledLawGains | None = None
+    source_file: str = ""
+
+
+def list_aircraft() -> list[str]:
+    """Names of the shipped aircraft configurations."""
+    return sorted(p.stem for p in aircraft_dir().glob("*.yaml"))
+
+
+def load_aircraft_file(path: str | Path) -> AircraftConfig:
+    """Load and validate an aircraft YAML file; raise :class:`ConfigError` naming file and field."""
+    path = Path(path)
+    raw = read_mapping(path, "aircraft file")
+    raw.setdefault("name", path.stem)
+    raw["source_file"] = str(path)
+    try:
+        return AircraftConfig.model_validate(raw)
+    except ValidationError as err:
+        raise ConfigError(validation_message(str(path), err)) from None
+
+
+@lru_cache(maxsize=32)
+def load_aircraft(name: str) -> AircraftConfig:
+    """Load a shipped aircraft by name (``aircraft/NAME.yaml``) or from a path to a YAML file."""
+    p = Path(name)
+    if p.suffix in (".yaml", ".yml") and p.exists():
+        return load_aircraft_file(p)
+    path = aircraft_dir() / f"{name}.yaml"
+    if not path.exists():
+        raise ConfigError(
+            f"unknown aircraft '{name}': shipped aircraft are {', '.join(list_aircraft())}")
+    return load_aircraft_file(path)

@@ -1,0 +1,2 @@
+"""Evaluation: flight errors (FTE/NSE/PDE/TSE), constraint compliance, database invariants
+(``procedures check``) and vertical-law comparisons."""

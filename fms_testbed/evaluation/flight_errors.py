@@ -1,0 +1,214 @@
+"""Flight errors of a procedure flight: FTE, NSE, PDE, TSE, RNP containment, constraint compliance.
+
+Definitions (RNP, ICAO Doc 9613; ``shared/notes/navigation-monitoring.md``), all horizontal, m:
+
+* FTE — flight technical error: the navigation solution's cross-track from the path guidance
+  flies (``nav_xtk_m``);
+* NSE — navigation system error: distance between the navigation solution and the true position;
+* PDE — path definition error: distance of the built path from the ideal coded path where that
+  is defined (TF: geodesic between the fixes; CF: coded course line; RF: coded centre/radius),
+  evaluated per built segment (``pde_m``);
+* TSE — total system error: the true position's cross-track from the path (``xtk_m``).
+
+The straight parts of heading legs (VA/VD/VI/VM/VR, flown as a heading; ``heading_leg`` = 1)
+have no defined ground track: they are left out of the FTE and TSE statistics and of RNP
+containment (their turn arcs count); ``errors.heading_leg_samples`` says how many samples that is.
+
+Statistics are the 95th percentile of the absolute value and the maximum, over the whole flight,
+over **straight flight** (on a line segment at least :data:`STRAIGHT_MARGIN_M` from the nearest
+arc, so roll-in/roll-out transients count as turns), and per leg. RNP containment: TSE95 ≤ the
+leg's RNP value (record, else the scenario's ``rnp_nm``, else 1 NM for SID/STAR and 0.3 NM for
+approaches). Constraint compliance: at the sample nearest each constrained fix (or at the end of
+an altitude-terminated leg) the true altitude must be inside the coded window within
+:data:`ALT_TOL_FT` and the CAS inside the coded speed limit within :data:`SPEED_TOL_KT`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+
+from fms_testbed.path.profile import window
+
+FT_M = 0.3048
+KT_MPS = 1852.0 / 3600.0
+ALT_TOL_FT = 50.0
+SPEED_TOL_KT = 5.0
+STRAIGHT_MARGIN_M = 2000.0
+FIX_PASS_MAX_M = 1852.0
+"""A constrained fix counts as passed when the flight came within this distance of it, m."""
+_R_M = 6371008.8
+
+
+def _dist_m(lat1, lon1, lat2, lon2):
+    """Equirectangular distance (deg inputs, vectorised), m — accurate to < 0.1 % at < 50 km."""
+    la1, la2 = np.radians(lat1), np.radians(lat2)
+    x = np.radians(np.asarray(lon2) - np.asarray(lon1)) * np.cos(0.5 * (la1 + la2))
+    return _R_M * np.hypot(x, la2 - la1)
+
+
+def _stats(x: np.ndarray) -> dict[str, float | None]:
+    x = np.abs(x[np.isfinite(x)])
+    if x.size == 0:
+        return {"p95_m": None, "max_m": None, "n": 0}
+    return {"p95_m": round(float(np.percentile(x, 95)), 2), "max_m": round(float(x.max()), 2),
+            "n": int(x.size)}
+
+
+def error_columns(df: pd.DataFrame) -> pd.DataFrame:
+    """Add ``fte_m`` (= nav_xtk_m), ``tse_m`` (= xtk_m) and ``nse_m`` (nav vs truth) columns;
+    FTE and TSE are NaN on the straight part of heading legs (``heading_leg``), which have no
+    defined ground track."""
+    df = df.copy()
+    free = df["heading_leg"].to_numpy() == 1 if "heading_leg" in df else np.zeros(len(df), bool)
+    df["fte_m"] = np.where(free, np.nan, df["nav_xtk_m"])
+    df["tse_m"] = np.where(free, np.nan, df["xtk_m"])
+    df["nse_m"] = _dist_m(df["lat_deg"].to_numpy(), df["lon_deg"].to_numpy(),
+                          df["nav_lat_deg"].to_numpy(), df["nav_lon_deg"].to_numpy())
+    return df
+
+
+def error_stats(df: pd.DataFrame) -> dict:
+    """FTE/NSE/PDE/TSE statistics overall, on straight flight and in turns (module docstring)."""
+    straight = (df["curvature_1pm"].to_numpy() == 0) & (df["straight_m"].to_numpy()
+                                                       >= STRAIGHT_MARGIN_M)
+    out = {}
+    for name in ("fte", "nse", "pde", "tse"):
+        x = df[f"{name}_m"].to_numpy(dtype=float)
+        out[name] = {"all": _stats(x), "straight": _stats(x[straight]),
+                     "turns": _stats(x[~straight])}
+    return out
+
+
+def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
+    """Per-leg statistics and RNP containment (TSE95 ≤ RNP)."""
+    rows = []
+    for k, rec in enumerate(seq_legs):
+        d = df[df["leg_index"] == k]
+        row = {"leg": k + 1, "code": rec.path_term, "fix": rec.fix.ident if rec.fix else "",
+               "samples": int(len(d))}
+        if len(d):
+            rnp = float(d["rnp_m"].iloc[0])
+            for name in ("fte", "nse", "pde", "tse"):
+                s = _stats(d[f"{name}_m"].to_numpy(dtype=float))
+                row[f"{name}95_m"], row[f"{name}_max_m"] = s["p95_m"], s["max_m"]
+            row["rnp_nm"] = round(rnp / 1852.0, 2)
+            row["rnp_contained"] = (None if row["tse95_m"] is None
+                                    else bool(row["tse95_m"] <= rnp))
+        rows.append(row)
+    return rows
+
+
+def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
+    """Altitude and speed compliance at each constrained fix (module docstring)."""
+    built = {lg.index: lg for lg in fp.path.legs}
+    out = []
+    leg_col = df["leg_index"].to_numpy()
+    for k, rec in enumerate(fp.seq.legs):
+        lo, hi = window(rec.alt_desc, rec.alt1_m, rec.alt2_m)
+        spd = rec.speed_limit_mps
+        if lo is None and hi is None and not spd:
+            continue
+        row = {"leg": k + 1, "code": rec.path_term, "fix": rec.fix.ident if rec.fix else "",
+               "alt_desc": rec.alt_desc}
+        bl = built.get(k)
+        term = bl.termination if bl is not None else None
+        if term is not None and term.kind == "altitude" and not term.fix_ident:
+            sel = np.flatnonzero(leg_col == k)
+            if not sel.size:
+                row.update(ok=False, why="leg not flown")
+                out.append(row)
+                continue
+            i = int(sel[-1])
+            row["where"] = "leg end"
+        else:
+            if term is None or term.lat_deg is None or k == 0 and rec.path_term == "IF" \
+                    and not len(df):
+                row.update(ok=None, why="no fix position to check against")
+                out.append(row)
+                continue
+            sel = np.flatnonzero((leg_col >= k - 1) & (leg_col <= k + 1))
+            if not sel.size:
+                row.update(ok=False, why="fix never approached")
+                out.append(row)
+                continue
+            d = _dist_m(df["lat_deg"].to_numpy()[sel], df["lon_deg"].to_numpy()[sel],
+                        term.lat_deg, term.lon_deg)
+            j = int(np.argmin(d))
+            i = int(sel[j])
+            row["where"] = f"{d[j]:.0f} m from the fix"
+            if d[j] > FIX_PASS_MAX_M:
+                row.update(ok=False, why=f"fix passed {d[j] / 1852:.2f} NM away")
+                out.append(row)
+                continue
+        alt_ft = float(df["alt_m"].iloc[i]) / FT_M
+        cas_kt = float(df["cas_mps"].iloc[i]) / KT_MPS
+        ok = True
+        msgs = []
+        row["alt_ft"] = round(alt_ft)
+        if lo is not None or hi is not None:
+            row["window_ft"] = [None if lo is None else round(lo / FT_M),
+                                None if hi is None else round(hi / FT_M)]
+            if lo is not None and alt_ft < lo / FT_M - ALT_TOL_FT:
+                ok = False
+                msgs.append(f"{lo / FT_M - alt_ft:.0f} ft below")
+            if hi is not None and alt_ft > hi / FT_M + ALT_TOL_FT:
+                ok = False
+                msgs.append(f"{alt_ft - hi / FT_M:.0f} ft above")
+        if spd:
+            row["cas_kt"] = round(cas_kt, 1)
+            row["speed_limit_kt"] = f"{rec.speed_desc or '@'}{spd / KT_MPS:.0f}"
+            lim = spd / KT_MPS
+            if rec.speed_desc in ("", "@", "-") and cas_kt > lim + SPEED_TOL_KT:
+                ok = False
+                msgs.append(f"{cas_kt - lim:.1f} kt fast")
+            if rec.speed_desc in ("", "@", "+") and cas_kt < lim - SPEED_TOL_KT:
+                ok = False
+                msgs.append(f"{lim - cas_kt:.1f} kt slow")
+        row["ok"] = ok
+        if msgs:
+            row["why"] = ", ".join(msgs)
+        out.append(row)
+    return out
+
+
+def sequencing(guidance, n_legs: int) -> dict:
+    """Legs entered in order: none skipped, none entered twice."""
+    seq = list(guidance.legs_sequenced)
+    seen, repeated = set(), []
+    for k in seq:
+        if k in seen:
+            repeated.append(k + 1)
+        seen.add(k)
+    last = max(seq) if seq else -1
+    skipped = [k + 1 for k in range(last + 1) if k not in seen]
+    return {"legs": n_legs, "legs_entered": len(seen), "skipped": skipped,
+            "repeated": repeated, "in_order": seq == sorted(seq),
+            "completed": bool(guidance.done and not guidance.abort_reason)}
+
+
+def flight_errors(df: pd.DataFrame, fp, guidance) -> dict:
+    """Everything the summary gets: ``errors``, ``rnp``, ``constraints``, ``sequencing``."""
+    if df.empty or "xtk_m" not in df:
+        return {"errors": {}, "constraints": [], "sequencing": sequencing(guidance, 0)}
+    d = error_columns(df)
+    legs = per_leg(d, fp.seq.legs)
+    flown = [r for r in legs if r["samples"]]
+    cons = constraint_checks(d, fp)
+    tse95 = _stats(d["tse_m"].to_numpy(dtype=float))["p95_m"]
+    return {
+        "errors": {**error_stats(d), "per_leg": legs,
+                   "heading_leg_samples": int(d["heading_leg"].sum()) if "heading_leg" in d
+                   else 0},
+        "rnp": {"contained": all(r["rnp_contained"] is not False for r in flown),
+                "legs_not_contained": [r["leg"] for r in flown if r["rnp_contained"] is False],
+                "tse95_m": tse95,
+                "min_rnp_nm": round(min(r["rnp_nm"] for r in flown), 2) if flown else None},
+        "constraints": cons,
+        "constraints_met": all(c.get("ok") is not False for c in cons),
+        "sequencing": sequencing(guidance, len(fp.seq.legs)),
+    }
+
+
+__all__ = ["error_columns", "error_stats", "per_leg", "constraint_checks", "sequencing",
+           "flight_errors"]

@@ -1,0 +1,204 @@
+"""Data passed between the leg interpreter, the segmentation, the profile and the monitor.
+
+Frozen dataclasses only; the later guidance issue flies :class:`ProcedurePath` objects: an ordered
+tuple of :class:`PathSegment` (each a :class:`~fms_testbed.core.segments.Line` or
+:class:`~fms_testbed.core.segments.Arc` tagged with its leg) and, per leg, a :class:`BuiltLeg` holding the
+leg's kind and its termination condition as data (:class:`Termination`).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from fms_testbed.core.segments import Arc, Line
+from fms_testbed.procedures.legrecord import LegRecord
+
+KT_MPS = 1852.0 / 3600.0
+
+
+@dataclass(frozen=True, slots=True)
+class BuildParams:
+    """Tunable build settings (units in names).
+
+    bank_plan_deg: nominal bank for planned turns; bank_limit_deg: the monitor's |γ| bound (25°
+    by the paper, lowered to the aircraft's ``bank_max_deg`` when that is smaller);
+    manual_leg_m: length flown on FM/VM legs before the crew takes over; timed_speed_mps:
+    speed for timed legs (hold legs given in minutes, the procedure turn's minute) when no
+    speed limit is coded (210 kt = 3.5 NM/min); flyby_max_deg: largest track change
+    flown as a fly-by turn (above it the turn is flown over the fix); climb_min_gradient: the
+    3.3 % minimum climb gradient; descent_angle_deg: default descent path angle.
+    """
+
+    bank_plan_deg: float = 20.0
+    bank_limit_deg: float = 25.0
+    manual_leg_m: float = 5 * 1852.0
+    timed_speed_mps: float = 210 * KT_MPS
+    flyby_max_deg: float = 120.0
+    climb_min_gradient: float = 0.033
+    descent_angle_deg: float = 3.0
+    max_iterations: int = 5
+
+
+@dataclass(frozen=True, slots=True)
+class Performance:
+    """Aircraft performance the builder uses (from ``aircraft.limits``), SI.
+
+    tas_plan_mps: planned TAS; tas_min_mps: lowest acceptable TAS for a correction;
+    climb_gradient_max: rise over run at ``tas_plan_mps``; climb_rate_max_mps;
+    descent_rate_max_mps; bank_max_deg.
+    """
+
+    tas_plan_mps: float
+    tas_min_mps: float
+    climb_gradient_max: float
+    climb_rate_max_mps: float
+    descent_rate_max_mps: float
+    bank_max_deg: float
+
+    @classmethod
+    def from_aircraft(cls, ac) -> "Performance":
+        """Take the limits of an :class:`~fms_testbed.config.aircraft.AircraftConfig`."""
+        lim = ac.limits
+        return cls(tas_plan_mps=lim.climb_tas_mps, tas_min_mps=lim.cas_min_mps,
+                   climb_gradient_max=lim.climb_gradient_max,
+                   climb_rate_max_mps=lim.climb_rate_max_mps,
+                   descent_rate_max_mps=lim.descent_rate_max_mps, bank_max_deg=lim.bank_max_deg)
+
+    def climb_gradient_at(self, tas_mps: float) -> float:
+        """Climb gradient capability at a TAS, rise over run: the climb rate is taken as
+        constant, so the gradient scales as 1/V from ``climb_gradient_max`` at the planned TAS,
+        and never exceeds ``climb_rate_max_mps / V``."""
+        return min(self.climb_gradient_max * self.tas_plan_mps, self.climb_rate_max_mps) / tas_mps
+
+
+@dataclass(frozen=True, slots=True)
+class FlightState:
+    """Where the planned aircraft is while legs are built.
+
+    lat_deg/lon_deg: position; track_deg: true track (None before the first course is known);
+    alt_m: planned altitude; flyby: the position is a fly-by fix whose corner may be cut by
+    the next leg; fix_ident: the fix at the position ('' if none).
+    """
+
+    lat_deg: float
+    lon_deg: float
+    track_deg: float | None
+    alt_m: float
+    flyby: bool = False
+    fix_ident: str = ""
+
+    @property
+    def pos(self) -> tuple[float, float]:
+        """(lat_deg, lon_deg)."""
+        return self.lat_deg, self.lon_deg
+
+
+@dataclass(frozen=True, slots=True)
+class Termination:
+    """How a leg ends, as data for guidance.
+
+    kind: 'fix' | 'altitude' | 'dme' | 'radial' | 'intercept' | 'manual' | 'distance' | 'time'
+    | 'circuit'. Only the fields of that kind are set: ``lat_deg/lon_deg`` (fix or computed end
+    point), ``alt_m`` (altitude terminations), ``dme_m`` and ``navaid_lat_deg/lon_deg`` (DME),
+    ``radial_deg`` (true, with the navaid), ``distance_m``/``time_s``, ``next_leg`` (intercept).
+    """
+
+    kind: str
+    lat_deg: float | None = None
+    lon_deg: float | None = None
+    fix_ident: str = ""
+    alt_m: float | None = None
+    dme_m: float | None = None
+    radial_deg: float | None = None
+    navaid_lat_deg: float | None = None
+    navaid_lon_deg: float | None = None
+    distance_m: float | None = None
+    time_s: float | None = None
+    next_leg: int | None = None
+
+
+@dataclass(frozen=True, slots=True)
+class PathSegment:
+    """One Line or Arc of a built path with its tags.
+
+    role: 'leg' (the leg's own path), 'turn' (turn flown from the present position onto the
+    leg), 'flyby' (fly-by transition arc, tagged with the leg it ends), 'hold', 'connector'
+    (bridge over a discontinuity); speed_mps: planned TAS; bank_deg: planned bank (arcs);
+    lead_m: turn anticipation of a fly-by arc.
+    """
+
+    geom: Line | Arc
+    leg_index: int
+    path_term: str
+    fix_ident: str
+    role: str = "leg"
+    speed_mps: float = 0.0
+    bank_deg: float = 0.0
+    lead_m: float = 0.0
+    """Fly-by arcs: turn anticipation, the distance from the corner to where the turn starts, m."""
+
+
+@dataclass(frozen=True, slots=True)
+class Finding:
+    """A monitor or builder finding: leg index (-1: procedure), category, message, branch."""
+
+    leg_index: int
+    category: str     # 'correction' | 'impossible' | 'discontinuity' | 'loop' | 'no-intercept' | 'info'
+    message: str
+    branch: str = ""  # paper branch: 'R', 'V,γ', 'γ', 'V,Θ', 'V,γ,φ,λ'
+
+
+@dataclass(frozen=True, slots=True)
+class BuiltLeg:
+    """One interpreted leg: its record, where it starts and ends, and its termination."""
+
+    index: int
+    record: LegRecord
+    path_term: str
+    start: FlightState
+    end: FlightState
+    termination: Termination
+    speed_mps: float
+    seg_first: int = 0
+    seg_count: int = 0
+
+
+@dataclass(frozen=True)
+class ProcedurePath:
+    """A built procedure transition: segments, legs, vertical profile and monitor outcome."""
+
+    name: str
+    airport: str
+    proc_type: str
+    proc_id: str
+    transition: str
+    legs: tuple[BuiltLeg, ...]
+    segments: tuple[PathSegment, ...]
+    findings: tuple[Finding, ...] = ()
+    profile: object = None
+    status: str = "ok"
+    start_kind: str = "fix"
+    """Where the build started: 'runway' (departure end), 'fix', 'airport' or 'given'."""
+
+    def length_m(self) -> float:
+        """Total horizontal path length, m."""
+        return math.fsum(s.geom.length_m() for s in self.segments)
+
+    def leg_types(self) -> list[str]:
+        """Path terminators in order."""
+        return [lg.path_term for lg in self.legs]
+
+
+def isa_tas_mps(cas_mps: float, alt_m: float) -> float:
+    """TAS from CAS in the ISA troposphere (incompressible), m/s: CAS/sqrt(σ)."""
+    h = min(max(alt_m, 0.0), 11000.0)
+    sigma = (1.0 - 2.25577e-5 * h) ** 4.2559
+    return cas_mps / math.sqrt(sigma)
+
+
+def turn_radius_m(tas_mps: float, bank_deg: float, g_mps2: float) -> float:
+    """R = V²/(g tan γ), m (Danilin 2017, turn radius from speed and bank)."""
+    return tas_mps * tas_mps / (g_mps2 * math.tan(math.radians(bank_deg)))
+
+

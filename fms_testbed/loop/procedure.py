@@ -1,0 +1,137 @@
+"""Fly a real ARINC-424 procedure in JSBSim: build it, start the aircraft on it, fly the closed
+loop with :class:`~fms_testbed.guidance.fms.ProcedureGuidance`, then measure the flight errors.
+
+Start condition (stated plainly, it is a simplification): JSBSim cannot take off here in a
+useful way, so a SID starts **airborne at the departure end of the runway (DER)** at the
+builder's planned start altitude (35 ft above the runway), trimmed straight and level at the
+aircraft's planned climb TAS on the runway heading; the profile then climbs it. STARs and
+approaches start at their first fix at the first coded altitude, on the first segment's
+course. In both cases the aircraft is placed one roll-in anticipation distance (≈ 400 m for the
+737) *before* the path start on that course, so a turn that begins at the path start is entered
+like any other planned turn. The start speed is the planned TAS moved into the first leg's coded
+speed limit. An approach ends at the runway/MAP (the missed approach is not flown). JSBSim's
+terrain is at mean sea level, so height above ground is altitude above MSL.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+
+from fms_testbed.config.aircraft import load_aircraft
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.guidance.fms import ProcedureGuidance
+from fms_testbed.control import procedure_law
+from fms_testbed.config.procedure import ProcedureSpec, parse_procedure
+from fms_testbed.path.plan import FlyablePath, build_procedure, load_db
+from fms_testbed.config.yamlfile import read_mapping
+from fms_testbed.config.scenario import Scenario, parse_scenario
+
+MPS_KT = 3600.0 / 1852.0
+OUTER_RATE_HZ = 10.0
+"""Rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS runs
+LNAV/VNAV at 5-20 Hz; the same as the scenario default). A scenario's ``outer_rate_hz`` wins."""
+
+
+def runner_log_every(scn: Scenario) -> int:
+    """Outer steps between two logged rows, computed as the runner does (JSBSim at 120 Hz)."""
+    from fms_testbed.sim.jsbsim_core import DT_S
+
+    n_outer = max(1, int(round(1.0 / (scn.outer_rate_hz * DT_S))))
+    return max(1, int(round(1.0 / (scn.log_rate_hz * n_outer * DT_S))))
+
+
+def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
+    """The scenario ``initial`` block for the start of a built path (module docstring)."""
+    from fms_testbed.guidance.vertical import cas_band, leg_speed_limits, tas_target_mps
+
+    from fms_testbed.guidance.lateral import LateralGains, anticipation_m
+    from fms_testbed.core.geodesy import direct
+
+    seg0 = fp.path.segments[0].geom
+    crs = seg0.start_course_deg
+    # start one roll-in anticipation before the path start on its initial course, so that a
+    # turn beginning at the path start (a fly-by at the DER) is flown like any planned turn
+    lead = anticipation_m(cfg.limits.climb_tas_mps, math.radians(20.0),
+                          LateralGains.for_aircraft(cfg))
+    lat, lon, _ = direct(seg0.start[0], seg0.start[1], crs + 180.0, lead)
+    alt = fp.path.legs[0].start.alt_m
+    lo, hi = cas_band(leg_speed_limits(fp.seq.legs[:1])[0], None)
+    tas = tas_target_mps(cfg.limits.climb_tas_mps, alt, lo, hi, cfg.limits.cas_min_mps)
+    return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,
+            "tas_mps": round(tas, 3), "heading_deg": crs % 360.0}
+
+
+@dataclass
+class PreparedProcedure:
+    """A scenario's procedure, built and checked: what :class:`~fms_testbed.loop.flight.Flight`
+    needs to fly it.
+
+    Attributes
+    ----------
+    spec : the validated ``procedure:`` block
+    path : the built path (with its sequence, RNP per leg and monitor findings)
+    db : the database it was built from (guidance rebuilds conditional legs from it)
+    """
+
+    spec: ProcedureSpec
+    path: FlyablePath
+    db: Any
+
+    def guidance(self, scn: Scenario, cfg) -> tuple[ProcedureGuidance, Any]:
+        """The procedure guidance and the vertical law (None: the scenario's) for a flight."""
+        g = ProcedureGuidance(self.path, cfg, db=self.db, spec=self.spec,
+                              log_every=runner_log_every(scn))
+        law = procedure_law(cfg) if scn.vertical_law == "coupled" and cfg.coupled_law else None
+        return g, law
+
+
+def prepare(raw: dict, source: str = "<scenario>", db=None
+            ) -> tuple[Scenario, ProcedureSpec, FlyablePath, Any]:
+    """Validate a scenario mapping that has a ``procedure:`` block and build the procedure.
+
+    ``initial`` defaults to the start of the built path (:func:`initial_from_path`) and
+    ``duration_s`` to 1.6 × the path length at the planned speed + 120 s (guidance ends the
+    flight at the end of the procedure anyway), ``outer_rate_hz`` to :data:`OUTER_RATE_HZ`.
+
+    Returns
+    -------
+    (scenario, procedure spec, built procedure, database)
+    """
+    raw = dict(raw)
+    if "procedure" not in raw:
+        raise ConfigError(f"{source}: a procedure flight needs a 'procedure:' block")
+    spec = parse_procedure(raw["procedure"], source)
+    if "aircraft" not in raw:
+        raise ConfigError(f"{source}: field 'aircraft': missing")
+    cfg = load_aircraft(raw["aircraft"])
+    if db is None:
+        base = Path(source).parent if source and not source.startswith("<") else None
+        db = load_db(spec.db, base)
+    fp = build_procedure(db, spec, cfg)
+    raw.setdefault("initial", initial_from_path(fp, cfg))
+    raw.setdefault("duration_s", min(6 * 3600.0, 1.6 * fp.path.length_m()
+                                     / cfg.limits.climb_tas_mps + 120.0))
+    raw.setdefault("name", f"{spec.airport}-{spec.procedure}".lower())
+    raw.setdefault("outer_rate_hz", OUTER_RATE_HZ)
+    raw["procedure"] = spec.model_dump(exclude_none=True)
+    return parse_scenario(raw, source), spec, fp, db
+
+
+def load_procedure_scenario(path: str | Path):
+    """Read a procedure scenario YAML file and :func:`prepare` it."""
+    path = Path(path)
+    raw = read_mapping(path, "scenario file")
+    raw.setdefault("name", path.stem)
+    return prepare(raw, str(path))
+
+
+def prepare_procedure(raw: dict, source: str = "<scenario>", db=None
+                      ) -> tuple[Scenario, PreparedProcedure]:
+    """:func:`prepare`, returning the scenario and a :class:`PreparedProcedure`."""
+    scn, spec, fp, db = prepare(raw, source, db)
+    return scn, PreparedProcedure(spec, fp, db)

@@ -1,0 +1,40 @@
+"""Navigation sources: what guidance flies on.
+
+A source turns the true state (and, on the truth side, its sensors' errors) into a
+:class:`~fms_testbed.core.state.NavSolution`. Sources are registered by name in :data:`SOURCES`;
+a scenario picks one with ``navigation: {source: NAME, ...}``. A new source is a class with
+``from_spec(spec, seed)`` and ``update(truth) -> NavSolution``, added to :data:`SOURCES` — nothing
+else changes.
+"""
+
+from __future__ import annotations
+
+from fms_testbed.core.contracts import NavigationSource
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.navigation.sins import SinsNavigation
+from fms_testbed.navigation.truth import TruthNavigation
+
+#: Source name (``navigation.source`` in a scenario) → class with ``from_spec(spec, seed)``.
+SOURCES: dict[str, type] = {
+    "truth": TruthNavigation,
+    "sins": SinsNavigation,
+}
+
+
+def make_source(spec: dict | None, seed: int | None = None) -> NavigationSource:
+    """Build the navigation source a scenario's ``navigation`` block names (``None``: truth).
+
+    Parameters
+    ----------
+    spec : the ``navigation:`` mapping (``source`` plus the source's own keys)
+    seed : seed for the source's error realisation
+    """
+    spec = dict(spec or {})
+    name = spec.get("source", "truth")
+    if name not in SOURCES:
+        raise ConfigError(f"field 'navigation.source': unknown source {name!r} "
+                          f"(available: {', '.join(SOURCES)})")
+    return SOURCES[name].from_spec(spec, seed=seed)
+
+
+__all__ = ["SOURCES", "make_source", "NavigationSource", "TruthNavigation", "SinsNavigation"]

@@ -1,0 +1,293 @@
+"""The built-in parameter monitor (Danilin 2017, Fig. 5) and the per-procedure outcome.
+
+The computed vector X = (φ, λ, Ω, R, V, γ, Θ) of the built path is compared with the database
+and performance values: fixes where the database puts them (φ, λ), RF radius and arc angle
+(R, Ω), planned speed against coded limits (V), |γ| ≤ 25° (γ), and the climb gradient window
+3.3 % ≤ Θ ≤ Θ_perf. Failures are corrected in the paper's order — R; V,γ; γ; V,Θ; V,γ,φ,λ — each
+with a bounded number of iterations (the fly-by branches R, V,γ and V,γ,φ,λ run while the
+corners are rounded, see ``segmentation.round_corners``). If no branch succeeds the outcome is
+"impossible" with the reason. The monitor also flags discontinuities, looping or duplicated
+paths (the paper's Fig. 4 coding error) and intercepts that never happen.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+
+from fms_testbed.core.geodesy import inverse, wrap180
+from fms_testbed.core.segments import Arc, project
+from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
+from fms_testbed.path.profile import plan_profile
+
+NM_M = 1852.0
+KT = 1852.0 / 3600.0
+#: Tolerances: RF radius vs coded (the FAA data agree within 0.049 NM), fly-over pass, gaps.
+RF_RADIUS_TOL_M = 0.05 * NM_M
+FIX_TOL_M = 1.0
+GAP_TOL_M = 1.0
+#: Largest track change between consecutive segments not flagged as a kink, deg.
+KINK_TOL_DEG = 10.0
+#: Legs whose end is a database fix the path must honour.
+FIX_LEGS = frozenset({"TF", "CF", "DF", "IF", "RF", "AF"})
+
+
+@dataclass(frozen=True, slots=True)
+class FixCheck:
+    """Distance from a fix-terminated leg's end to its fix, with the allowed distance, m."""
+
+    leg_index: int
+    fix_ident: str
+    miss_m: float
+    allowed_m: float
+    fly_over: bool
+
+
+def leg_end_checks(path: ProcedurePath) -> list[FixCheck]:
+    """(φ, λ) check: every TF/CF/DF/IF/RF/AF leg ends at its fix — over it when fly-over,
+    within the turn anticipation L = R tan(Ω/2) of the fly-by arc that replaces the corner."""
+    out = []
+    own: dict[int, int] = {}
+    for k, seg in enumerate(path.segments):
+        own[seg.leg_index] = k
+    for lg in path.legs:
+        if lg.path_term not in FIX_LEGS or lg.termination.kind != "fix":
+            continue
+        allowed = FIX_TOL_M
+        k = own.get(lg.index)
+        if k is None:
+            end = (lg.end.lat_deg, lg.end.lon_deg)
+        elif path.segments[k].role == "flyby":
+            arc = path.segments[k].geom
+            allowed += path.segments[k].lead_m or \
+                arc.radius_m * math.tan(math.radians(abs(arc.sweep_deg)) / 2.0)
+            end = arc.start
+        else:
+            end = path.segments[k].geom.end
+        t = lg.termination
+        miss = inverse(end[0], end[1], t.lat_deg, t.lon_deg)[0]
+        out.append(FixCheck(lg.index, t.fix_ident, miss, allowed, lg.record.fly_over))
+    return out
+
+
+def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
+                g: float) -> list[Finding]:
+    """(R, Ω, γ) checks of the coded arcs (RF, AF) with the γ and V,γ corrections."""
+    out = []
+    gplan = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    for lg in path.legs:
+        if lg.path_term not in ("RF", "AF"):
+            continue
+        arcs = [s for s in path.segments if s.leg_index == lg.index and isinstance(s.geom, Arc)
+                and s.role == "leg"]
+        if not arcs:
+            continue
+        arc = arcs[0].geom
+        r = lg.record
+        if r.turn_dir in ("L", "R") and arc.turn != r.turn_dir:
+            out.append(Finding(lg.index, "impossible", f"{lg.path_term} arc turns {arc.turn}, "
+                               f"coded {r.turn_dir}"))
+        if lg.path_term == "RF" and lg.index > 0 and path.legs[lg.index - 1].record.fix \
+                and path.legs[lg.index - 1].termination.kind == "fix" and r.fix is not None:
+            # Ω: the angle the database's fixes subtend about the coded centre
+            t0 = path.legs[lg.index - 1].termination
+            _, a0, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, t0.lat_deg, t0.lon_deg)
+            _, a1, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, lg.termination.lat_deg,
+                               lg.termination.lon_deg)
+            omega_k = (a1 - a0) % 360.0 if arc.turn == "R" else (a0 - a1) % 360.0
+            built = sum(abs(s.geom.sweep_deg) for s in arcs)
+            if abs(built - omega_k) > 1.0 and abs(built - omega_k) < 359.0:
+                out.append(Finding(lg.index, "discontinuity", f"RF arc angle built "
+                                   f"{built:.1f}° vs {omega_k:.1f}° between its fixes"))
+        coded_r = r.arc_radius_m if lg.path_term == "RF" else r.rho_m
+        if coded_r:
+            dr = arc.radius_m - coded_r
+            tol = RF_RADIUS_TOL_M if lg.path_term == "RF" else 0.6 * NM_M
+            if abs(dr) > tol:
+                out.append(Finding(lg.index, "correction",
+                                   f"{lg.path_term} radius coded {coded_r / NM_M:.3f} NM, fixes "
+                                   f"give {arc.radius_m / NM_M:.3f} NM: path follows the fixes",
+                                   "R"))
+        v = lg.speed_mps
+        for _ in range(params.max_iterations):
+            g_req = math.degrees(math.atan(v * v / (arc.radius_m * g)))
+            if g_req <= gplan + 1e-9:
+                break
+            if g_req <= gmax:
+                out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
+                                   f"{arc.radius_m / NM_M:.2f} NM at {v / KT:.0f} kt: bank "
+                                   f"{gplan:.0f} -> {g_req:.1f}°", "γ"))
+                break
+            v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax)))
+            if v_reg >= perf.tas_min_mps:
+                out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
+                                   f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT:.0f} -> "
+                                   f"{v_reg / KT:.0f} kt at bank {gmax:.0f}°", "V,γ"))
+                break
+            out.append(Finding(lg.index, "impossible", f"{lg.path_term} radius "
+                               f"{arc.radius_m / NM_M:.2f} NM needs bank {g_req:.0f}° > "
+                               f"{gmax:.0f}° even at the minimum speed {v_reg / KT:.0f} kt"))
+            break
+    return out
+
+
+def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
+                     start_alt_m: float) -> tuple[list[Finding], object]:
+    """Θ window: 3.3 % ≤ Θ ≤ Θ_perf in climbs, descent within the descent rate; branch V,Θ."""
+    out = []
+    v = perf.tas_plan_mps
+    theta_perf = perf.climb_gradient_at(v)
+    climbs = path.proc_type == "D" or any(lg.record.missed_approach_start for lg in path.legs)
+    if climbs and theta_perf < params.climb_min_gradient:
+        v_need = perf.climb_gradient_max * perf.tas_plan_mps / params.climb_min_gradient
+        if v_need >= perf.tas_min_mps:
+            out.append(Finding(-1, "correction", f"climb gradient {100 * theta_perf:.1f}% < 3.3%:"
+                               f" speed {v / KT:.0f} -> {v_need / KT:.0f} kt", "V,Θ"))
+            v = v_need
+            theta_perf = perf.climb_gradient_at(v)
+        else:
+            out.append(Finding(-1, "impossible", f"aircraft climb gradient "
+                               f"{100 * theta_perf:.1f}% below the 3.3% minimum"))
+    prof = plan_profile(path, theta_perf, start_alt_m, params.descent_angle_deg)
+    if path.proc_type == "D" and path.start_kind != "runway" and prof.windows:
+        # the aircraft arrives from an earlier transition at an unknown altitude: assume it
+        # just makes the first climb constraint and check the rest
+        w = next((w for w in prof.windows if w.lo_m is not None), None)
+        if w is not None:
+            a0 = w.lo_m - theta_perf * prof.along_m[w.leg_index + 1]
+            if a0 > start_alt_m:
+                prof = plan_profile(path, theta_perf, a0, params.descent_angle_deg)
+    for w in prof.windows:
+        k = w.leg_index + 1
+        if not prof.climb[k] or w.lo_m is None or prof.alt_m[k] >= w.lo_m - 1.0:
+            continue
+        if path.legs[w.leg_index].path_term in ("HA", "HF", "HM", "CA", "FA", "VA"):
+            continue  # altitude-terminated or reached in the hold: met by construction
+        nxt = path.legs[w.leg_index + 1] if w.leg_index + 1 < len(path.legs) else None
+        if nxt is not None and nxt.path_term in ("HA", "HF", "HM") and nxt.record.fix \
+                and nxt.record.fix.ident == w.fix_ident:
+            continue  # climb in the hold that follows at the same fix
+        # find the last node where the climb was free to start from
+        j = k - 1
+        ds = prof.along_m[k] - prof.along_m[j]
+        while j > 0 and prof.climb[j] and ds < 1.0:
+            j -= 1
+            ds = prof.along_m[k] - prof.along_m[j]
+        need = (w.lo_m - prof.alt_m[j]) / max(prof.along_m[k] - prof.along_m[0], 1.0) \
+            if j == 0 else (w.lo_m - prof.alt_m[j]) / max(ds, 1.0)
+        need = max(need, (w.lo_m - prof.alt_m[0]) / max(prof.along_m[k], 1.0))
+        name = w.fix_ident or f"the end of {path.legs[w.leg_index].path_term}"
+        ok = False
+        vv = v
+        for _ in range(params.max_iterations):
+            vv = max(perf.tas_min_mps, vv * min(theta_perf / need, 0.97))
+            if perf.climb_gradient_at(vv) >= need:
+                ok = True
+                break
+        if ok:
+            out.append(Finding(w.leg_index, "correction", f"{name} at or above "
+                               f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.1f}% climb: speed "
+                               f"{v / KT:.0f} -> {vv / KT:.0f} kt", "V,Θ"))
+        else:
+            out.append(Finding(w.leg_index, "impossible", f"{name} at or above "
+                               f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.2f}% climb, aircraft "
+                               f"max {100 * perf.climb_gradient_at(perf.tas_min_mps):.2f}% at "
+                               "minimum speed"))
+    grads = prof.gradients()
+    for k in range(1, len(prof.alt_m)):
+        if prof.climb[k] or not grads[k - 1] < 0:
+            continue
+        need = -grads[k - 1]
+        cap = perf.descent_rate_max_mps / v
+        if need <= cap * 1.005:
+            continue
+        v_reg = perf.descent_rate_max_mps / need
+        lg = path.legs[k - 1]
+        ident = lg.record.fix.ident if lg.record.fix else lg.path_term
+        if v_reg >= perf.tas_min_mps:
+            out.append(Finding(k - 1, "correction", f"descent to {ident} needs "
+                               f"{100 * need:.1f}%: speed {v / KT:.0f} -> {v_reg / KT:.0f} kt",
+                               "V,Θ"))
+        else:
+            out.append(Finding(k - 1, "impossible", f"descent to {ident} needs "
+                               f"{100 * need:.1f}% (> {100 * perf.descent_rate_max_mps / perf.tas_min_mps:.1f}% "
+                               "at minimum speed)"))
+    return out, prof
+
+
+def _topology_checks(path: ProcedurePath) -> list[Finding]:
+    """Gaps between segments, duplicated/looping paths (Fig. 4) and doubled-back legs."""
+    out = []
+    segs = path.segments
+    for k in range(1, len(segs)):
+        a, b = segs[k - 1], segs[k]
+        gap = inverse(*a.geom.end, *b.geom.start)[0]
+        if gap > GAP_TOL_M:
+            out.append(Finding(b.leg_index, "discontinuity",
+                               f"gap of {gap:.1f} m before leg {b.leg_index + 1}"))
+        elif "connector" not in (a.role, b.role) and a.geom.length_m() > 1.0 \
+                and b.geom.length_m() > 1.0:
+            jump = abs(wrap180(b.geom.start_course_deg - a.geom.end_course_deg))
+            if jump > KINK_TOL_DEG:
+                out.append(Finding(b.leg_index, "discontinuity", f"track jumps by {jump:.0f}° "
+                                   f"in leg {b.leg_index + 1} ({b.path_term})"))
+    seen: dict[tuple[str, str], int] = {}
+    prev_fix = ""
+    for lg in path.legs:
+        r = lg.record
+        f = r.fix.ident if r.fix else ""
+        if lg.path_term in ("TF", "CF", "DF") and prev_fix and f:
+            key = (prev_fix, f)
+            if key in seen:
+                out.append(Finding(lg.index, "loop", f"path {prev_fix}->{f} flown twice "
+                                   f"(legs {seen[key] + 1} and {lg.index + 1})"))
+            seen.setdefault(key, lg.index)
+        prev_fix = f if lg.termination.kind == "fix" else ""
+    lines = [s for s in segs if s.geom.kind == "line" and s.role == "leg"
+             and s.geom.length_m() > 100.0]
+    for a, b in zip(lines, lines[1:]):
+        if b.leg_index == a.leg_index + 1 and \
+                abs(wrap180(b.geom.start_course_deg - a.geom.end_course_deg)) > 175.0 and \
+                a.path_term not in ("PI", "HM", "HF", "HA") and \
+                b.path_term not in ("PI", "HM", "HF", "HA"):
+            mid = b.geom.point_at(0.5 * b.geom.length_m())
+            along, xtk, _, _ = project(a.geom, *mid)
+            if abs(xtk) < 100.0 and -100.0 < along < a.geom.length_m() + 100.0:
+                out.append(Finding(b.leg_index, "loop", f"leg {b.leg_index + 1} doubles back "
+                                   f"over leg {a.leg_index + 1}"))
+    return out
+
+
+def outcome(findings) -> str:
+    """'impossible' if any finding says so, 'corrected' if the plan was changed, else 'ok'."""
+    cats = {f.category for f in findings}
+    if "impossible" in cats:
+        return "impossible"
+    if cats & {"correction", "no-intercept", "discontinuity"}:
+        return "corrected"
+    return "ok"
+
+
+def check_path(path: ProcedurePath, perf: Performance, params: BuildParams | None = None,
+               g_mps2: float = 9.80665) -> ProcedurePath:
+    """Run the monitor on a built path; return it with findings, profile and status.
+
+    Parameters
+    ----------
+    path : built procedure transition (``segmentation.build_sequence``)
+    perf : aircraft performance; params : build settings; g_mps2 : local gravity, m/s²
+    """
+    params = params or BuildParams()
+    if not path.legs:
+        return replace(path, status=outcome(path.findings) if path.findings else "impossible")
+    findings = list(path.findings)
+    for fc in leg_end_checks(path):
+        if fc.miss_m > fc.allowed_m:
+            findings.append(Finding(fc.leg_index, "impossible", f"path misses {fc.fix_ident} by "
+                                    f"{fc.miss_m:.1f} m (allowed {fc.allowed_m:.1f} m)"))
+    findings += _arc_checks(path, perf, params, g_mps2)
+    grad, prof = _gradient_checks(path, perf, params, path.legs[0].start.alt_m)
+    findings += grad
+    findings += _topology_checks(path)
+    return replace(path, findings=tuple(findings), profile=prof, status=outcome(findings))

@@ -1,0 +1,235 @@
+"""What to fly: the scenario's ``procedure:`` block, selection of the ARINC-424 sequences that
+make one flyable procedure, and (re)building it into a :class:`ProcedurePath`.
+
+A flyable procedure is the concatenation of the database's transitions, in flying order:
+
+* SID:  runway transition (``RWxx`` / ``RWxxB``) → common route → en-route transition
+* STAR: en-route transition → common route → runway transition
+* approach: approach transition (route type ``A``) → final approach, cut at the missed-approach
+  point (an approach ends at the runway/MAP: the flight stops there)
+
+The ``IF`` that starts a later part is dropped when it repeats the fix the previous part ends at.
+The path itself comes from the issue-4 builder (``arinc424.segmentation.build_sequence``) and
+monitor (``arinc424.monitor.check_path``); :func:`rebuild_from` builds the rest of a procedure
+from the aircraft's actual state when a conditional leg ends in flight.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from fms_testbed.config.procedure import ProcedureSpec, parse_procedure  # noqa: F401 (re-export)
+from fms_testbed.core.errors import ConfigError, UserError
+
+NM_M = 1852.0
+FT_M = 0.3048
+
+
+def load_db(spec_db: str, base: Path | None = None):
+    """Load an ARINC-424 database ('embedded' = the excerpt in ``procedures/``)."""
+    from fms_testbed.procedures.database import load_database
+
+    if spec_db in ("", "embedded"):
+        return load_database(None)
+    p = Path(spec_db)
+    if not p.is_absolute() and base is not None and not p.exists():
+        p = base / p
+    return load_database(p)
+
+
+def _is_rw(t: str) -> bool:
+    return t.startswith("RW")
+
+
+def _runway_match(trans: str, runway: str) -> bool:
+    rw = runway if runway.startswith("RW") else "RW" + runway
+    if trans == rw:
+        return True
+    # 'RW16B' serves 16L/16C/16R
+    return trans.endswith("B") and rw[:-1] == trans[:-1] and rw[-1] in "LRC"
+
+
+def select_parts(db, airport: str, procedure: str, transition: str | None,
+                 runway: str | None) -> list:
+    """The database sequences that make the procedure, in flying order (module docstring).
+
+    Raises
+    ------
+    UserError naming the procedure and the transitions it has, when a part is missing.
+    """
+    seqs = db.select(airport, procedure)
+    kind = seqs[0].proc_type
+    name = f"{airport} {procedure}"
+    trans = sorted({s.transition for s in seqs})
+    if kind == "F":
+        final = [s for s in seqs if s.route_type != "A"]
+        if not final:
+            raise UserError(f"{name}: no final approach sequence in the database")
+        parts = []
+        if transition:
+            t = [s for s in seqs if s.route_type == "A" and s.transition == transition]
+            if not t:
+                raise UserError(f"{name}: no approach transition {transition!r}; transitions: "
+                                f"{', '.join(x for x in trans if x) or 'none'}")
+            parts.append(t[0])
+        parts.append(final[0])
+        return parts
+    rw = [s for s in seqs if _is_rw(s.transition)]
+    common = [s for s in seqs if s.transition in ("", "ALL")]
+    enroute = [s for s in seqs if s.transition not in ("", "ALL") and not _is_rw(s.transition)]
+    rw_part = []
+    if runway:
+        rw_part = [s for s in rw if _runway_match(s.transition, runway)][:1]
+        if not rw_part:
+            raise UserError(f"{name}: no runway transition for {runway!r}; runway transitions: "
+                            f"{', '.join(s.transition for s in rw) or 'none'}")
+    en_part = []
+    if transition:
+        en_part = [s for s in enroute if s.transition == transition][:1]
+        if not en_part:
+            raise UserError(f"{name}: no transition {transition!r}; transitions: "
+                            f"{', '.join(s.transition for s in enroute) or 'none'}")
+    parts = (rw_part + common[:1] + en_part) if kind == "D" else (en_part + common[:1] + rw_part)
+    if not parts:
+        raise UserError(f"{name}: give --runway or --transition (runway transitions: "
+                        f"{', '.join(s.transition for s in rw) or 'none'}; transitions: "
+                        f"{', '.join(s.transition for s in enroute) or 'none'})")
+    return parts
+
+
+def merge_parts(parts: list):
+    """One :class:`~fms_testbed.procedures.database.Sequence` from the parts; the approach is cut
+    at its missed-approach point."""
+    legs = list(parts[0].legs)
+    for p in parts[1:]:
+        nxt = list(p.legs)
+        if nxt and nxt[0].path_term == "IF" and legs and legs[-1].fix is not None \
+                and nxt[0].fix is not None and nxt[0].fix.ident == legs[-1].fix.ident:
+            nxt = nxt[1:]
+        legs += nxt
+    if parts[0].proc_type == "F":
+        cut = next((i for i, lg in enumerate(legs) if lg.missed_approach_start), len(legs))
+        legs = legs[:cut]
+    trans = "+".join(p.transition for p in parts if p.transition)
+    return replace(parts[-1], transition=trans, legs=tuple(legs))
+
+
+PLAN_CLIMB_FRACTION = 0.75
+"""The plan climbs at this fraction of the aircraft's sustained climb rate (margin for the
+law to catch up after turns and speed changes)."""
+
+
+def plan_climb_rate_mps(cfg) -> float:
+    """Planned climb rate, m/s: PLAN_CLIMB_FRACTION × ``limits.climb_rate_max_mps``."""
+    return PLAN_CLIMB_FRACTION * cfg.limits.climb_rate_max_mps
+
+
+@dataclass(frozen=True)
+class FlyablePath:
+    """A built procedure and what guidance needs besides it.
+
+    path: the built and checked :class:`ProcedurePath` (profile attached); seq: the merged
+    sequence it came from; leg_offset: index of its first leg in the whole procedure (non-zero
+    after an in-flight rebuild); rnp_m: RNP per leg, m.
+    """
+
+    path: object
+    seq: object
+    leg_offset: int
+    rnp_m: tuple[float, ...]
+
+
+def _perf_params(cfg, spec: ProcedureSpec):
+    from fms_testbed.legs.model import BuildParams, Performance
+
+    perf = Performance.from_aircraft(cfg)
+    grad = spec.climb_gradient or plan_climb_rate_mps(cfg) / perf.tas_plan_mps
+    perf = replace(perf, climb_gradient_max=min(grad, perf.climb_gradient_max))
+    params = BuildParams(manual_leg_m=spec.manual_leg_nm * NM_M,
+                         bank_limit_deg=min(25.0, cfg.limits.bank_max_deg))
+    return perf, params
+
+
+def _rnp(seq, spec: ProcedureSpec, offset: int = 0) -> tuple[float, ...]:
+    default = 0.3 if seq.proc_type == "F" else 1.0
+    out = []
+    for lg in seq.legs[offset:]:
+        v = lg.rnp_nm if lg.rnp_nm else (spec.rnp_nm or default)
+        out.append(v * NM_M)
+    return tuple(out)
+
+
+def _finish(path, seq, spec, cfg, perf, params, offset: int) -> FlyablePath:
+    from fms_testbed.path.monitor import check_path
+    from fms_testbed.path.profile import plan_profile
+
+    checked = check_path(path, perf, params)
+    if checked.legs:
+        grad = perf.climb_gradient_at(perf.tas_plan_mps)
+        prof = plan_profile(checked, grad, checked.legs[0].start.alt_m,
+                            climb_top_m=spec.climb_top_ft * FT_M)
+        checked = replace(checked, profile=prof)
+    return FlyablePath(checked, seq, offset, _rnp(seq, spec, 0))
+
+
+def build_procedure(db, spec: ProcedureSpec, cfg) -> FlyablePath:
+    """Select, merge, build and check the procedure a spec names, for aircraft ``cfg``.
+
+    Raises
+    ------
+    UserError when the procedure cannot be found or is impossible to build (with the monitor's
+    reason).
+    """
+    from fms_testbed.path.segmentation import build_sequence
+
+    seq = merge_parts(select_parts(db, spec.airport, spec.procedure, spec.transition,
+                                   spec.runway))
+    perf, params = _perf_params(cfg, spec)
+    path = build_sequence(db, seq, perf, params)
+    start_alt = spec.start_alt_ft * FT_M if spec.start_alt_ft is not None else None
+    if start_alt is None and seq.proc_type == "D" and path.start_kind != "runway" and path.legs:
+        # a SID that starts at a fix (the runway part is vectors): arrive there at its
+        # 'at or above' altitude, not at runway height
+        from fms_testbed.path.profile import window
+        r0 = seq.legs[0]
+        lo, _ = window(r0.alt_desc, r0.alt1_m, r0.alt2_m)
+        if lo is not None and lo > path.legs[0].start.alt_m:
+            start_alt = lo
+    if start_alt is not None and path.legs:
+        from fms_testbed.legs.model import FlightState
+        st = path.legs[0].start
+        start = FlightState(st.lat_deg, st.lon_deg, st.track_deg, start_alt,
+                            st.flyby, st.fix_ident)
+        path = replace(build_sequence(db, seq, perf, params, start=start),
+                       start_kind=path.start_kind)
+    fp = _finish(path, seq, spec, cfg, perf, params, 0)
+    if fp.path.status == "impossible" or not fp.path.segments:
+        why = "; ".join(f.message for f in fp.path.findings if f.category == "impossible")
+        raise UserError(f"{seq.name}: the monitor finds the procedure impossible to fly: "
+                        f"{why or 'no path segments'}")
+    return fp
+
+
+def rebuild_from(db, whole: FlyablePath, spec: ProcedureSpec, cfg, next_leg: int,
+                 lat_deg: float, lon_deg: float, track_deg: float, alt_m: float
+                 ) -> FlyablePath | None:
+    """Build legs ``next_leg..`` of the procedure from the aircraft's actual state.
+
+    Used when a conditional leg (altitude, DME, radial) ends in flight somewhere other than
+    planned. Returns None when nothing is left or the rest cannot be built.
+    """
+    from fms_testbed.legs.model import FlightState
+    from fms_testbed.path.segmentation import build_sequence
+
+    legs = whole.seq.legs[next_leg:]
+    if not legs:
+        return None
+    seq = replace(whole.seq, legs=legs)
+    perf, params = _perf_params(cfg, spec)
+    start = FlightState(lat_deg, lon_deg, track_deg, alt_m)
+    path = build_sequence(db, seq, perf, params, start=start)
+    if not path.segments or path.status == "impossible":
+        return None
+    fp = _finish(path, seq, spec, cfg, perf, params, next_leg)
+    return replace(fp, rnp_m=whole.rnp_m[next_leg:])

@@ -1,0 +1,185 @@
+"""Planned vertical profile from the coded altitude constraints and climb/descent gradients.
+
+Nodes are the path start and every leg end (distance along the built path, m). Climb phases
+(SIDs, missed approaches) climb at the aircraft's gradient, level off below every 'at or
+below' constraint ahead and at the highest climb constraint still ahead (with none: the coded
+transition altitude, else 18,000 ft); descent phases are planned backwards from the last constrained fix at
+the coded vertical angle (else 3°), clamped into each fix's altitude window, never above
+the start altitude or the highest coded altitude, and never climbing within a descent phase. One geometry feeds
+both: the distances come from the same segments the map and guidance use.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fms_testbed.legs.model import ProcedurePath
+
+
+@dataclass(frozen=True, slots=True)
+class AltitudeWindow:
+    """Altitude constraint at a leg end: lo_m ≤ alt ≤ hi_m (None = unbounded), m."""
+
+    leg_index: int
+    fix_ident: str
+    along_m: float
+    desc: str
+    lo_m: float | None
+    hi_m: float | None
+
+
+@dataclass(frozen=True)
+class VerticalProfile:
+    """Planned altitude along the path.
+
+    along_m, alt_m: node distances from the path start (m) and planned altitudes (m);
+    climb: per node, True where the segment ending at that node is a climb phase;
+    windows: the coded constraints.
+    """
+
+    along_m: np.ndarray
+    alt_m: np.ndarray
+    climb: np.ndarray
+    windows: tuple[AltitudeWindow, ...]
+
+    def alt_at(self, s_m: float | np.ndarray) -> float | np.ndarray:
+        """Planned altitude at distance ``s_m`` (m) along the path, m."""
+        return np.interp(s_m, self.along_m, self.alt_m)
+
+    def gradients(self) -> np.ndarray:
+        """Rise over run of each node-to-node piece (dimensionless; NaN for zero length)."""
+        ds = np.diff(self.along_m)
+        dh = np.diff(self.alt_m)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(ds > 1.0, dh / ds, np.nan)
+
+
+def window(desc: str, alt1_m: float | None, alt2_m: float | None
+           ) -> tuple[float | None, float | None]:
+    """(lo_m, hi_m) from an ARINC-424 altitude descriptor (column 83) and its two altitudes."""
+    if alt1_m is None:
+        return None, None
+    if desc in ("+", "H", "J", "V"):
+        return alt1_m, None
+    if desc in ("-", "Y"):
+        return None, alt1_m
+    if desc == "B" and alt2_m is not None:
+        return min(alt1_m, alt2_m), max(alt1_m, alt2_m)
+    if desc == "C" and alt2_m is not None:
+        return alt2_m, None
+    return alt1_m, alt1_m  # '', '@', 'X', 'G', 'I': at
+
+
+def leg_end_distances(path: ProcedurePath) -> np.ndarray:
+    """Distance along the path (m) at the end of each built leg."""
+    ends = np.zeros(len(path.legs))
+    s = 0.0
+    per_leg: dict[int, float] = {}
+    for seg in path.segments:
+        s += seg.geom.length_m()
+        per_leg[seg.leg_index] = s
+    last = 0.0
+    for k, lg in enumerate(path.legs):
+        last = per_leg.get(lg.index, last)
+        ends[k] = last
+    return ends
+
+
+def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
+                 descent_angle_deg: float = 3.0, climb_top_m: float | None = None
+                 ) -> VerticalProfile:
+    """Plan the vertical profile of a built path.
+
+    Parameters
+    ----------
+    path : the built procedure transition
+    climb_gradient : planned climb gradient (rise over run) for climb phases
+    start_alt_m : altitude at the path start, m
+    descent_angle_deg : default descent path angle where no vertical angle is coded, deg
+    climb_top_m : where a climb levels off, m (raised to the highest climb constraint ahead);
+        None: the highest climb constraint ahead, else the coded transition altitude, else
+        18,000 ft (the database check). A flight passes its own climb top so that the planned
+        profile and the flown climb level at the same altitude.
+    """
+    n = len(path.legs)
+    ends = leg_end_distances(path)
+    windows = []
+    climb = np.zeros(n + 1, dtype=bool)
+    climbing = path.proc_type == "D"
+    for k, lg in enumerate(path.legs):
+        r = lg.record
+        if r.missed_approach_start:
+            climbing = True
+        climb[k + 1] = climbing
+        lo, hi = window(r.alt_desc, r.alt1_m, r.alt2_m)
+        if lo is not None or hi is not None:
+            windows.append(AltitudeWindow(k, r.fix.ident if r.fix else "", ends[k], r.alt_desc,
+                                          lo, hi))
+    along = np.concatenate(([0.0], ends))
+    alt = np.full(n + 1, start_alt_m)
+    lo_at = [None] * (n + 1)
+    hi_at = [None] * (n + 1)
+    for w in windows:
+        lo_at[w.leg_index + 1], hi_at[w.leg_index + 1] = w.lo_m, w.hi_m
+    # descent: backward pass from the last descent node, then clamp into windows
+    desc_idx = [k for k in range(1, n + 1) if not climb[k]]
+    coded = [v for w in windows for v in (w.lo_m, w.hi_m) if v is not None]
+    ceiling = max([start_alt_m] + coded)   # never plan above the start or any coded altitude
+    if desc_idx:
+        last = desc_idx[-1]
+        h = next((lo_at[k] if lo_at[k] is not None else hi_at[k]
+                  for k in reversed(desc_idx) if lo_at[k] is not None or hi_at[k] is not None),
+                 start_alt_m)
+        alt[last] = h
+        for k in range(last - 1, -1, -1):
+            ang = descent_angle_deg
+            vpa = path.legs[k].record.vpa_deg if k < n else None
+            if vpa:
+                ang = abs(vpa)
+            h = alt[k + 1] + math.tan(math.radians(ang)) * (along[k + 1] - along[k])
+            h = min(h, ceiling)
+            if hi_at[k] is not None:
+                h = min(h, hi_at[k])
+            if lo_at[k] is not None:
+                h = max(h, lo_at[k])
+            alt[k] = h if k > 0 else min(h, max(start_alt_m, alt[1]))
+        # forward pass: no steeper than the planned angle where the windows allow staying high
+        for k in range(1, last + 1):
+            ang = descent_angle_deg
+            vpa = path.legs[k - 1].record.vpa_deg
+            if vpa:
+                ang = abs(vpa)
+            floor = alt[k - 1] - math.tan(math.radians(ang)) * (along[k] - along[k - 1])
+            if floor > alt[k]:
+                alt[k] = floor if hi_at[k] is None else min(floor, max(hi_at[k], alt[k]))
+        # a descent phase never climbs: after the last constraint (e.g. a STAR ending in vectors)
+        # the backward pass from the final node can plan above an earlier 'at' fix
+        for k in range(1, n + 1):
+            if not climb[k] and not climb[k - 1] and alt[k] > alt[k - 1]:
+                alt[k] = max(alt[k - 1], lo_at[k] if lo_at[k] is not None else -np.inf)
+    # climb: forward pass, capped by every 'at or below' ahead and levelling off at the
+    # highest climb constraint still ahead (else the coded transition altitude, else 18,000 ft)
+    cap = np.full(n + 1, np.inf)
+    run = np.inf
+    top = -np.inf
+    trans = next((lg.record.trans_alt_m for lg in path.legs if lg.record.trans_alt_m), None)
+    for k in range(n, -1, -1):
+        if climb[k]:
+            if hi_at[k] is not None:
+                run = min(run, hi_at[k])
+                top = max(top, hi_at[k])
+            elif lo_at[k] is not None:
+                top = max(top, lo_at[k])
+        if climb_top_m is not None:
+            level = max(top, climb_top_m)
+        else:
+            level = top if np.isfinite(top) else (trans if trans else 18000 * 0.3048)
+        cap[k] = min(run, level)
+    for k in range(1, n + 1):
+        if climb[k]:
+            base = alt[k - 1]
+            alt[k] = min(base + climb_gradient * (along[k] - along[k - 1]), max(cap[k], base))
+    return VerticalProfile(along, alt, climb, tuple(windows))

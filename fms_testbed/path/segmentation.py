@@ -1,0 +1,407 @@
+"""Segmentation of a procedure transition into geodesic lines and circular arcs.
+
+:func:`build_sequence` resolves the legs, chooses the start (departure end of the runway for a
+SID runway transition, else the first fix), runs each leg's class, then rounds every fly-by
+corner with an arc of radius R = V²/(g tan γ) and turn anticipation L = R tan(Ω/2) (Danilin 2017,
+Fig. 2). When the lead does not fit between the neighbouring fixes the paper's monitor
+corrections apply in order (R; V,γ; V,γ,φ,λ) with the formulas
+
+    R_geom = L_avail / tan(Ω/2)
+    γ_reg  = atan(V² / (R_geom g))      (when ≤ γ_max: branch R, V kept)
+    V_reg  = sqrt(R_geom g tan γ_max)   (branch V,γ, when V_reg ≥ V_min)
+
+and, failing both, the turn is flown over the fix and rejoins (branch V,γ,φ,λ).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+from fms_testbed.core.geodesy import LocalFrame, direct, gravity_mps2, inverse, wrap180, wrap360
+from fms_testbed.core.segments import Arc, Line
+from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
+from fms_testbed.legs.construct import turn_arc
+from fms_testbed.procedures.database import Database, Sequence
+from fms_testbed.procedures.records import Fix
+from fms_testbed.legs.types import LEG_TYPES, LegError
+from fms_testbed.legs.model import (BuildParams, BuiltLeg, Finding, FlightState, Performance, PathSegment,
+                    ProcedurePath, isa_tas_mps, turn_radius_m)
+
+FT_M = 0.3048
+#: Leg types that end at their fix (the next TF starts from that fix).
+FIX_ENDING = frozenset({"IF", "TF", "CF", "DF", "RF", "AF", "HF", "HA", "HM"})
+
+
+def resolve_legs(db: Database, seq: Sequence) -> tuple[list[ResolvedLeg], list[Finding]]:
+    """Look up the fixes of each leg and turn magnetic courses true."""
+    apt = db.airports.get(seq.airport)
+    apt_var = apt.magvar_deg if apt else 0.0
+    out, findings = [], []
+    for i, rec in enumerate(seq.legs):
+        fix = db.find_fix(rec.fix, seq.airport)
+        nav = db.find_fix(rec.navaid, seq.airport)
+        ctr = db.find_fix(rec.centre, seq.airport)
+        for ref, got in ((rec.fix, fix), (rec.navaid, nav), (rec.centre, ctr)):
+            if ref is not None and got is None:
+                findings.append(Finding(i, "impossible",
+                                        f"fix {ref.ident} ({ref.region} {ref.section}) not in "
+                                        f"the database (line {rec.line})"))
+        var = nav.magvar_deg if nav is not None and nav.section in ("D ", "PI") else apt_var
+        crs = None
+        if rec.course_deg is not None:
+            crs = wrap360(rec.course_deg + (0.0 if rec.course_true else var))
+        out.append(ResolvedLeg(rec, fix, nav, ctr, crs, var))
+    return out, findings
+
+
+def _runway(db: Database, airport: str, transition: str):
+    cands = db.terminal.get((airport, transition), [])
+    for f in cands:
+        if f.section == "PG":
+            return f
+    if transition.startswith("RW") and transition.endswith("B"):
+        for suffix in ("L", "R", "C"):
+            for f in db.terminal.get((airport, transition[:-1] + suffix), []):
+                if f.section == "PG":
+                    return f
+    return None
+
+
+def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightState:
+    """Planned start: a SID runway transition starts at the departure end of the runway
+    (threshold + length along the runway's true bearing, 35 ft above the threshold); other
+    transitions start at their first fix (STAR/approach altitude: the first coded altitude, else
+    airport elevation + 10,000 ft / 3,000 ft); a SID without either starts over the airport."""
+    apt = db.airports.get(seq.airport)
+    elev = (apt.elev_m if apt and apt.elev_m is not None else 0.0)
+    first = legs[0]
+    if seq.proc_type == "D":
+        rwy = _runway(db, seq.airport, seq.transition) if seq.transition.startswith("RW") else None
+        if rwy is not None and first.pt != "IF":
+            brg = wrap360((rwy.bearing_deg or 0.0) + (apt.magvar_deg if apt else 0.0))
+            lat, lon, az = direct(rwy.lat_deg, rwy.lon_deg, brg, rwy.length_m or 0.0)
+            alt = (rwy.elev_m if rwy.elev_m is not None else elev) + 35 * FT_M
+            return FlightState(lat, lon, wrap360(az), alt)
+        alt = elev + 35 * FT_M
+    else:
+        alt = next((lg.rec.alt1_m for lg in legs if lg.rec.alt1_m is not None), None)
+        if alt is None:
+            alt = elev + (10000 if seq.proc_type == "E" else 3000) * FT_M
+    if first.fix is not None:
+        return FlightState(first.fix.lat_deg, first.fix.lon_deg, None, alt,
+                           fix_ident=first.fix.ident)
+    if apt is not None:
+        return FlightState(apt.lat_deg, apt.lon_deg, first.course_true_deg, alt)
+    raise LegError(f"{seq.name}: no runway, fix or airport to start from")
+
+
+def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float) -> float:
+    """Planned TAS: the aircraft's planned speed (flown as a CAS: its TAS at ``alt_m``) capped by
+    an 'at or below' speed limit, raised to
+    an 'at or above' one, and equal to an 'at' one — the speed guidance will fly there, so turn
+    radii are planned for it (limits are IAS, turned to TAS in the ISA), m/s."""
+    v = isa_tas_mps(perf.tas_plan_mps, alt_m)  # the planned speed is flown as a CAS
+    lim = leg.rec.speed_limit_mps
+    if lim is None:
+        return v
+    lim_tas = isa_tas_mps(lim, alt_m)
+    if leg.rec.speed_desc == "-":
+        return min(v, lim_tas)
+    if leg.rec.speed_desc == "+":
+        return max(v, lim_tas)
+    return lim_tas  # blank or '@': at
+
+
+def build_sequence(db: Database, seq: Sequence, perf: Performance,
+                   params: BuildParams | None = None, start: FlightState | None = None
+                   ) -> ProcedurePath:
+    """Build one procedure transition into a :class:`ProcedurePath` (segments + legs).
+
+    Parameters
+    ----------
+    db : the database the sequence comes from (fix look-ups)
+    seq : the procedure transition
+    perf : aircraft performance (planned TAS, climb gradient, bank limit)
+    params : build settings; defaults :class:`BuildParams`
+    start : planned start state (position deg, track deg true, altitude m); default
+        :func:`start_state`. Guidance uses this to rebuild from the aircraft's actual state.
+
+    Returns
+    -------
+    ProcedurePath with findings from the builder and the fly-by corrections; the vertical
+    profile and monitor outcome are added by :func:`fms_testbed.path.monitor.check_path`.
+    """
+    params = params or BuildParams()
+    legs, findings = resolve_legs(db, seq)
+    path = ProcedurePath(seq.name, seq.airport, seq.proc_type, seq.proc_id, seq.transition,
+                         (), (), tuple(findings), status="impossible")
+    if any(f.category == "impossible" for f in findings):
+        return path
+    try:
+        state = start or start_state(db, seq, legs)
+        kind = "given" if start else _start_kind(db, seq, legs, state)
+    except LegError as exc:
+        return replace(path, findings=path.findings + (Finding(-1, "impossible", str(exc)),))
+    ref = legs[0].fix or db.airports.get(seq.airport)
+    g = gravity_mps2(ref.lat_deg if ref else state.lat_deg)
+    prev_fixes = [None] + [lg.fix if lg.pt in FIX_ENDING else None for lg in legs[:-1]]
+    b = LegBuilder(legs, perf, params, g, prev_fixes)
+    b.climbing = seq.proc_type == "D"
+    bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
+    built: list[BuiltLeg] = []
+    for i, leg in enumerate(legs):
+        b.i = i
+        if leg.rec.missed_approach_start:
+            b.climbing = True
+        speed_in = b.speed_mps if i else None
+        b.speed_mps = planned_speed_mps(perf, leg, state.alt_m)
+        b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
+        # a turn at the start of the leg is entered at the previous leg's speed: plan its radius
+        # for the faster of the two
+        b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0), bank, g)
+        start_st = state
+        try:
+            state, term = LEG_TYPES[leg.pt].build(b, state)
+        except LegError as exc:
+            b.finding("impossible", f"leg {i + 1} {leg.pt}: {exc} (line {leg.rec.line})")
+            break
+        state = b.settle(state)
+        if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
+            state = replace(state, alt_m=_descent_target(leg))
+        built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps))
+    segs = round_corners(b, perf, params, bank)
+    built = _attach_segments(built, segs)
+    status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
+    return replace(path, legs=tuple(built), segments=tuple(segs),
+                   findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
+
+
+def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
+    if st.track_deg is not None and seq.proc_type == "D" and legs[0].pt != "IF" \
+            and seq.transition.startswith("RW") and _runway(db, seq.airport, seq.transition):
+        return "runway"
+    return "fix" if legs[0].fix is not None else "airport"
+
+
+def _descent_target(leg: ResolvedLeg) -> float:
+    r = leg.rec
+    if r.alt_desc == "B" and r.alt2_m is not None:
+        return 0.5 * (r.alt1_m + r.alt2_m)
+    return r.alt1_m
+
+
+def _attach_segments(built: list[BuiltLeg], segs: list[PathSegment]) -> list[BuiltLeg]:
+    first: dict[int, int] = {}
+    count: dict[int, int] = {}
+    for k, s in enumerate(segs):
+        first.setdefault(s.leg_index, k)
+        count[s.leg_index] = count.get(s.leg_index, 0) + 1
+    return [replace(lg, seg_first=first.get(lg.index, first.get(lg.index - 1, 0)),
+                    seg_count=count.get(lg.index, 0)) for lg in built]
+
+
+def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_deg: float,
+                  depth: int = 0) -> list[PathSegment]:
+    """Replace every sharp fly-by corner by a tangent arc (with the monitor's corrections)."""
+    segs = b.segments
+    out: list[PathSegment] = []
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    for k, seg in enumerate(segs):
+        if k in b.corners and out and isinstance(seg.geom, Arc) \
+                and isinstance(out[-1].geom, Line):
+            out.extend(_line_arc_fillet(b, out, seg, perf, params, bank_deg))
+            continue
+        if k not in b.corners or not out or not isinstance(seg.geom, Line) \
+                or not isinstance(out[-1].geom, Line):
+            out.append(seg)
+            continue
+        a = out[-1]
+        omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
+        if abs(omega) < 0.5:
+            out.append(seg)
+            continue
+        # the aircraft enters the turn at the inbound speed and leaves it at the outbound one:
+        # plan the radius for the faster, which the bank limit must cover
+        v = max(a.speed_mps, seg.speed_mps)
+        r = turn_radius_m(v, bank_deg, b.g)
+        t = math.tan(math.radians(abs(omega)) / 2.0)
+        avail_a = a.geom.length_m()  # already trimmed by the previous corner, if any
+        avail_c = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
+        l_avail = max(min(avail_a, avail_c), 0.0)
+        bank = bank_deg
+        fix = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
+        if r * t > l_avail:
+            r_geom = l_avail / t
+            b.i = a.leg_index
+            if r_geom <= 1.0:
+                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v, gmax, b.g), depth))
+                continue
+            g_reg = math.degrees(math.atan(v * v / (r_geom * b.g)))
+            if g_reg <= gmax:
+                b.finding("correction", f"fly-by at {fix}: radius {r:.0f} -> {r_geom:.0f} m, "
+                          f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°)", "R")
+                r, bank = r_geom, g_reg
+            else:
+                v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax)))
+                if v_reg >= perf.tas_min_mps:
+                    b.finding("correction", f"fly-by at {fix}: speed {v / 0.514444:.0f} -> "
+                              f"{v_reg / 0.514444:.0f} kt, bank {gmax:.0f}°, radius "
+                              f"{r_geom:.0f} m (turn {omega:+.0f}°)", "V,γ")
+                    r, bank, v = r_geom, gmax, v_reg
+                else:
+                    out.extend(_flyover(b, a, seg, omega, turn_radius_m(
+                        perf.tas_min_mps, gmax, b.g), depth))
+                    continue
+        lead = r * t
+        la = a.geom.length_m()
+        t1 = a.geom.point_at(la - lead)
+        crs1 = a.geom.course_at(la - lead)
+        arc = turn_arc(t1[0], t1[1], crs1, omega, r)
+        new_a = Line(a.geom.start_lat_deg, a.geom.start_lon_deg, *arc.start)
+        out[-1] = replace(a, geom=new_a)
+        if new_a.length_m() < 0.01:
+            out.pop()
+        out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "flyby", v, bank,
+                               lead))
+        t2 = seg.geom.point_at(lead)
+        # end the arc exactly where the next line resumes
+        fixed = _retarget_arc(arc, t2)
+        out[-1] = replace(out[-1], geom=fixed)
+        rest = Line(*fixed.end, seg.geom.end_lat_deg, seg.geom.end_lon_deg)
+        if rest.length_m() >= 0.01:
+            out.append(replace(seg, geom=rest))
+    return out
+
+
+def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
+                     perf: Performance, params: BuildParams, bank_deg: float
+                     ) -> list[PathSegment]:
+    """Fly-by from a line onto a coded arc (CI/VI onto a DME arc, a non-tangent RF entry).
+
+    The fillet of radius r = V²/(g tan γ) is tangent to the line and to the arc (internally when
+    both turn the same way, |F − C| = R − r; externally otherwise, |F − C| = R + r), solved in a
+    local plane about the junction; γ is raised to the monitor's limit when the planned radius
+    does not fit. Returns the segments that replace ``seg`` (``out[-1]`` is trimmed in place);
+    when no fillet fits the sharp corner is kept (the monitor then reports the track jump).
+    """
+    a = out[-1]
+    arc = seg.geom
+    omega = wrap180(arc.start_course_deg - a.geom.end_course_deg)
+    if abs(omega) < 0.5:
+        return [seg]
+    sgn = 1.0 if omega > 0 else -1.0
+    same = (arc.sweep_deg > 0) == (omega > 0)
+    fr = LocalFrame(*arc.start)
+    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
+    u = math.radians(a.geom.end_course_deg)
+    ux, uy = math.sin(u), math.cos(u)
+    nx, ny = sgn * uy, -sgn * ux          # unit normal toward the turn side
+    v = min(a.speed_mps, seg.speed_mps)
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    for bank in (bank_deg, gmax):
+        r = turn_radius_m(v, bank, b.g)
+        d = arc.radius_m - r if same else arc.radius_m + r
+        if d <= 0:
+            continue
+        # F = -L u + r n, |F - C| = d  ->  L² + 2 L (u·(C - r n)) + |C - r n|² - d² = 0 ... in -L
+        px, py = r * nx - cx, r * ny - cy
+        bq = -(px * ux + py * uy)
+        cq = px * px + py * py - d * d
+        disc = bq * bq - cq
+        if disc < 0:
+            continue
+        roots = sorted(x for x in (-bq - math.sqrt(disc), -bq + math.sqrt(disc)) if x >= 0)
+        if not roots or roots[0] > a.geom.length_m():
+            continue
+        lead = roots[0]
+        fx, fy = -lead * ux + r * nx, -lead * uy + r * ny
+        # the contact point lies on the ray from C through F (planar radial from C) ...
+        radial_t2 = math.degrees(math.atan2(fx - cx, fy - cy))
+        # ... and from here on the geometry is exact: the contact point on the coded arc and a
+        # fillet started on the line, ended on the radial through the contact point
+        t2 = direct(arc.centre_lat_deg, arc.centre_lon_deg, _geo_radial(fr, arc, radial_t2),
+                    arc.radius_m)[:2]
+        la = a.geom.length_m()
+        t1 = a.geom.point_at(la - lead)
+        fillet = _retarget_arc(turn_arc(t1[0], t1[1], a.geom.course_at(la - lead), omega, r),
+                               t2)
+        _, r2, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, *fillet.end)
+        used = (r2 - arc.start_radial_deg) % 360.0 if arc.sweep_deg > 0 else \
+            (arc.start_radial_deg - r2) % 360.0
+        if used >= abs(arc.sweep_deg) or used > 180.0:
+            continue
+        rest = Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, r2,
+                   arc.sweep_deg - math.copysign(used, arc.sweep_deg))
+        new_a = Line(a.geom.start_lat_deg, a.geom.start_lon_deg, *fillet.start)
+        out[-1] = replace(a, geom=new_a)
+        if new_a.length_m() < 0.01:
+            out.pop()
+        g_used = math.degrees(math.atan(v * v / (r * b.g)))
+        res = [PathSegment(fillet, a.leg_index, a.path_term, a.fix_ident, "flyby", v, g_used,
+                           lead)]
+        gap = inverse(*fillet.end, *rest.start)[0]
+        if gap > 0.01:
+            res.append(replace(seg, geom=Line(*fillet.end, *rest.start), role="connector"))
+        res.append(replace(seg, geom=rest))
+        if bank > bank_deg:
+            b.i = seg.leg_index
+            b.finding("correction", f"fly-by onto the {seg.path_term} arc: bank "
+                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ")
+        return res
+    return [seg]
+
+
+def _geo_radial(fr: LocalFrame, arc: Arc, planar_radial_deg: float) -> float:
+    """Geodesic radial from the arc centre matching a radial measured in the local plane."""
+    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
+    a = math.radians(planar_radial_deg)
+    px, py = cx + arc.radius_m * math.sin(a), cy + arc.radius_m * math.cos(a)
+    lat, lon = fr.to_latlon(px, py)
+    return inverse(arc.centre_lat_deg, arc.centre_lon_deg, lat, lon)[1]
+
+
+def _retarget_arc(arc: Arc, pt: tuple[float, float]) -> Arc:
+    """The same arc ending on the radial through ``pt`` (small correction only)."""
+    _, az, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, pt[0], pt[1])
+    if arc.sweep_deg >= 0:
+        sweep = wrap360(az - arc.start_radial_deg)
+        if sweep > 359.0:
+            sweep -= 360.0
+    else:
+        sweep = -wrap360(arc.start_radial_deg - az)
+        if sweep < -359.0:
+            sweep += 360.0
+    if abs(sweep - arc.sweep_deg) > 5.0:
+        return arc
+    return Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, arc.start_radial_deg, sweep)
+
+
+def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: float,
+             depth: int = 0) -> list[PathSegment]:
+    """Branch V,γ,φ,λ: the turn cannot be cut inside the fixes; fly over the corner, turn at
+    the lowest speed and maximum bank, then go direct to the end of the next line."""
+    at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
+    b.finding("correction", f"fly-by at {at} (turn {omega:+.0f}°) "
+              f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
+              "V,γ,φ,λ")
+    lat, lon = a.geom.end
+    end = seg.geom.end
+    # rejoin the next line's own course before its end, so that the legs built after it (which
+    # assumed that course) still start tangent to the path
+    tmp = LegBuilder(b.legs, b.perf, b.params, b.g, b.prev_fixes)
+    tmp.i, tmp.speed_mps, tmp.radius_m = seg.leg_index, seg.speed_mps, r
+    tmp.climbing = False
+    target = Fix(ident=seg.fix_ident, region="", section="", lat_deg=end[0], lon_deg=end[1])
+    state = FlightState(lat, lon, a.geom.end_course_deg, 0.0, flyby=False)
+    tmp.join_course(state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
+    if depth == 0:
+        segs = round_corners(tmp, b.perf, b.params, math.degrees(math.atan(
+            seg.speed_mps ** 2 / (r * b.g))), depth=1)
+    else:
+        segs = tmp.segments
+    out = [replace(x, role="turn" if x.role == "leg" else x.role) for x in segs[:-1]]
+    out.append(replace(segs[-1], role=seg.role) if segs else replace(
+        seg, geom=Line(lat, lon, *end)))
+    b.findings.extend(f for f in tmp.findings if f.category != "info")
+    return out  # 'a' is already in the caller's output list

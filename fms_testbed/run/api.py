@@ -1,0 +1,144 @@
+"""One run path for every scenario: :func:`run_scenario` flies a scenario file, a mapping or a
+validated :class:`~fms_testbed.config.scenario.Scenario`, with or without a ``procedure:`` block,
+and returns :class:`~fms_testbed.run.results.Results`. The CLI's ``run``, ``fly`` and ``demo`` use
+it, so a scenario flies the same from Python and from the command line.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.config.scenario import Scenario, parse_scenario
+from fms_testbed.config.yamlfile import read_mapping
+from fms_testbed.core.contracts import Guidance
+from fms_testbed.core.errors import UserError
+from fms_testbed.core.units import NM_M
+from fms_testbed.evaluation.flight_errors import error_columns, flight_errors
+from fms_testbed.loop.flight import Flight
+from fms_testbed.loop.procedure import PreparedProcedure, prepare_procedure
+from fms_testbed.run.results import Results, Summary
+
+_PROC_TYPE = {"D": "SID", "E": "STAR", "F": "APPROACH"}
+
+
+def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedProcedure | None]:
+    """Validate a scenario (path, mapping or :class:`Scenario`) and build its procedure.
+
+    Parameters
+    ----------
+    scenario : path to a YAML file, a mapping, or a validated :class:`Scenario`
+    overrides : keys merged into the scenario before validation; each top-level key replaces
+        the scenario's (``wind``, ``navigation``, ``aircraft``, ...), except ``procedure``, whose
+        keys are merged into the scenario's ``procedure:`` block (e.g. ``{"rnp_nm": 0.3}``)
+
+    Returns
+    -------
+    (scenario, prepared procedure or None)
+    """
+    overrides = dict(overrides or {})
+    if isinstance(scenario, Scenario):
+        source = scenario.source_file or "<scenario>"
+        raw = scenario.model_dump(exclude_none=True)
+    elif isinstance(scenario, dict):
+        source, raw = "<scenario>", dict(scenario)
+    else:
+        path = Path(scenario)
+        source = str(path)
+        raw = read_mapping(path, "scenario file")
+        raw.setdefault("name", path.stem)
+    proc_over = overrides.pop("procedure", None)
+    if proc_over is not None:
+        if not isinstance(raw.get("procedure"), dict):
+            raise UserError(f"{source}: procedure options (--rnp) need a scenario with a "
+                            "'procedure:' block")
+        raw["procedure"] = {**raw["procedure"], **proc_over}
+    raw.update(overrides)
+    raw.pop("source_file", None)
+    if raw.get("procedure") is not None:
+        return prepare_procedure(raw, source)
+    raw.pop("procedure", None)
+    return parse_scenario(raw, source), None
+
+
+def _procedure_summary(scn: Scenario, proc: PreparedProcedure) -> dict[str, Any]:
+    p = proc.path.path
+    return {
+        "name": p.name, "airport": p.airport, "type": _PROC_TYPE.get(p.proc_type),
+        "procedure": p.proc_id, "transition": p.transition, "start": p.start_kind,
+        "legs": p.leg_types(), "length_nm": round(p.length_m() / NM_M, 2),
+        "monitor_status": p.status, "navigation": (scn.navigation or {}).get("source", "truth"),
+        "findings": [f"leg {f.leg_index + 1}: {f.category}: {f.message}" for f in p.findings],
+    }
+
+
+def results_of(flight: Flight) -> Results:
+    """The :class:`Results` of a (finished or stopped) :class:`Flight`: its timeseries and summary,
+    and for a procedure flight the errors, RNP containment, constraints and sequencing."""
+    df, summary = flight.result()
+    summary = Summary(summary)
+    proc, g = flight.procedure, flight.guidance
+    rebuilt: list = []
+    if proc is not None:
+        summary["procedure"] = _procedure_summary(flight.scn, proc)
+        summary.update(flight_errors(df, proc.path, g))
+        summary["guidance_events"] = g.events
+        if "xtk_m" in df:
+            df = error_columns(df)
+        rebuilt = list(g.rebuilt)
+    return Results(df=df, summary=summary, scenario=flight.scn, procedure=proc,
+                   flown_paths=rebuilt)
+
+
+def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None = None,
+                 overrides: dict | None = None, csv: bool = False, plots: bool = True,
+                 progress: bool | None = None, guidance: Guidance | None = None,
+                 aircraft_config: AircraftConfig | None = None, vertical_law=None) -> Results:
+    """Fly a scenario and optionally write its outputs.
+
+    Parameters
+    ----------
+    scenario : path to a YAML file, a mapping, or a validated :class:`Scenario`; a scenario with
+        a ``procedure:`` block is a procedure flight (built from the database it names)
+    out_dir : folder for ``timeseries.parquet``, ``summary.json`` and plots (None: write nothing)
+    seed : seed for turbulence and navigation errors (default 0); ``navigation.seed`` in the
+        scenario, when given, seeds the navigation errors instead
+    overrides : top-level scenario keys merged in before validation
+    csv, plots : also write ``timeseries.csv`` / the PNG plots (with ``out_dir``)
+    progress : progress bar (default: on a terminal, for runs longer than 2 s)
+    guidance : a path guidance to fly instead of the scenario's procedure
+    aircraft_config : an :class:`AircraftConfig` replacing the scenario's aircraft (tuning)
+    vertical_law : a ready vertical-law instance replacing the scenario's ``vertical_law``
+
+    Returns
+    -------
+    :class:`Results` (``.df``, ``.summary``, ``.plot()``, ``.save(dir)``)
+    """
+    if aircraft_config is not None and not isinstance(aircraft_config, AircraftConfig):
+        raise UserError("aircraft_config must be an AircraftConfig")
+    scn, proc = load(scenario, overrides)
+    flight = Flight(scn, cfg=aircraft_config, seed=seed, guidance=guidance, progress=progress,
+                    vertical_law=vertical_law, procedure=None if guidance is not None else proc)
+    flight.run()
+    res = results_of(flight)
+    if out_dir is not None:
+        res.save(out_dir, csv=csv, plots=plots)
+    return res
+
+
+
+
+
+def fly_procedure(scn: Scenario, spec, fp, db, out_dir: str | Path | None = None,
+                  seed: int | None = None, plots: bool = True, csv: bool = False,
+                  progress: bool | None = None) -> Results:
+    """Fly an already built procedure (:func:`fms_testbed.loop.procedure.prepare`'s results);
+    the same as :func:`run_scenario` on its scenario, without building it again."""
+    flight = Flight(scn, seed=seed, progress=progress, procedure=PreparedProcedure(spec, fp, db))
+    flight.run()
+    res = results_of(flight)
+    if out_dir is not None:
+        res.save(out_dir, csv=csv, plots=plots)
+    return res
+__all__ = ["fly_procedure", "load", "results_of", "run_scenario"]

@@ -1,0 +1,133 @@
+"""The results of one flight: the timeseries, a summary that serialises to ``summary.json``, and
+what is needed to draw it (the built procedure, the paths rebuilt in flight).
+
+Like python-control's ``TimeResponseData``: :meth:`Results.to_pandas` gives the data,
+:meth:`Results.plot` returns figures (it draws, it does not compute), :meth:`Results.save`
+writes the outputs of a run into a folder.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from fms_testbed.config.scenario import Scenario
+from fms_testbed.loop.procedure import PreparedProcedure
+from fms_testbed.viz.figure import save as save_figure
+from fms_testbed.viz.procedure import plot_procedure
+from fms_testbed.viz.run import plot_run
+
+
+def _finite_or_none(x: Any) -> Any:
+    """JSON value of ``x``: non-finite floats become null (summary.json is strict JSON)."""
+    if isinstance(x, float):
+        return x if math.isfinite(x) else None
+    if isinstance(x, dict):
+        return {k: _finite_or_none(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return [_finite_or_none(v) for v in x]
+    if hasattr(x, "item") and not isinstance(x, (str, bytes)):  # numpy scalars
+        return _finite_or_none(x.item())
+    return x
+
+
+class Summary(dict):
+    """The summary of a flight: a mapping (as written to ``summary.json``) with typed accessors.
+
+    Keys of every flight: ``scenario``, ``aircraft``, ``jsbsim_model``, ``status``, ``reason``,
+    ``seed``, ``duration_s`` (simulated, s), ``wall_time_s``, ``real_time_factor``,
+    ``loop_wall_time_s``, ``loop_steps_per_s``, ``trim`` and ``metrics``. A procedure flight
+    adds ``procedure``, ``errors`` (FTE/NSE/PDE/TSE, m), ``rnp``, ``constraints``,
+    ``sequencing`` and ``guidance_events``.
+    """
+
+    @property
+    def status(self) -> str:
+        """Outcome of the flight (``ok``, ``diverged``, ``incomplete``)."""
+        return self["status"]
+
+    @property
+    def reason(self) -> str:
+        """Why the flight ended as it did."""
+        return self["reason"]
+
+    @property
+    def ok(self) -> bool:
+        """True only for status ``ok``."""
+        return self["status"] == "ok"
+
+    @property
+    def seed(self) -> int:
+        """The seed actually used for every stochastic part of the flight."""
+        return self["seed"]
+
+    @property
+    def duration_s(self) -> float:
+        """Simulated time flown, s."""
+        return self["duration_s"]
+
+    def to_json(self) -> str:
+        """Strict JSON (non-finite numbers as null), indented."""
+        return json.dumps(_finite_or_none(dict(self)), indent=2, allow_nan=False) + "\n"
+
+
+@dataclass
+class Results:
+    """One flown scenario.
+
+    Attributes
+    ----------
+    df : timeseries, one row per logged step (:data:`fms_testbed.core.timeseries.COLUMNS`, then
+        navigation-error and guidance columns)
+    summary : :class:`Summary`
+    scenario : the validated scenario that was flown
+    procedure : the built procedure (procedure flights), else None
+    flown_paths : paths rebuilt in flight (conditional legs), drawn on the track plot
+    out_dir : where :meth:`save` last wrote the outputs (None: not written)
+    """
+
+    df: pd.DataFrame
+    summary: Summary
+    scenario: Scenario
+    procedure: PreparedProcedure | None = None
+    flown_paths: list = field(default_factory=list)
+    out_dir: Path | None = None
+
+    def to_pandas(self) -> pd.DataFrame:
+        """The timeseries as a DataFrame."""
+        return self.df
+
+    def plot(self) -> dict[str, Any]:
+        """The standard figures of the flight, by file stem (``ground_track``, ``time_histories``
+        and, for a procedure flight, ``procedure_track``, ``procedure_vertical``,
+        ``procedure_errors``); matplotlib :class:`~matplotlib.figure.Figure` objects."""
+        figs = dict(plot_run(self.df, self.summary))
+        if self.procedure is not None:
+            figs.update(plot_procedure(self.df, self.summary, self.procedure.path,
+                                       self.flown_paths))
+        return figs
+
+    def save(self, out_dir: str | Path, csv: bool = False, plots: bool = True) -> Path:
+        """Write ``timeseries.parquet``, ``summary.json``, the PNG plots (and ``timeseries.csv``)
+        into ``out_dir``; return the folder."""
+        out = Path(out_dir)
+        out.mkdir(parents=True, exist_ok=True)
+        self.df.to_parquet(out / "timeseries.parquet", index=False)
+        if csv:
+            self.df.to_csv(out / "timeseries.csv", index=False, float_format="%.7g")
+        if plots:
+            names = []
+            for stem, fig in self.plot().items():
+                names.append(save_figure(fig, out / f"{stem}.png").name)
+            self.summary["plots"] = names
+        (out / "summary.json").write_text(self.summary.to_json())
+        self.out_dir = out
+        return out
+
+
+__all__ = ["Results", "Summary"]

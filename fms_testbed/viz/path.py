@@ -1,0 +1,125 @@
+"""Plot a built procedure transition like Danilin (2017), Fig. 2: legs labelled with their path
+terminator codes, arcs visible with their centres, fixes marked. Plotting never computes the
+path; it only draws the segments it is given, in an azimuthal-equidistant plane (NM) about the
+first fix."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from fms_testbed.viz.figure import subplots
+
+from fms_testbed.core.geodesy import LocalFrame
+from fms_testbed.core.segments import Arc
+from fms_testbed.legs.model import ProcedurePath
+
+NM_M = 1852.0
+_STYLE = {"leg": ("tab:blue", "-"), "turn": ("tab:orange", "-"), "flyby": ("tab:red", "-"),
+          "hold": ("tab:purple", "-"), "connector": ("grey", ":")}
+
+
+def _xy(fr: LocalFrame, lat: float, lon: float) -> tuple[float, float]:
+    x, y = fr.to_xy(lat, lon)
+    return x / NM_M, y / NM_M
+
+
+def plot_path(path: ProcedurePath, out_file: str | Path) -> Path:
+    """Draw the path to a PNG; return its path."""
+    if not path.segments:
+        raise ValueError(f"{path.name}: nothing to plot (no segments)")
+    lat0, lon0 = path.segments[0].geom.start
+    fr = LocalFrame(lat0, lon0)
+    prof = path.profile
+    if prof is not None and len(prof.along_m) > 1:
+        fig, (ax, axv) = subplots(2, 1, figsize=(9, 10.5),
+                                      gridspec_kw={"height_ratios": [3.2, 1]})
+    else:
+        fig, ax = subplots(figsize=(9, 8))
+        axv = None
+    used = set()
+    for seg in path.segments:
+        g = seg.geom
+        n = max(2, int(abs(g.sweep_deg) / 3) + 2) if isinstance(g, Arc) else 2
+        pts = [g.point_at(g.length_m() * k / (n - 1)) for k in range(n)]
+        xs, ys = zip(*(_xy(fr, *p) for p in pts))
+        colour, ls = _STYLE.get(seg.role, ("black", "-"))
+        label = None
+        kind = f"{seg.role} {'arc' if isinstance(g, Arc) else 'line'}"
+        if kind not in used:
+            used.add(kind)
+            label = kind
+        ax.plot(xs, ys, color=colour, ls=ls, lw=2 if seg.role == "leg" else 1.5, label=label)
+        if isinstance(g, Arc) and seg.role == "leg":
+            cx, cy = _xy(fr, *g.centre)
+            ax.plot(cx, cy, "+", color="tab:green", ms=9,
+                    label=None if "arc centre" in used else "arc centre")
+            used.add("arc centre")
+    # leg codes at the middle of each leg's own path
+    for lg in path.legs:
+        segs = [s for s in path.segments if s.leg_index == lg.index and s.role != "flyby"]
+        if not segs:
+            continue
+        mid = max(segs, key=lambda s: s.geom.length_m())
+        x, y = _xy(fr, *mid.geom.point_at(0.5 * mid.geom.length_m()))
+        ax.annotate(f"{lg.index + 1}:{lg.path_term}", (x, y), fontsize=8, color="navy",
+                    xytext=(4, 4), textcoords="offset points",
+                    bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="navy", alpha=0.7))
+    marked = set()
+    for lg in path.legs:
+        f = lg.record.fix
+        t = lg.termination
+        if f is None or t.lat_deg is None or f.ident in marked or t.kind not in (
+                "fix", "circuit", "manual", "altitude") or not t.fix_ident and t.kind != "fix":
+            continue
+        marked.add(f.ident)
+        x, y = _xy(fr, t.lat_deg, t.lon_deg)
+        fo = lg.record.fly_over
+        ax.plot(x, y, marker="^" if not fo else "o", color="k", mfc="none" if fo else "k",
+                ms=7, ls="none",
+                label=None if ("fly-over fix" if fo else "fly-by fix") in used
+                else ("fly-over fix" if fo else "fly-by fix"))
+        used.add("fly-over fix" if fo else "fly-by fix")
+        ax.annotate(f.ident, (x, y), fontsize=8, xytext=(5, -10), textcoords="offset points")
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    first = path.legs[0].record.fix if path.legs else None
+    origin = first.ident if first is not None and path.legs[0].path_term == "IF" else "start"
+    ax.set_xlabel(f"east of {origin} [NM]")
+    ax.set_ylabel("north [NM]")
+    ax.set_title(f"{path.name} — {path.status}\n"
+                 + " ".join(f"{lg.path_term}" for lg in path.legs), fontsize=10)
+    ax.legend(loc="best", fontsize=8)
+    if axv is not None:
+        _profile_panel(axv, path)
+    out = Path(out_file)
+    out.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    return out
+
+
+def _profile_panel(ax, path: ProcedurePath) -> None:
+    """Planned altitude along the path with the coded altitude windows."""
+    prof = path.profile
+    ax.plot(prof.along_m / NM_M, prof.alt_m / 0.3048, "-", color="tab:blue",
+            label="planned altitude")
+    for name, sel, marker in (("at or above", lambda w: w.lo_m is not None and w.hi_m is None,
+                               "^"),
+                              ("at or below", lambda w: w.hi_m is not None and w.lo_m is None,
+                               "v"),
+                              ("at / window", lambda w: w.lo_m is not None
+                               and w.hi_m is not None, "s")):
+        ws = [w for w in prof.windows if sel(w)]
+        if not ws:
+            continue
+        xs = [w.along_m / NM_M for w in ws]
+        ys = [(w.lo_m if w.lo_m is not None else w.hi_m) / 0.3048 for w in ws]
+        ax.plot(xs, ys, marker, color="k", mfc="none", ls="none", label=name)
+        for w, x, y in zip(ws, xs, ys):
+            if w.fix_ident:
+                ax.annotate(w.fix_ident, (x, y), fontsize=7, xytext=(3, 3),
+                            textcoords="offset points")
+    ax.set_xlabel("distance along the path [NM]")
+    ax.set_ylabel("altitude [ft]")
+    ax.grid(True, alpha=0.3)
+    ax.legend(loc="best", fontsize=8)
