@@ -15,7 +15,7 @@ from fms_testbed.path.monitor import check_path
 from fms_testbed.path.segmentation import build_sequence
 from fms_testbed.cli import main
 
-CIFP = Path(__file__).resolve().parents[1].parent / "shared" / "data" / "cifp" / "FAACIFP18_230126"
+CIFP = Path(__file__).resolve().parents[2].parent / "shared" / "data" / "cifp" / "FAACIFP18_230126"
 FAA_ABSENT = {"FD", "CR"}
 
 

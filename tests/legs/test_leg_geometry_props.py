@@ -13,7 +13,7 @@ from fms_testbed.procedures.synth import (airport_record, leg_record, offset, wa
                                         write_file)
 from fms_testbed.core.segments import Arc
 from fms_testbed.core.geodesy import inverse, wrap180
-from tests.test_arinc424_world import PARAMS, PERF
+from tests.path.test_world import PARAMS, PERF
 
 SETTINGS = settings(max_examples=40, deadline=None,
                     suppress_health_check=[HealthCheck.function_scoped_fixture])

@@ -8,7 +8,7 @@ import pytest
 from fms_testbed.path.profile import window
 from fms_testbed.procedures.synth import leg_record as L
 from fms_testbed.procedures.synth import offset, waypoint_record
-from tests.test_arinc424_world import APT, PERF, build, world
+from tests.path.test_world import APT, PERF, build, world
 
 FT = 0.3048
 

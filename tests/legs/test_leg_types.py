@@ -12,7 +12,7 @@ from fms_testbed.procedures.synth import leg_record as L
 from fms_testbed.procedures.synth import offset, waypoint_record
 from fms_testbed.core.segments import Arc
 from fms_testbed.core.geodesy import gravity_mps2, inverse
-from tests.test_arinc424_world import APT, PARAMS, PERF, build, world
+from tests.path.test_world import APT, PARAMS, PERF, build, world
 
 FT = 0.3048
 NM = 1852.0

@@ -7,7 +7,7 @@ import pytest
 
 from fms_testbed.procedures.synth import leg_record as L
 from fms_testbed.procedures.synth import offset, waypoint_record
-from tests.test_arinc424_world import PERF, build, world
+from tests.path.test_world import PERF, build, world
 
 NM = 1852.0
 
