@@ -99,3 +99,28 @@ def bank_command_rad(xtk_m: float, track_err_rad: float, gs_mps: float, curvatur
     phi = math.atan(tan_phi)
     lim = math.radians(gains.bank_max_deg)
     return lim if phi > lim else (-lim if phi < -lim else phi)
+
+
+def wrap_pi(a_rad: float) -> float:
+    """Angle wrapped into [-π, π), rad."""
+    return (a_rad + math.pi) % (2 * math.pi) - math.pi
+
+
+def heading_hold_bank_rad(heading_cmd_rad: float, heading_rad: float, kp: float,
+                          bank_max_rad: float) -> float:
+    """Heading hold: bank command proportional to the heading error, limited.
+
+    Parameters
+    ----------
+    heading_cmd_rad : heading to hold, rad (true)
+    heading_rad : current (navigation) heading, rad (true)
+    kp : heading-hold gain, rad of bank per rad of heading error (aircraft file
+        ``inner_loops.heading_kp``)
+    bank_max_rad : bank limit, rad
+
+    Returns
+    -------
+    bank command, rad (right wing down positive)
+    """
+    err = wrap_pi(heading_cmd_rad - heading_rad)
+    return max(-bank_max_rad, min(bank_max_rad, kp * err))

@@ -15,7 +15,6 @@ terrain is at mean sea level, so height above ground is altitude above MSL.
 
 from __future__ import annotations
 
-import json
 import math
 from dataclasses import dataclass
 from pathlib import Path

@@ -1,0 +1,231 @@
+"""The named steps of one outer-loop period of a flight, in the order the loop calls them:
+
+read (JSBSim → :class:`AircraftState`, in :mod:`fms_testbed.sim.jsbsim_core`) → check
+(:class:`~fms_testbed.sim.divergence.Divergence`) → wind ramp (:class:`WindRamp`) → navigate
+(the navigation source, or :class:`NavHold` between slower updates) → events (:class:`EventQueue`
+into :class:`Targets`) → guide (the guidance, merged by :func:`merge_guidance`) → lateral
+(:class:`LateralStep`: heading hold or bank hold, roll-rate limit) → vertical + command
+(:class:`VerticalStep`: the vertical law or the direct inner-loop targets, sent to JSBSim) → log.
+
+Each step is small and testable alone; tuning (gains, limits from the aircraft file) is given at
+construction, run-time state lives in the step object.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.config.scenario import Event, Scenario
+from fms_testbed.core.atmosphere import cas_to_tas_scalar
+from fms_testbed.core.contracts import GuidanceOutput
+from fms_testbed.core.state import AircraftState, NavSolution
+from fms_testbed.core.units import FT_M
+from fms_testbed.guidance.lateral import heading_hold_bank_rad, wrap_pi
+
+WIND_RAMP_S = 20.0
+"""The scenario's steady wind grows linearly from zero to its value over this time after trim, s
+(JSBSim 1.3.3 cannot trim in wind)."""
+
+
+@dataclass(slots=True)
+class Targets:
+    """What the flight is currently asked to do (events and guidance write here).
+
+    bank_rad: bank target, rad;  heading_rad: heading-hold target, rad (None: bank hold)
+    ny: normal load-factor target, g;  nx: tangential load-factor target, g (None: throttle)
+    throttle: direct throttle 0..1 (None: the n_x loop);  alt_m: altitude target, m
+    speed_kind: "tas" or "cas";  speed_mps: speed target, m/s
+    vertical: True while the vertical law flies alt_m/speed_mps
+    """
+
+    bank_rad: float = 0.0
+    heading_rad: float | None = None
+    ny: float = 1.0
+    nx: float | None = None
+    throttle: float | None = None
+    alt_m: float | None = None
+    speed_kind: str = "tas"
+    speed_mps: float | None = None
+    vertical: bool = False
+
+
+class EventQueue:
+    """Timed and conditional scenario events, each fired once, in file order."""
+
+    def __init__(self, events: list[Event]):
+        self.pending = list(events)
+
+    def due(self, t_s: float, alt_m: float) -> list[Event]:
+        """Remove and return the events due at time ``t_s`` (s) and altitude ``alt_m`` (m)."""
+        fired, keep = [], []
+        for ev in self.pending:
+            if ev.t_s is not None:
+                ok = t_s + 1e-9 >= ev.t_s
+            else:
+                w = ev.when
+                ok = ((w.alt_m_above is None or alt_m >= w.alt_m_above)
+                      and (w.alt_m_below is None or alt_m <= w.alt_m_below)
+                      and (w.t_s_after is None or t_s >= w.t_s_after))
+            (fired if ok else keep).append(ev)
+        self.pending = keep
+        return fired
+
+
+def apply_event(ev: Event, tg: Targets) -> None:
+    """Write an event's targets into ``tg`` (unset targets keep their value)."""
+    if ev.bank_deg is not None:
+        tg.bank_rad, tg.heading_rad = math.radians(ev.bank_deg), None
+    if ev.heading_deg is not None:
+        tg.heading_rad = math.radians(ev.heading_deg)
+    if ev.ny is not None:
+        tg.ny, tg.vertical = ev.ny, False
+    if ev.nx is not None:
+        tg.nx, tg.throttle, tg.vertical = ev.nx, None, False
+    if ev.throttle is not None:
+        tg.throttle, tg.nx, tg.vertical = ev.throttle, None, False
+    if ev.altitude_m is not None:
+        tg.alt_m, tg.vertical = ev.altitude_m, True
+    kind, spd = ev.speed
+    if spd is not None:
+        tg.speed_kind, tg.speed_mps, tg.vertical = kind, spd, True
+
+
+def merge_guidance(gout: GuidanceOutput, tg: Targets) -> None:
+    """Write a guidance output into ``tg``: its bank replaces heading/bank hold, its altitude and
+    TAS engage the vertical law."""
+    if gout.bank_rad is not None:
+        tg.bank_rad, tg.heading_rad = gout.bank_rad, None
+    if gout.alt_m is not None:
+        tg.alt_m, tg.vertical = gout.alt_m, True
+    if gout.tas_mps is not None:
+        tg.speed_kind, tg.speed_mps, tg.vertical = "tas", gout.tas_mps, True
+
+
+def wind_ned_mps(scn: Scenario) -> tuple[float, float, float]:
+    """The scenario's steady wind as the velocity of the air, NED, m/s."""
+    if scn.wind is None:
+        return (0.0, 0.0, 0.0)
+    to = math.radians(scn.wind.from_deg + 180.0)
+    return (scn.wind.speed_ms * math.cos(to), scn.wind.speed_ms * math.sin(to), 0.0)
+
+
+class WindRamp:
+    """Ramp the steady wind in over :data:`WIND_RAMP_S` after trim (JSBSim wind properties)."""
+
+    def __init__(self, fdm, scn: Scenario, dt_outer_s: float):
+        self.wind_ned = wind_ned_mps(scn)
+        self.active = any(self.wind_ned)
+        self.end_s = WIND_RAMP_S + dt_outer_s
+        pm = fdm.get_property_manager()
+        self.nodes = [pm.get_node(f"atmosphere/wind-{c}-fps", False)
+                      for c in ("north", "east", "down")]
+
+    def __call__(self, t_s: float) -> None:
+        """Set the wind for time ``t_s`` (s after trim); call while ``t_s <= end_s``."""
+        frac = min(1.0, t_s / WIND_RAMP_S)
+        for node, w in zip(self.nodes, self.wind_ned):
+            node.set_double_value(frac * w / FT_M)
+
+
+class NavHold:
+    """Apply the last navigation errors to truth between navigation updates (navigation slower
+    than the outer loop)."""
+
+    def __init__(self, source, dt_s: float):
+        self.source, self.dt_s = source, dt_s
+        self.next_t = 0.0
+        self.err = None
+        self.errors: dict[str, float] = {}
+
+    def __call__(self, s: AircraftState) -> NavSolution:
+        """The navigation solution at ``s.t_s``."""
+        if self.err is None or s.t_s + 1e-9 >= self.next_t:
+            nav = self.source.update(s)
+            self.err = (nav.lat_rad - s.lat_rad, nav.lon_rad - s.lon_rad, nav.alt_m - s.alt_m,
+                        nav.v_enu_mps - s.v_enu_mps, nav.roll_rad - s.roll_rad,
+                        nav.pitch_rad - s.pitch_rad, wrap_pi(nav.heading_rad - s.heading_rad))
+            self.errors = dict(nav.errors)
+            self.next_t = s.t_s + self.dt_s
+            return nav
+        e = self.err
+        return NavSolution(t_s=s.t_s, lat_rad=s.lat_rad + e[0], lon_rad=s.lon_rad + e[1],
+                           alt_m=s.alt_m + e[2], v_enu_mps=s.v_enu_mps + e[3],
+                           roll_rad=s.roll_rad + e[4], pitch_rad=s.pitch_rad + e[5],
+                           heading_rad=wrap_pi(s.heading_rad + e[6]) % (2 * math.pi),
+                           errors=self.errors)
+
+
+class LateralStep:
+    """Bank command: heading hold on the navigation heading, else the bank target; commands from
+    guidance or heading hold are limited to the aircraft's passenger-comfort roll rate."""
+
+    __slots__ = ("bank_max_rad", "roll_step_rad", "heading_kp", "last_bank_rad")
+
+    def __init__(self, cfg: AircraftConfig, dt_outer_s: float):
+        lim = cfg.limits
+        self.bank_max_rad = math.radians(lim.bank_max_deg)
+        self.roll_step_rad = math.radians(lim.roll_rate_max_dps) * dt_outer_s
+        self.heading_kp = cfg.inner_loops.heading_kp
+        self.last_bank_rad = 0.0
+
+    def __call__(self, tg: Targets, nav: NavSolution, guided: bool) -> float:
+        """The bank command, rad, for this outer step."""
+        hdg_cmd = tg.heading_rad
+        if hdg_cmd is not None:
+            bank = heading_hold_bank_rad(hdg_cmd, nav.heading_rad, self.heading_kp,
+                                         self.bank_max_rad)
+        else:
+            bank = tg.bank_rad
+        if hdg_cmd is not None or guided:
+            last, step = self.last_bank_rad, self.roll_step_rad
+            bank = min(max(bank, last - step), last + step)
+        self.last_bank_rad = bank
+        return bank
+
+
+class VerticalStep:
+    """The vertical channel and the command to JSBSim: the vertical law while an altitude/speed
+    target is active (the law works in the vertical plane and returns the vertical component of
+    n_y, divided here by cos φ), else the direct n_y/n_x/throttle targets."""
+
+    __slots__ = ("law", "command", "dt_s", "engaged")
+
+    def __init__(self, law, aircraft, dt_outer_s: float):
+        self.law, self.command, self.dt_s = law, aircraft.command, dt_outer_s
+        self.engaged = False
+
+    def __call__(self, s: AircraftState, tg: Targets, bank_rad: float
+                 ) -> tuple[float, float, float, float]:
+        """Compute and send this step's commands; return them: (cmd_nx g, cmd_ny g, altitude
+        command m, TAS command m/s), NaN where inactive."""
+        if tg.vertical:
+            if tg.alt_m is None:
+                tg.alt_m = s.alt_m
+            alt_cmd = tg.alt_m
+            if tg.speed_mps is None:
+                tg.speed_kind, tg.speed_mps = "tas", s.tas_mps
+            tas_cmd = (cas_to_tas_scalar(tg.speed_mps, s.alt_m) if tg.speed_kind == "cas"
+                       else tg.speed_mps)
+            law = self.law
+            if not self.engaged:
+                law.engage(s, alt_cmd, tas_cmd)
+                self.engaged = True
+            cmd_nx, ny_vert = law.update(self.dt_s, s, alt_cmd, tas_cmd)
+            cmd_ny = ny_vert / max(math.cos(s.roll_rad), 0.5)
+            self.command(bank_rad=bank_rad, ny=cmd_ny, nx=cmd_nx)
+            return cmd_nx, cmd_ny, alt_cmd, tas_cmd
+        self.engaged = False
+        nan = float("nan")
+        cmd_ny = tg.ny
+        if tg.throttle is not None:
+            self.command(bank_rad=bank_rad, ny=cmd_ny, throttle=tg.throttle)
+            return nan, cmd_ny, nan, nan
+        cmd_nx = tg.nx if tg.nx is not None else 0.0
+        self.command(bank_rad=bank_rad, ny=cmd_ny, nx=cmd_nx)
+        return cmd_nx, cmd_ny, nan, nan
+
+
+__all__ = ["WIND_RAMP_S", "Targets", "EventQueue", "apply_event", "merge_guidance",
+           "wind_ned_mps", "WindRamp", "NavHold", "LateralStep", "VerticalStep"]
