@@ -26,6 +26,7 @@ from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_valid
                       model_validator)
 
 from fms_testbed.config.aircraft import list_aircraft
+from fms_testbed.config.navigation import NavigationBlock, with_default_source
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.config.yamlfile import read_mapping, validation_message
 
@@ -39,7 +40,10 @@ _ALT_KEYS = {"alt_m": 1.0, "alt_ft": FT}
 
 
 class _Strict(BaseModel):
-    model_config = ConfigDict(extra="forbid")
+    """Base of the scenario blocks: unknown keys, booleans given as numbers (``alt_m: true``),
+    strings given as numbers, infinities and NaN are all errors."""
+
+    model_config = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
 
 
 def _speed(values: dict, where: str, required: bool) -> tuple[str | None, float | None]:
@@ -194,10 +198,22 @@ class Scenario(_Strict):
         10.0, description="rate of navigation, guidance, heading hold and the vertical law, Hz")
     log_rate_hz: Annotated[float, Field(ge=1, le=120)] = Field(
         10.0, description="timeseries rate, Hz (at most the outer rate)")
-    navigation: dict[str, Any] | None = None
+    navigation: NavigationBlock | None = None
     procedure: dict[str, Any] | None = None
     events: list[Event] = Field(default_factory=list)
     source_file: str = ""
+
+    @model_validator(mode="after")
+    def _rates(self):
+        if self.log_rate_hz > self.outer_rate_hz:
+            raise ValueError(f"log_rate_hz {self.log_rate_hz:g} Hz is above outer_rate_hz "
+                             f"{self.outer_rate_hz:g} Hz (a row is logged per outer step at most)")
+        return self
+
+    @field_validator("aircraft", mode="before")
+    @classmethod
+    def _name(cls, v):
+        return str(v) if isinstance(v, int) and not isinstance(v, bool) else v  # aircraft: 737
 
     @field_validator("aircraft")
     @classmethod
@@ -209,12 +225,17 @@ class Scenario(_Strict):
             raise ValueError(f"unknown aircraft '{v}' (shipped: {', '.join(known)})")
         return v
 
-    @field_validator("navigation")
+    @field_validator("navigation", mode="before")
     @classmethod
-    def _nav(cls, v):
-        if v is not None and v.get("source", "truth") not in ("truth", "sins"):
-            raise ValueError(f"navigation.source must be truth or sins, not {v.get('source')!r}")
-        return v
+    def _nav_default(cls, v):
+        return with_default_source(v)
+
+    @property
+    def navigation_spec(self) -> dict[str, Any]:
+        """The navigation block as the source's mapping (keys that were given, and ``source``)."""
+        if self.navigation is None:
+            return {"source": "truth"}
+        return self.navigation.model_dump(exclude_unset=True) | {"source": self.navigation.source}
 
 
 def parse_scenario(raw: Any, source: str = "<scenario>") -> Scenario:

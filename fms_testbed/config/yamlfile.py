@@ -15,6 +15,10 @@ import yaml
 from fms_testbed.core.errors import ConfigError
 
 
+MAX_YAML_BYTES = 10_000_000
+"""Largest YAML file read, bytes (a scenario or aircraft file is a few KB)."""
+
+
 def read_mapping(path: str | Path, what: str = "file") -> dict[str, Any]:
     """Read a YAML file whose top level is a mapping; raise :class:`ConfigError` otherwise.
 
@@ -25,7 +29,14 @@ def read_mapping(path: str | Path, what: str = "file") -> dict[str, Any]:
     """
     path = Path(path)
     try:
-        text = path.read_text()
+        if path.exists() and not path.is_dir() and not path.is_file():
+            raise ConfigError(f"{path}: not a regular file (a device or a pipe?)")
+        if path.is_file() and path.stat().st_size > MAX_YAML_BYTES:
+            raise ConfigError(f"{path}: {path.stat().st_size} bytes is too large for a {what} "
+                              f"(at most {MAX_YAML_BYTES} bytes)")
+        text = path.read_text(encoding="utf-8")
+    except UnicodeDecodeError as exc:
+        raise ConfigError(f"{path}: not UTF-8 text (byte {exc.start}: {exc.reason})") from None
     except FileNotFoundError:
         raise ConfigError(f"{path}: no such {what}") from None
     except IsADirectoryError:
@@ -43,10 +54,18 @@ def read_mapping(path: str | Path, what: str = "file") -> dict[str, Any]:
     return raw
 
 
+_TAGGED_FIELDS = ("navigation",)
+"""Fields whose value is a discriminated union (pydantic adds the tag to the error location)."""
+
+
 def validation_message(source: str, err) -> str:
     """One line from a pydantic ``ValidationError``: the first failing field and why."""
     e = err.errors()[0]
-    loc = ".".join(str(x) for x in e["loc"]) or "<root>"
+    parts = list(e["loc"])
+    # a discriminated union (the navigation block) puts its tag into the location: drop it
+    parts = [x for i, x in enumerate(parts)
+             if not (i > 0 and parts[i - 1] in _TAGGED_FIELDS and isinstance(x, str))]
+    loc = ".".join(str(x) for x in parts) or "<root>"
     msg = e["msg"].removeprefix("Value error, ")
     if e["type"] == "extra_forbidden":
         msg = "unknown field"

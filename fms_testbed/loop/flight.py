@@ -88,9 +88,11 @@ class Flight:
         ac.engage()
         ac.command(bank_rad=0.0, ny=1.0, nx=0.0)
 
-        nav_spec = scn.navigation or {}
+        nav_spec = scn.navigation_spec
+        # navigation.seed, when the scenario gives one, seeds the navigation errors
+        self.navigation_seed = int(nav_spec.get("seed", self.seed))
         try:
-            source = make_source(nav_spec, seed=int(nav_spec.get("seed", self.seed)))
+            source = make_source(nav_spec, seed=self.navigation_seed)
         except UserError as exc:
             where = scn.source_file or scn.name or "scenario"
             raise type(exc)(f"{where}: {exc}") from None
@@ -146,7 +148,7 @@ class Flight:
         rows, extra_rows, raw_log, bar = self.rows, self.extra_rows, self.raw_log, self._bar
         no_errors: dict = {}
         n_outer, dt_outer = self.n_frames, self.dt_outer_s
-        nav_spec = scn.navigation or {}
+        nav_spec = scn.navigation_spec
         nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
         # hold the navigation errors between updates only when navigation runs slower than
         # guidance
@@ -231,7 +233,7 @@ class Flight:
         summary = {
             "scenario": scn.name, "aircraft": cfg.name, "jsbsim_model": cfg.jsbsim_model,
             "status": status, "reason": reason,
-            "seed": self.seed,
+            "seed": self.seed, "navigation_seed": self.navigation_seed,
             "duration_s": round(flown, 3), "wall_time_s": round(wall, 3),
             "real_time_factor": round(flown / wall, 1) if wall > 0 else None,
             "loop_wall_time_s": round(loop_wall, 4),

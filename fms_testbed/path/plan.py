@@ -27,13 +27,14 @@ FT_M = 0.3048
 
 
 def load_db(spec_db: str, base: Path | None = None):
-    """Load an ARINC-424 database ('embedded' = the excerpt in ``procedures/``)."""
+    """Load an ARINC-424 database ('embedded' = the excerpt in ``fms_testbed/data/procedures/``);
+    a relative path is relative to ``base`` (the scenario file's folder) when one is given."""
     from fms_testbed.procedures.database import load_database
 
     if spec_db in ("", "embedded"):
         return load_database(None)
     p = Path(spec_db)
-    if not p.is_absolute() and base is not None and not p.exists():
+    if not p.is_absolute() and base is not None:
         p = base / p
     return load_database(p)
 

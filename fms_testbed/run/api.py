@@ -68,7 +68,7 @@ def _procedure_summary(scn: Scenario, proc: PreparedProcedure) -> dict[str, Any]
         "name": p.name, "airport": p.airport, "type": _PROC_TYPE.get(p.proc_type),
         "procedure": p.proc_id, "transition": p.transition, "start": p.start_kind,
         "legs": p.leg_types(), "length_nm": round(p.length_m() / NM_M, 2),
-        "monitor_status": p.status, "navigation": (scn.navigation or {}).get("source", "truth"),
+        "monitor_status": p.status, "navigation": scn.navigation_spec["source"],
         "findings": [f"leg {f.leg_index + 1}: {f.category}: {f.message}" for f in p.findings],
     }
 
