@@ -10,14 +10,19 @@ from __future__ import annotations
 import argparse
 import importlib
 import logging
+import signal
+import os
 import sys
+import threading
 
+from fms_testbed import __version__
 from fms_testbed.core.errors import UserError
 
 #: Modules that contribute sub-commands; a new command group is added here and nowhere else.
 COMMAND_MODULES = (
     "fms_testbed.cli.run",          # run, demo
-    "fms_testbed.cli.procedures",   # procedures build / check
+    "fms_testbed.cli.inner",        # inner
+    "fms_testbed.cli.procedures",   # procedures build / check / list
     "fms_testbed.cli.fly",          # fly
     "fms_testbed.cli.coupled",      # tune, compare, analyse
     "fms_testbed.cli.ins",         # ins
@@ -30,6 +35,7 @@ def build_parser() -> argparse.ArgumentParser:
         prog="fms-testbed",
         description="Flight-management-system testbed on JSBSim.")
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
+    parser.add_argument("--version", action="version", version=f"fms-testbed {__version__}")
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     for name in COMMAND_MODULES:
         try:
@@ -42,8 +48,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _exit_on_sigterm(signum, frame) -> None:  # pragma: no cover - exercised in a subprocess
+    """SIGTERM ends the process through ``sys.exit`` so atexit handlers run (the JSBSim sandbox
+    folder in the temporary folder is removed)."""
+    raise SystemExit(128 + signum)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; return the process exit code."""
+    if threading.current_thread() is threading.main_thread():
+        signal.signal(signal.SIGTERM, _exit_on_sigterm)
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -60,6 +74,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:
         print("fms-testbed: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:  # output piped into `head`: stop quietly (Python docs, signal)
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
 
 
 if __name__ == "__main__":  # pragma: no cover

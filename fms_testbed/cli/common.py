@@ -4,13 +4,15 @@ printed summary of a flight."""
 
 from __future__ import annotations
 
+import math
 import re
 
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.units import KMH_MPS, KT_MPS
 
 WIND_HELP = ("steady wind FROM_DEG/SPEED_KT (deg true it blows from / kt), e.g. 270/20; "
              "a unit suffix selects another speed unit: 270/10mps, 270/36kmh")
-_WIND_UNITS = {"": "speed_kt", "kt": "speed_kt", "mps": "speed_mps", "kmh": None}
+_WIND_UNITS = {"": "speed_kt", "kt": "speed_kt", "mps": "speed_mps"}
 
 
 def parse_wind(text: str) -> dict:
@@ -25,12 +27,54 @@ def parse_wind(text: str) -> dict:
         raise UserError(f"--wind {text!r}: expected FROM_DEG/SPEED_KT, e.g. 270/20 "
                         "(deg true from / kt; or 270/10mps, 270/36kmh)")
     d, s, unit = float(m.group(1)), float(m.group(2)), m.group(3) or ""
-    kt = s if unit in ("", "kt") else s * 3600.0 / 1852.0 if unit == "mps" else s / 1.852
+    kt = (s if unit in ("", "kt") else s / KT_MPS if unit == "mps"
+          else s * KMH_MPS / KT_MPS)
     if d > 360 or kt > 200:
         raise UserError(f"--wind {text!r}: direction must be 0-360 deg and speed ≤ 200 kt")
     if unit == "kmh":
-        return {"from_deg": d, "speed_kt": round(kt, 6)}
+        return {"from_deg": d, "speed_mps": s * KMH_MPS}
     return {"from_deg": d, _WIND_UNITS[unit]: s}
+
+
+def _cell(v) -> str:
+    if isinstance(v, (list, tuple)):
+        return " ".join(str(x) if str(x) else "-" for x in v)
+    if isinstance(v, float):
+        return "—" if not math.isfinite(v) else f"{v:.4g}"
+    return str(v)
+
+
+def text_table(df, right: tuple[str, ...] = ()) -> str:
+    """A DataFrame as an aligned plain-text table for the terminal: text columns left-aligned,
+    numbers (and the columns named in ``right``) right-aligned, lists joined with spaces (an
+    empty item as '-'), non-finite floats as '—'."""
+    cols = list(df.columns)
+    cells = [[_cell(v) for v in df[c]] for c in cols]
+    numeric = [df[c].dtype.kind in "iuf" or c in right for c in cols]
+    widths = [max([len(c)] + [len(x) for x in col]) for c, col in zip(cols, cells)]
+
+    def line(values):
+        return "  ".join(v.rjust(w) if num else v.ljust(w)
+                         for v, w, num in zip(values, widths, numeric)).rstrip()
+
+    out = [line(cols), line(["-" * w for w in widths])]
+    out += [line(row) for row in zip(*cells)]
+    return "\n".join(out)
+
+
+def _md(v) -> str:
+    if isinstance(v, float):
+        return "—" if not math.isfinite(v) else f"{v:.3g}" if abs(v) < 1000 else f"{v:.0f}"
+    return str(v)
+
+
+def markdown_table(df) -> str:
+    """A DataFrame as a GitHub Markdown table (floats to 3 significant digits, non-finite '—')."""
+    cols = list(df.columns)
+    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+    for _, r in df.iterrows():
+        lines.append("| " + " | ".join(_md(r[c]) for c in cols) + " |")
+    return "\n".join(lines)
 
 
 def add_override_options(p, aircraft_default: str | None = None) -> None:
@@ -99,4 +143,5 @@ def print_results(res) -> None:
               f"{q.get('skipped')}, repeated {q.get('repeated')}")
     if res.out_dir is not None:
         print(f"  outputs in {res.out_dir}: "
-              + ", ".join(["timeseries.parquet", "summary.json"] + s.get("plots", [])))
+              + ", ".join(["timeseries.parquet", "summary.json"] + s.get("plots", [])
+                        + s.get("tracks", [])))

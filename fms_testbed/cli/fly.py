@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fms_testbed.cli.common import add_override_options, overrides_from_args, print_results
+from fms_testbed.run.outputs import check_out_dir
 from fms_testbed.core.errors import UserError
 from fms_testbed.data import results_dir
 
@@ -34,8 +35,6 @@ def scenario_from_args(args) -> dict:
 
 def cmd_fly(args) -> int:
     """Fly one procedure (from the options or a scenario file, with the same overrides)."""
-    from fms_testbed.run.api import run_scenario
-
     if args.scenario:
         if args.airport or args.procedure or args.transition or args.runway or args.db:
             raise UserError("--scenario names the procedure; --db/--airport/--procedure/"
@@ -45,10 +44,15 @@ def cmd_fly(args) -> int:
         scenario = scenario_from_args(args)
         default = scenario["name"]
     out = Path(args.out) if args.out else results_dir() / default
-    res = run_scenario(scenario, out_dir=out, seed=args.seed, overrides=overrides_from_args(args),
-                       csv=args.csv, plots=not args.no_plots, progress=None)
+    check_out_dir(out, args.overwrite)                          # before any work
+    from fms_testbed.evaluation.outcome import EXIT_CODES
+    from fms_testbed.run.api import run_scenario
+
+    res = run_scenario(scenario, seed=args.seed, overrides=overrides_from_args(args),
+                       progress=None)
+    res.save(out, csv=args.csv, plots=not args.no_plots, overwrite=args.overwrite)
     print_results(res)
-    return 0 if res.summary["status"] == "ok" else 1
+    return EXIT_CODES[res.summary["status"]]
 
 
 def register(sub) -> None:
@@ -64,4 +68,6 @@ def register(sub) -> None:
     p.add_argument("--out", help="output folder (default results/<airport>-<procedure>)")
     p.add_argument("--csv", action="store_true", help="also write timeseries.csv")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an --out folder that holds other files than a previous run")
     p.set_defaults(func=cmd_fly)

@@ -40,6 +40,12 @@ class Limits(_Frozen):
         5.0, description="rate limit on the bank command from heading hold/guidance, deg/s")
     ny_min: Annotated[float, Field(ge=-1, le=1)] = Field(description="min normal load factor, g")
     ny_max: Annotated[float, Field(ge=1, le=4)] = Field(description="max normal load factor, g")
+    ny_limit_min: Annotated[float, Field(ge=-4, le=0)] = Field(
+        -1.0, description="limit manoeuvring load factor, negative, g (CS 25.337: -1.0 for "
+                          "transport aeroplanes; the envelope check of a flight's outcome)")
+    ny_limit_max: Annotated[float, Field(ge=1.5, le=10)] = Field(
+        2.5, description="limit manoeuvring load factor, positive, g (CS 25.337: 2.5 for "
+                         "transport aeroplanes; CS 23: 3.8 normal category)")
     stall_alpha_deg: Pos = Field(description="alpha at which the run is declared stalled, deg")
     climb_rate_max_mps: Pos = Field(description="max sustained climb rate near sea level, m/s")
     climb_gradient_max: Annotated[float, Field(gt=0, lt=0.5)] = Field(
@@ -138,7 +144,8 @@ class AircraftConfig(_Frozen):
 
     name: str
     description: str = ""
-    jsbsim_model: str = Field(description="model folder name in the jsbsim wheel's aircraft/")
+    jsbsim_model: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_-]*$", max_length=64)] = Field(
+        description="model folder name in the jsbsim wheel's aircraft/ (a plain name: no path)")
     category: str = Field(description="narrow-body | business-jet | light")
     limits: Limits
     trim: TrimSettings

@@ -29,14 +29,11 @@ from fms_testbed.config.aircraft import list_aircraft
 from fms_testbed.config.navigation import NavigationBlock, with_default_source
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.config.yamlfile import read_mapping, validation_message
+from fms_testbed.core.units import FT_M, KMH_MPS, KT_MPS
 
-FT = 0.3048
-KT = 1852.0 / 3600.0
-KMH = 1.0 / 3.6
-
-_SPEED_KEYS = {"tas_mps": ("tas", 1.0), "tas_kmh": ("tas", KMH), "tas_kt": ("tas", KT),
-               "cas_mps": ("cas", 1.0), "cas_kt": ("cas", KT), "cas_kmh": ("cas", KMH)}
-_ALT_KEYS = {"alt_m": 1.0, "alt_ft": FT}
+_SPEED_KEYS = {"tas_mps": ("tas", 1.0), "tas_kmh": ("tas", KMH_MPS), "tas_kt": ("tas", KT_MPS),
+               "cas_mps": ("cas", 1.0), "cas_kt": ("cas", KT_MPS), "cas_kmh": ("cas", KMH_MPS)}
+_ALT_KEYS = {"alt_m": 1.0, "alt_ft": FT_M}
 
 
 class _Strict(BaseModel):
@@ -132,7 +129,7 @@ class Wind(_Strict):
     @property
     def speed_ms(self) -> float:
         """Wind speed, m/s."""
-        return self.speed_mps if self.speed_mps is not None else self.speed_kt * KT
+        return self.speed_mps if self.speed_mps is not None else self.speed_kt * KT_MPS
 
 
 class Turbulence(_Strict):
@@ -199,6 +196,10 @@ class Scenario(_Strict):
     log_rate_hz: Annotated[float, Field(ge=1, le=120)] = Field(
         10.0, description="timeseries rate, Hz (at most the outer rate)")
     navigation: NavigationBlock | None = None
+    rnp_nm: Annotated[float, Field(gt=0, le=30)] | None = Field(
+        None, description="RNP for the navigation error of a flight without a procedure, NM "
+                          "(default: 2 NM when the navigation source is not truth; a procedure "
+                          "flight takes its RNP from the procedure)")
     procedure: dict[str, Any] | None = None
     events: list[Event] = Field(default_factory=list)
     source_file: str = ""

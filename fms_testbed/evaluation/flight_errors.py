@@ -28,23 +28,22 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
+from fms_testbed.core.earth import MEAN_RADIUS_M
+from fms_testbed.core.units import FT_M, KT_MPS, NM_M
 from fms_testbed.path.profile import window
 
-FT_M = 0.3048
-KT_MPS = 1852.0 / 3600.0
 ALT_TOL_FT = 50.0
 SPEED_TOL_KT = 5.0
 STRAIGHT_MARGIN_M = 2000.0
-FIX_PASS_MAX_M = 1852.0
+FIX_PASS_MAX_M = 1.0 * NM_M
 """A constrained fix counts as passed when the flight came within this distance of it, m."""
-_R_M = 6371008.8
 
 
 def _dist_m(lat1, lon1, lat2, lon2):
     """Equirectangular distance (deg inputs, vectorised), m — accurate to < 0.1 % at < 50 km."""
     la1, la2 = np.radians(lat1), np.radians(lat2)
     x = np.radians(np.asarray(lon2) - np.asarray(lon1)) * np.cos(0.5 * (la1 + la2))
-    return _R_M * np.hypot(x, la2 - la1)
+    return MEAN_RADIUS_M * np.hypot(x, la2 - la1)
 
 
 def _stats(x: np.ndarray) -> dict[str, float | None]:
@@ -81,7 +80,7 @@ def error_stats(df: pd.DataFrame) -> dict:
 
 
 def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
-    """Per-leg statistics and RNP containment (TSE95 ≤ RNP)."""
+    """Per-leg statistics and RNP containment (TSE95 ≤ RNP and max TSE ≤ 2 × RNP)."""
     rows = []
     for k, rec in enumerate(seq_legs):
         d = df[df["leg_index"] == k]
@@ -92,9 +91,11 @@ def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
             for name in ("fte", "nse", "pde", "tse"):
                 s = _stats(d[f"{name}_m"].to_numpy(dtype=float))
                 row[f"{name}95_m"], row[f"{name}_max_m"] = s["p95_m"], s["max_m"]
-            row["rnp_nm"] = round(rnp / 1852.0, 2)
+            row["rnp_nm"] = round(rnp / NM_M, 2)
+            # RNP containment: TSE95 within RNP and the largest TSE within 2 x RNP
             row["rnp_contained"] = (None if row["tse95_m"] is None
-                                    else bool(row["tse95_m"] <= rnp))
+                                    else bool(row["tse95_m"] <= rnp
+                                              and row["tse_max_m"] <= 2.0 * rnp))
         rows.append(row)
     return rows
 
@@ -115,12 +116,19 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
         term = bl.termination if bl is not None else None
         if term is not None and term.kind == "altitude" and not term.fix_ident:
             sel = np.flatnonzero(leg_col == k)
-            if not sel.size:
-                row.update(ok=False, why="leg not flown")
-                out.append(row)
-                continue
-            i = int(sel[-1])
-            row["where"] = "leg end"
+            if sel.size:
+                i = int(sel[-1])
+                row["where"] = "leg end"
+            else:
+                # ended between two logged rows (an altitude already reached when the leg
+                # began): check the state when the next leg began
+                after = np.flatnonzero(leg_col > k)
+                if not after.size:
+                    row.update(ok=False, why="leg not flown")
+                    out.append(row)
+                    continue
+                i = int(after[0])
+                row["where"] = "leg end (ended within one logged step)"
         else:
             if term is None or term.lat_deg is None or k == 0 and rec.path_term == "IF" \
                     and not len(df):
@@ -138,7 +146,7 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
             i = int(sel[j])
             row["where"] = f"{d[j]:.0f} m from the fix"
             if d[j] > FIX_PASS_MAX_M:
-                row.update(ok=False, why=f"fix passed {d[j] / 1852:.2f} NM away")
+                row.update(ok=False, why=f"fix passed {d[j] / NM_M:.2f} NM away")
                 out.append(row)
                 continue
         alt_ft = float(df["alt_m"].iloc[i]) / FT_M

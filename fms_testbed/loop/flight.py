@@ -231,7 +231,8 @@ class Flight:
                 reason = (f"duration {scn.duration_s:.0f} s ended on leg {g.leg + 1} of "
                           f"{len(self.procedure.path.seq.legs)}")
         summary = {
-            "scenario": scn.name, "aircraft": cfg.name, "jsbsim_model": cfg.jsbsim_model,
+            "scenario": scn.name, "aircraft": cfg.name, "aircraft_file": cfg.source_file,
+            "jsbsim_model": cfg.jsbsim_model,
             "status": status, "reason": reason,
             "seed": self.seed, "navigation_seed": self.navigation_seed,
             "duration_s": round(flown, 3), "wall_time_s": round(wall, 3),

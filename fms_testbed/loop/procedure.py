@@ -30,7 +30,6 @@ from fms_testbed.path.plan import FlyablePath, build_procedure, load_db
 from fms_testbed.config.yamlfile import read_mapping
 from fms_testbed.config.scenario import Scenario, parse_scenario
 
-MPS_KT = 3600.0 / 1852.0
 OUTER_RATE_HZ = 10.0
 """Rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS runs
 LNAV/VNAV at 5-20 Hz; the same as the scenario default). A scenario's ``outer_rate_hz`` wins."""

@@ -16,6 +16,7 @@ from fms_testbed.core.contracts import Guidance
 from fms_testbed.core.errors import UserError
 from fms_testbed.core.units import NM_M
 from fms_testbed.evaluation.flight_errors import error_columns, flight_errors
+from fms_testbed.evaluation.outcome import DEFAULT_ENROUTE_RNP_NM, decide
 from fms_testbed.loop.flight import Flight
 from fms_testbed.loop.procedure import PreparedProcedure, prepare_procedure
 from fms_testbed.run.results import Results, Summary
@@ -50,10 +51,13 @@ def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedPro
         raw.setdefault("name", path.stem)
     proc_over = overrides.pop("procedure", None)
     if proc_over is not None:
-        if not isinstance(raw.get("procedure"), dict):
-            raise UserError(f"{source}: procedure options (--rnp) need a scenario with a "
-                            "'procedure:' block")
-        raw["procedure"] = {**raw["procedure"], **proc_over}
+        if isinstance(raw.get("procedure"), dict):
+            raw["procedure"] = {**raw["procedure"], **proc_over}
+        elif set(proc_over) == {"rnp_nm"}:     # --rnp on a flight without a procedure
+            raw["rnp_nm"] = proc_over["rnp_nm"]
+        else:
+            raise UserError(f"{source}: procedure options need a scenario with a 'procedure:' "
+                            "block")
     raw.update(overrides)
     raw.pop("source_file", None)
     if raw.get("procedure") is not None:
@@ -87,6 +91,12 @@ def results_of(flight: Flight) -> Results:
         if "xtk_m" in df:
             df = error_columns(df)
         rebuilt = list(g.rebuilt)
+        rnp_nm = None
+    else:
+        scn = flight.scn
+        rnp_nm = scn.rnp_nm if scn.rnp_nm is not None else (
+            DEFAULT_ENROUTE_RNP_NM if scn.navigation_spec["source"] != "truth" else None)
+    decide(summary, df, flight.cfg, rnp_nm)
     return Results(df=df, summary=summary, scenario=flight.scn, procedure=proc,
                    flown_paths=rebuilt)
 

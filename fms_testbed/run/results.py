@@ -17,8 +17,12 @@ from typing import Any
 import pandas as pd
 
 from fms_testbed.config.scenario import Scenario
+from fms_testbed.core.errors import UserError
 from fms_testbed.loop.procedure import PreparedProcedure
+from fms_testbed.run.outputs import OutputFolder, file_sha256
 from fms_testbed.viz.figure import save as save_figure
+from fms_testbed.viz.geojson import write_track_geojson
+from fms_testbed.viz.kml import write_track_kml
 from fms_testbed.viz.procedure import plot_procedure
 from fms_testbed.viz.run import plot_run
 
@@ -112,22 +116,59 @@ class Results:
                                        self.flown_paths))
         return figs
 
-    def save(self, out_dir: str | Path, csv: bool = False, plots: bool = True) -> Path:
+    def inputs(self) -> dict[str, dict]:
+        """The files this flight was built from, with their SHA-256 (for ``run.json``)."""
+        files = {"scenario": self.scenario.source_file,
+                 "aircraft": self.summary.get("aircraft_file")}
+        if self.procedure is not None:
+            files["procedure_db"] = getattr(self.procedure.db, "path", None)
+        return {k: {"path": str(v), "sha256": file_sha256(v)} for k, v in files.items()
+                if v and not str(v).startswith("<")}
+
+    def save(self, out_dir: str | Path, csv: bool = False, plots: bool = True,
+             overwrite: bool = False, command: list[str] | None = None) -> Path:
         """Write ``timeseries.parquet``, ``summary.json``, the PNG plots (and ``timeseries.csv``)
-        into ``out_dir``; return the folder."""
-        out = Path(out_dir)
-        out.mkdir(parents=True, exist_ok=True)
-        self.df.to_parquet(out / "timeseries.parquet", index=False)
-        if csv:
-            self.df.to_csv(out / "timeseries.csv", index=False, float_format="%.7g")
-        if plots:
-            names = []
-            for stem, fig in self.plot().items():
-                names.append(save_figure(fig, out / f"{stem}.png").name)
-            self.summary["plots"] = names
-        (out / "summary.json").write_text(self.summary.to_json())
-        self.out_dir = out
-        return out
+        and the tracks for Google Earth/QGIS (``track.geojson``, ``track.kml``: the designed path
+        of a procedure flight and the flown 3-D track) into ``out_dir``, atomically
+        (:class:`~fms_testbed.run.outputs.OutputFolder`: a previous run there is replaced as a
+        whole; ``run.json`` is written last); return the folder.
+
+        Parameters
+        ----------
+        out_dir : target folder
+        csv : also write ``timeseries.csv``;  plots : write the PNG figures
+        overwrite : replace a folder that holds something other than a testbed run
+        command : the command line to record in ``run.json`` (default ``sys.argv``)
+        """
+        folder = OutputFolder(out_dir, overwrite)
+        try:
+            with folder as tmp:
+                self.df.to_parquet(tmp / "timeseries.parquet", index=False)
+                if csv:
+                    self.df.to_csv(tmp / "timeseries.csv", index=False, float_format="%.7g")
+                if plots:
+                    names = []
+                    for stem, fig in self.plot().items():
+                        names.append(save_figure(fig, tmp / f"{stem}.png").name)
+                    self.summary["plots"] = names
+                if not self.df.empty:   # tracks for Google Earth / QGIS (viz.geojson, viz.kml)
+                    path = self.procedure.path.path if self.procedure is not None else None
+                    self.summary["tracks"] = [
+                        w(tmp / name, self.df, self.summary, path, tuple(self.flown_paths)).name
+                        for w, name in ((write_track_geojson, "track.geojson"),
+                                        (write_track_kml, "track.kml"))]
+                (tmp / "summary.json").write_text(self.summary.to_json())
+                folder.set_run_info(**({"command": command} if command is not None else {}),
+                                    scenario=self.summary.get("scenario"),
+                                    seed=self.summary.get("seed"),
+                                    status=self.summary.get("status"),
+                                    reason=self.summary.get("reason"),
+                                    inputs=self.inputs())
+        except OSError as exc:
+            raise UserError(f"--out {out_dir}: cannot write the outputs: "
+                            f"{exc.strerror or exc}") from None
+        self.out_dir = folder.out
+        return folder.out
 
 
 __all__ = ["Results", "Summary"]

@@ -1,0 +1,160 @@
+"""Output folders that can be trusted.
+
+* :func:`check_out_dir` runs before any work: the target must be a folder (or creatable), not a
+  file, not a symlink, writable; a folder that holds anything but a previous testbed run is
+  refused unless ``overwrite``. Problems are a one-line :class:`UserError` (CLI exit 2).
+* :class:`OutputFolder` writes into a fresh temporary folder beside the target and moves it into
+  place only when complete, with ``run.json`` written last as the completion marker; a previous
+  run in the target is replaced as a whole (nothing of it stays). Nothing already in the target is
+  written through, so a symlink there is never followed. A run killed mid-write leaves the
+  previous outputs as they were and a hidden ``.NAME.partial-*`` folder (removed by the next run).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import shutil
+import sys
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+from fms_testbed.core.errors import UserError
+
+RUN_MARKER = "run.json"
+"""Written last into a complete output folder; a folder holding it is a testbed run."""
+
+
+def _is_previous_run(folder: Path) -> bool:
+    try:
+        data = json.loads((folder / RUN_MARKER).read_text())
+    except (OSError, ValueError):
+        return False
+    return isinstance(data, dict) and data.get("tool") == "fms-testbed"
+
+
+def check_out_dir(out_dir: str | Path, overwrite: bool = False) -> Path:
+    """Check that ``out_dir`` can take a run's outputs; raise :class:`UserError` (one line) if not.
+
+    Parameters
+    ----------
+    out_dir : the target folder
+    overwrite : replace a folder that holds something other than a previous testbed run
+
+    Returns
+    -------
+    the target as an absolute path
+    """
+    out = Path(out_dir)
+    if out.is_symlink():
+        raise UserError(f"--out {out}: is a symbolic link; give the real folder")
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out}: is a file, not a folder")
+    if out.is_dir():
+        try:
+            content = [p.name for p in out.iterdir() if not p.name.startswith(f".{out.name}.")]
+        except OSError as exc:
+            raise UserError(f"--out {out}: cannot list the folder: {exc.strerror}") from None
+        if content and not _is_previous_run(out) and not overwrite:
+            raise UserError(f"--out {out}: the folder holds other files ({', '.join(content[:3])}"
+                            f"{', ...' if len(content) > 3 else ''}); give an empty or new folder, "
+                            "or --overwrite to replace it")
+    parent = out.absolute().parent
+    probe = parent
+    while not probe.exists():
+        probe = probe.parent
+    if not probe.is_dir():
+        raise UserError(f"--out {out}: {probe} is not a folder")
+    if not os.access(probe, os.W_OK | os.X_OK):
+        raise UserError(f"--out {out}: cannot write in {probe} (permission denied)")
+    return out.absolute()
+
+
+def file_sha256(path: str | Path) -> str | None:
+    """SHA-256 of a file's bytes (None when it cannot be read)."""
+    h = hashlib.sha256()
+    try:
+        with open(path, "rb") as f:
+            for block in iter(lambda: f.read(1 << 20), b""):
+                h.update(block)
+    except OSError:
+        return None
+    return h.hexdigest()
+
+
+class OutputFolder:
+    """A run's output folder, written atomically (module docstring).
+
+    Use as a context manager: ``with OutputFolder(out, overwrite) as tmp: ...write into tmp...``;
+    on a clean exit :meth:`commit` is called with the ``run.json`` content given to
+    :meth:`set_run_info`; on an exception the partial folder is removed and the target is left
+    as it was.
+    """
+
+    def __init__(self, out_dir: str | Path, overwrite: bool = False):
+        self.out = check_out_dir(out_dir, overwrite)
+        self.tmp: Path | None = None
+        self.info: dict = {}
+        self.started = datetime.now(timezone.utc)
+
+    def __enter__(self) -> Path:
+        parent = self.out.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+            for stale in parent.glob(f".{self.out.name}.partial-*"):
+                shutil.rmtree(stale, ignore_errors=True)
+            self.tmp = Path(tempfile.mkdtemp(prefix=f".{self.out.name}.partial-", dir=parent))
+        except OSError as exc:
+            raise UserError(f"--out {self.out}: cannot create the output folder: "
+                            f"{exc.strerror}") from None
+        return self.tmp
+
+    def set_run_info(self, **info) -> None:
+        """Fields of ``run.json`` (command, seed, inputs, status, ...)."""
+        self.info.update(info)
+
+    def commit(self) -> Path:
+        """Write ``run.json`` last, then move the folder into place (replacing a previous run)."""
+        from fms_testbed import __version__
+
+        assert self.tmp is not None
+        run = {"tool": "fms-testbed", "version": __version__,
+               "command": self.info.pop("command", sys.argv),
+               **self.info,
+               "started_utc": self.started.isoformat(timespec="seconds"),
+               "finished_utc": datetime.now(timezone.utc).isoformat(timespec="seconds")}
+        with open(self.tmp / RUN_MARKER, "w") as f:
+            f.write(json.dumps(run, indent=2, default=str) + "\n")
+            f.flush()
+            os.fsync(f.fileno())
+        old = None
+        if self.out.exists():
+            old = self.out.with_name(f".{self.out.name}.old-{os.getpid()}-{time.time_ns()}")
+            os.rename(self.out, old)
+        os.rename(self.tmp, self.out)
+        self.tmp = None
+        if old is not None:
+            shutil.rmtree(old, ignore_errors=True)
+        return self.out
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if exc_type is None:
+            try:
+                self.commit()
+            except OSError as err:
+                self._discard()
+                raise UserError(f"--out {self.out}: cannot finish writing: {err.strerror}") from None
+            return False
+        self._discard()
+        return False
+
+    def _discard(self) -> None:
+        if self.tmp is not None:
+            shutil.rmtree(self.tmp, ignore_errors=True)
+            self.tmp = None
+
+
+__all__ = ["RUN_MARKER", "OutputFolder", "check_out_dir", "file_sha256"]

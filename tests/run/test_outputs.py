@@ -1,0 +1,119 @@
+"""Output folders (issue 11): checked before any work, written atomically with run.json last, a
+previous run replaced as a whole, other content refused, symlinks never followed, a kill
+mid-write leaves the previous run intact."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from fms_testbed.core.errors import UserError
+from fms_testbed.run.outputs import RUN_MARKER, OutputFolder, check_out_dir
+
+
+def _write_run(out, files):
+    with OutputFolder(out) as tmp:
+        for name, text in files.items():
+            (tmp / name).write_text(text)
+    return out
+
+
+def test_new_folder_gets_run_json_last(tmp_path):
+    out = _write_run(tmp_path / "r", {"summary.json": "{}"})
+    info = json.loads((out / RUN_MARKER).read_text())
+    assert info["tool"] == "fms-testbed" and "version" in info and "finished_utc" in info
+    assert sorted(p.name for p in out.iterdir()) == ["run.json", "summary.json"]
+    assert not list(tmp_path.glob(".r.*"))        # no temporary folder left
+
+
+def test_second_run_leaves_nothing_of_the_first(tmp_path):
+    out = _write_run(tmp_path / "r", {"timeseries.csv": "a", "plot.png": "b", "summary.json": "1"})
+    _write_run(out, {"summary.json": "2"})
+    assert sorted(p.name for p in out.iterdir()) == ["run.json", "summary.json"]
+    assert (out / "summary.json").read_text() == "2"
+
+
+def test_folder_with_other_content_is_refused_unless_overwrite(tmp_path):
+    out = tmp_path / "mine"
+    out.mkdir()
+    (out / "thesis.tex").write_text("precious")
+    with pytest.raises(UserError, match="holds other files"):
+        check_out_dir(out)
+    _write_run_overwrite = OutputFolder(out, overwrite=True)
+    with _write_run_overwrite as tmp:
+        (tmp / "summary.json").write_text("{}")
+    assert not (out / "thesis.tex").exists()
+
+
+def test_file_symlink_and_readonly_targets(tmp_path):
+    f = tmp_path / "afile"
+    f.write_text("x")
+    with pytest.raises(UserError, match="is a file"):
+        check_out_dir(f)
+    link = tmp_path / "link"
+    link.symlink_to(tmp_path / "elsewhere", target_is_directory=True)
+    with pytest.raises(UserError, match="symbolic link"):
+        check_out_dir(link)
+    if os.geteuid() != 0:   # root writes anywhere
+        ro = tmp_path / "ro"
+        ro.mkdir()
+        ro.chmod(0o500)
+        with pytest.raises(UserError, match="permission denied"):
+            check_out_dir(ro / "out")
+
+
+def test_symlink_inside_a_previous_run_is_not_followed(tmp_path):
+    out = _write_run(tmp_path / "r", {"summary.json": "1"})
+    victim = tmp_path / "victim.txt"
+    victim.write_text("keep me")
+    (out / "summary.json").unlink()
+    (out / "summary.json").symlink_to(victim)
+    _write_run(out, {"summary.json": "new"})
+    assert victim.read_text() == "keep me"
+    assert not (out / "summary.json").is_symlink()
+
+
+def test_failure_inside_leaves_the_previous_run(tmp_path):
+    out = _write_run(tmp_path / "r", {"summary.json": "old"})
+    with pytest.raises(RuntimeError):
+        with OutputFolder(out) as tmp:
+            (tmp / "summary.json").write_text("half")
+            raise RuntimeError("disk on fire")
+    assert (out / "summary.json").read_text() == "old"
+    assert not list(tmp_path.glob(".r.partial-*"))
+
+
+def test_kill_mid_write_leaves_the_previous_run_complete(tmp_path):
+    out = _write_run(tmp_path / "r", {"summary.json": "old"})
+    code = ("import sys, time\n"
+            "from fms_testbed.run.outputs import OutputFolder\n"
+            f"with OutputFolder({str(out)!r}) as tmp:\n"
+            "    (tmp / 'timeseries.csv').write_text('')\n"
+            "    print('writing', flush=True)\n"
+            "    time.sleep(30)\n")
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, text=True)
+    assert p.stdout.readline().strip() == "writing"
+    p.send_signal(signal.SIGKILL)
+    p.wait(timeout=10)
+    assert (out / "summary.json").read_text() == "old"
+    assert json.loads((out / RUN_MARKER).read_text())["tool"] == "fms-testbed"
+    assert not (out / "timeseries.csv").exists()
+    _write_run(out, {"summary.json": "new"})          # the next run removes the partial folder
+    assert not list(tmp_path.glob(".r.partial-*"))
+
+
+def test_cli_refuses_a_bad_out_before_flying(tmp_path):
+    f = tmp_path / "afile"
+    f.write_text("x")
+    t0 = time.perf_counter()
+    r = subprocess.run([sys.executable, "-m", "fms_testbed", "demo", "--out", str(f)],
+                       capture_output=True, text=True, timeout=120)
+    assert r.returncode == 2 and "is a file" in r.stderr and "Traceback" not in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert time.perf_counter() - t0 < 5        # checked before loading JSBSim or flying (0.6 s here)
