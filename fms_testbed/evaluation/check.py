@@ -13,15 +13,16 @@ from collections import Counter
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass
 
+from fms_testbed.core.processes import die_with_parent
 from fms_testbed.core.geodesy import gravity_mps2, inverse
 from fms_testbed.core.segments import Arc
+from fms_testbed.core.units import NM_M
 from fms_testbed.procedures.database import Database, load_database
 from fms_testbed.procedures.legrecord import PATH_TERMINATORS, PROC_TYPES
 from fms_testbed.legs.model import BuildParams, Performance, ProcedurePath
 from fms_testbed.path.monitor import check_path, leg_end_checks
 from fms_testbed.path.segmentation import build_sequence
 
-NM_M = 1852.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -144,6 +145,7 @@ _WORKER: dict = {}
 
 
 def _init_worker(db_path: str, perf: Performance, params: BuildParams) -> None:
+    die_with_parent()                       # no orphan worker after a SIGKILL of the parent
     _WORKER["db"] = load_database(db_path)
     _WORKER["perf"] = perf
     _WORKER["params"] = params

@@ -1,0 +1,46 @@
+"""A flight interrupted by SIGINT ends with exit 130 and one 'interrupted' line; SIGTERM ends it
+with the JSBSim sandbox folder removed from the temporary folder."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "sins-stim300.yaml"
+
+
+def _start(tmp_path):
+    env = {**os.environ, "TMPDIR": str(tmp_path / "tmp")}
+    (tmp_path / "tmp").mkdir()
+    p = subprocess.Popen([sys.executable, "-m", "fms_testbed", "run", str(SCENARIO),
+                          "--out", str(tmp_path / "out"), "--no-plots"],
+                         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    deadline = time.time() + 60
+    while time.time() < deadline and not list((tmp_path / "tmp").glob("fms-testbed-jsbsim-*")):
+        time.sleep(0.05)
+    assert list((tmp_path / "tmp").glob("fms-testbed-jsbsim-*")), "the flight never started"
+    time.sleep(1.0)                 # inside the closed loop (SINS kernels in numba)
+    return p
+
+
+def test_sigint_exits_130_with_one_line(tmp_path):
+    p = _start(tmp_path)
+    p.send_signal(signal.SIGINT)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 130, err[-2000:]
+    assert "interrupted" in err and "Traceback" not in err
+    assert not list((tmp_path / "tmp").glob("fms-testbed-jsbsim-*"))
+    assert not (tmp_path / "out").exists()          # nothing that looks like a finished run
+
+
+def test_sigterm_removes_the_jsbsim_sandbox(tmp_path):
+    p = _start(tmp_path)
+    p.send_signal(signal.SIGTERM)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode == 128 + signal.SIGTERM, err[-2000:]
+    assert "Traceback" not in err
+    assert not list((tmp_path / "tmp").glob("fms-testbed-jsbsim-*"))
