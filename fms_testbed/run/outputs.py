@@ -23,6 +23,7 @@ from datetime import datetime, timezone
 from pathlib import Path
 
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.jsonio import dumps
 
 RUN_MARKER = "run.json"
 """Written last into a complete output folder; a folder holding it is a testbed run."""
@@ -127,7 +128,7 @@ class OutputFolder:
                "started_utc": self.started.isoformat(timespec="seconds"),
                "finished_utc": datetime.now(timezone.utc).isoformat(timespec="seconds")}
         with open(self.tmp / RUN_MARKER, "w") as f:
-            f.write(json.dumps(run, indent=2, default=str) + "\n")
+            f.write(dumps(run))
             f.flush()
             os.fsync(f.fileno())
         old = None

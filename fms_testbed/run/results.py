@@ -8,8 +8,6 @@ writes the outputs of a run into a folder.
 
 from __future__ import annotations
 
-import json
-import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -18,6 +16,7 @@ import pandas as pd
 
 from fms_testbed.config.scenario import Scenario
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.jsonio import dumps
 from fms_testbed.loop.procedure import PreparedProcedure
 from fms_testbed.run.outputs import OutputFolder, file_sha256
 from fms_testbed.viz.figure import save as save_figure
@@ -25,19 +24,6 @@ from fms_testbed.viz.geojson import write_track_geojson
 from fms_testbed.viz.kml import write_track_kml
 from fms_testbed.viz.procedure import plot_procedure
 from fms_testbed.viz.run import plot_run
-
-
-def _finite_or_none(x: Any) -> Any:
-    """JSON value of ``x``: non-finite floats become null (summary.json is strict JSON)."""
-    if isinstance(x, float):
-        return x if math.isfinite(x) else None
-    if isinstance(x, dict):
-        return {k: _finite_or_none(v) for k, v in x.items()}
-    if isinstance(x, (list, tuple)):
-        return [_finite_or_none(v) for v in x]
-    if hasattr(x, "item") and not isinstance(x, (str, bytes)):  # numpy scalars
-        return _finite_or_none(x.item())
-    return x
 
 
 class Summary(dict):
@@ -77,7 +63,7 @@ class Summary(dict):
 
     def to_json(self) -> str:
         """Strict JSON (non-finite numbers as null), indented."""
-        return json.dumps(_finite_or_none(dict(self)), indent=2, allow_nan=False) + "\n"
+        return dumps(dict(self))
 
 
 @dataclass
