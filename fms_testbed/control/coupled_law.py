@@ -45,15 +45,10 @@ import math
 from dataclasses import dataclass, replace
 
 from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.core.earth import A_M, OMEGA_IE_RPS, normal_gravity_mps2
 from fms_testbed.core.state import AircraftState
-
-G_MPS2 = 9.80665
-"""Standard gravity, m/s²."""
-
-_WGS84_A_M = 6378137.0
-_WGS84_F = 1.0 / 298.257223563
-_WGS84_M = 0.00344978650684  # ω² a² b / GM
-_OMEGA_E_RPS = 7.292115e-5
+from fms_testbed.core.units import G0_MPS2
+from fms_testbed.core.errors import ConfigError
 
 _SAT_EPS = 0.005
 """Throttle within this of a limit counts as saturated (normalised throttle)."""
@@ -129,8 +124,6 @@ def params_from_config(cfg: AircraftConfig, **overrides) -> CoupledLawParams:
     """
     gains = cfg.coupled_law
     if gains is None:
-        from fms_testbed.core.errors import ConfigError
-
         raise ConfigError(f"{cfg.source_file or cfg.name}: no 'coupled_law' block (T_V_s, xi_V, "
                           "T_H_s, xi_H) — run `fms-testbed tune` or add one")
     p = CoupledLawParams(
@@ -177,20 +170,18 @@ def gravity_ratio(lat_rad: float, alt_m: float, ve_mps: float = 0.0, vn_mps: flo
 
     Notes
     -----
-    WGS-84 Somigliana normal gravity with the second-order free-air correction, minus the
-    Eötvös term 2 Ω v_E cos φ and the curvature term v² / (R + h). Load factors are forces over
-    m·g0, so level flight reads n_y = g_eff / g0, not 1 (0.99901 at 3000 m, 45° N, at rest;
+    Normal gravity γ(φ, h) (:func:`fms_testbed.core.earth.normal_gravity_mps2`: WGS-84 Somigliana
+    with the second-order height term, NIMA TR8350.2 eq. 4-1, 4-3), minus the Eötvös term
+    2 Ω v_E cos φ and the curvature term v² / (a + h). Load factors are forces over m·g0, so
+    level flight reads n_y = g_eff / g0, not 1 (0.99901 at 3000 m, 45° N, at rest;
     0.9978 flying east at 400 km/h at 47° N). Ignoring it leaves a steady altitude offset
     ΔH = (1 - g_eff/g0) g0 T_H² (0.8 m for T_H = 8 s). The normal-gravity part matches JSBSim's
     trimmed n_y to 1e-5 (measured at 0/45/70° and 1000/3000/10000 m).
     """
-    s2 = math.sin(lat_rad) ** 2
-    g = 9.7803253359 * (1 + 0.00193185265241 * s2) / math.sqrt(1 - 0.00669437999013 * s2)
-    h = alt_m / _WGS84_A_M
-    g *= 1 - 2 * h * (1 + _WGS84_F + _WGS84_M - 2 * _WGS84_F * s2) + 3 * h * h
-    g -= 2.0 * _OMEGA_E_RPS * ve_mps * math.cos(lat_rad) + (ve_mps ** 2 + vn_mps ** 2) / (
-        _WGS84_A_M + alt_m)
-    return g / G_MPS2
+    g = normal_gravity_mps2(lat_rad, alt_m)
+    g -= 2.0 * OMEGA_IE_RPS * ve_mps * math.cos(lat_rad) + (ve_mps ** 2 + vn_mps ** 2) / (
+        A_M + alt_m)
+    return g / G0_MPS2
 
 
 def clip_altitude_error(dH_m: float, limit_m: float) -> float:
@@ -222,8 +213,8 @@ def altitude_channel_ny(p: CoupledLawParams, dH_lim_m: float, tas_mps: float, ga
     n_ya (g), unclipped. ``exact``: eq. 7 with weight terms scaled by g/g0;
     ``paper``: g/g0 + Δn_ya of eq. 19 with V_y = V θ.
     """
-    kd = 2.0 * p.xi_H / (G_MPS2 * p.T_H_s)
-    kp = 1.0 / (G_MPS2 * p.T_H_s ** 2)
+    kd = 2.0 * p.xi_H / (G0_MPS2 * p.T_H_s)
+    kp = 1.0 / (G0_MPS2 * p.T_H_s ** 2)
     if p.form == "paper":
         return g_ratio - kd * tas_mps * gamma_rad - kp * dH_lim_m
     s, c = math.sin(gamma_rad), math.cos(gamma_rad)
@@ -249,13 +240,13 @@ def thrust_channel_rate(p: CoupledLawParams, dV_mps: float, tas_mps: float, gamm
     dn_xa/dt, g/s. The first term is the cross-coupling that cancels the elevator's effect on V.
     """
     if p.form == "paper":
-        cross = (G_MPS2 / tas_mps) * (ny_cmd - g_ratio)
+        cross = (G0_MPS2 / tas_mps) * (ny_cmd - g_ratio)
         damp = nxa - gamma_rad
     else:
         c = g_ratio * math.cos(gamma_rad)
-        cross = (G_MPS2 / tas_mps) * c * (ny_cmd - c)
+        cross = (G0_MPS2 / tas_mps) * c * (ny_cmd - c)
         damp = nxa - g_ratio * math.sin(gamma_rad)
-    return cross - (2.0 * p.xi_V / p.T_V_s) * damp - dV_mps / (G_MPS2 * p.T_V_s ** 2)
+    return cross - (2.0 * p.xi_V / p.T_V_s) * damp - dV_mps / (G0_MPS2 * p.T_V_s ** 2)
 
 
 def speed_protection_limit(p: CoupledLawParams, side: int, dV_mps: float, tas_mps: float,
@@ -278,9 +269,9 @@ def speed_protection_limit(p: CoupledLawParams, side: int, dV_mps: float, tas_mp
     g_ratio : apparent gravity over g0 (:func:`gravity_ratio`)
     """
     tau = p.T_V_s / (2.0 * p.xi_V)
-    s_lim = min(max((nx_meas + dV_mps / (G_MPS2 * tau)) / g_ratio, -0.5), 0.5)
+    s_lim = min(max((nx_meas + dV_mps / (G0_MPS2 * tau)) / g_ratio, -0.5), 0.5)
     s_lim = max(s_lim, 0.0) if side > 0 else min(s_lim, 0.0)
-    return g_ratio * math.cos(gamma_rad) + (tas_mps / G_MPS2) * (
+    return g_ratio * math.cos(gamma_rad) + (tas_mps / G0_MPS2) * (
         math.asin(s_lim) - gamma_rad) / p.gamma_tau_s
 
 

@@ -19,8 +19,11 @@ from fms_testbed.core.atmosphere import cas_to_tas
 from fms_testbed.config.scenario import Scenario
 from fms_testbed.control import VERTICAL_LAWS
 from fms_testbed.control.coupled_law import CoupledLaw, CoupledLawParams, params_from_config
-from fms_testbed.control.metrics import KMH_PER_MPS, find_steps, settling_time, step_metrics
+from fms_testbed.control.metrics import find_steps, settling_time, step_metrics
+from fms_testbed.core.units import mps_to_kmh
 from fms_testbed.control.pointmass import CommandEvent, PointMassParams, second_order_step, simulate
+from fms_testbed.loop.flight import fly
+from fms_testbed.config.scenario import parse_scenario
 
 LAWS = ("coupled", "pi", "tecs")
 
@@ -91,8 +94,6 @@ def run_comparison(scn: Scenario, cfg: AircraftConfig | None = None,
     params : coupled-law tuning (default: from the config); the baselines use the same (T, ξ)
     seed : run seed
     """
-    from fms_testbed.loop.flight import fly
-
     cfg = cfg or load_aircraft(scn.aircraft)
     params = params or params_from_config(cfg)
     runs, status = {}, {}
@@ -144,8 +145,8 @@ def comparison_rows(cmp: ScenarioComparison, cfg: AircraftConfig) -> list[dict]:
             rows.append({
                 "scenario": cmp.scenario.name, "law": law, "status": cmp.status[law],
                 "step": (f"alt {m.step:+.0f} m" if ch == "alt"
-                         else f"speed {m.step * KMH_PER_MPS:+.0f} km/h"),
-                "max_dV_kmh": m.max_cross_dev * KMH_PER_MPS if ch == "alt" else float("nan"),
+                         else f"speed {mps_to_kmh(m.step):+.0f} km/h"),
+                "max_dV_kmh": mps_to_kmh(m.max_cross_dev) if ch == "alt" else float("nan"),
                 "max_dH_m": m.max_cross_dev if ch == "speed" else float("nan"),
                 "cross_ref": "ideal" if ref is not None else "command",
                 "settling_s": m.settling_s, "ideal_settling_s": ideal_settle,
@@ -222,12 +223,10 @@ def envelope_scenario(cfg: AircraftConfig, alt_m: float, tas_mps: float, kind: s
                       duration_s: float = 100.0) -> Scenario:
     """An unclipped step of ``cfg`` at ``alt_m`` (m), ``tas_mps`` (m/s): +100 m
     (``kind="alt"``) or +10 % TAS, flown for ``duration_s`` (s)."""
-    from fms_testbed.config.scenario import parse_scenario
-
     ev = ({"t_s": 5.0, "alt_m": alt_m + 100.0} if kind == "alt"
           else {"t_s": 5.0, "tas_mps": 1.1 * tas_mps})
     return parse_scenario({
-        "name": f"{cfg.name}-{alt_m:.0f}m-{tas_mps * 3.6:.0f}kmh-{kind}",
+        "name": f"{cfg.name}-{alt_m:.0f}m-{mps_to_kmh(tas_mps):.0f}kmh-{kind}",
         "aircraft": cfg.source_file or cfg.name, "duration_s": duration_s, "hold": True,
         "initial": {"alt_m": alt_m, "tas_mps": tas_mps, "lat_deg": 47.0, "heading_deg": 90.0},
         "events": [ev]}, f"<envelope {cfg.name}>")
@@ -246,14 +245,12 @@ def envelope_rows(cfg: AircraftConfig, laws: tuple[str, ...] = ("coupled", "pi")
     one row per (point, law) with settling (s), overshoot (%), the cross deviation (km/h in the
     altitude step, m in the speed step) and the throttle-saturation share (%)
     """
-    from fms_testbed.loop.flight import fly
-
     params = params_from_config(cfg)
     lo, hi = cfg.inner_loops.throttle_min, cfg.inner_loops.throttle_max
     rows = []
     for pt in cfg.envelope:
         for law in laws:
-            row = {"aircraft": cfg.name, "alt_m": pt.alt_m, "tas_kmh": pt.tas_mps * 3.6,
+            row = {"aircraft": cfg.name, "alt_m": pt.alt_m, "tas_kmh": mps_to_kmh(pt.tas_mps),
                    "law": law}
             for kind in ("alt", "speed"):
                 scn = envelope_scenario(cfg, pt.alt_m, pt.tas_mps, kind)
@@ -267,7 +264,7 @@ def envelope_rows(cfg: AircraftConfig, laws: tuple[str, ...] = ("coupled", "pi")
                 row[f"{kind}_overshoot_pct"] = m.overshoot_pct
                 row[f"{kind}_sat_pct"] = 100.0 * m.throttle_sat_frac
                 if kind == "alt":
-                    row["alt_step_max_dV_kmh"] = m.max_cross_dev * KMH_PER_MPS
+                    row["alt_step_max_dV_kmh"] = mps_to_kmh(m.max_cross_dev)
                 else:
                     row["speed_step_max_dH_m"] = m.max_cross_dev
             rows.append(row)

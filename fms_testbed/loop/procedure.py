@@ -29,6 +29,10 @@ from fms_testbed.config.procedure import ProcedureSpec, parse_procedure
 from fms_testbed.path.plan import FlyablePath, build_procedure, load_db
 from fms_testbed.config.yamlfile import read_mapping
 from fms_testbed.config.scenario import Scenario, parse_scenario
+from fms_testbed.sim.jsbsim_core import DT_S
+from fms_testbed.guidance.vertical import cas_band, leg_speed_limits, tas_target_mps
+from fms_testbed.guidance.lateral import LateralGains, anticipation_m
+from fms_testbed.core.geodesy import direct
 
 OUTER_RATE_HZ = 10.0
 """Rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS runs
@@ -37,19 +41,12 @@ LNAV/VNAV at 5-20 Hz; the same as the scenario default). A scenario's ``outer_ra
 
 def runner_log_every(scn: Scenario) -> int:
     """Outer steps between two logged rows, computed as the runner does (JSBSim at 120 Hz)."""
-    from fms_testbed.sim.jsbsim_core import DT_S
-
     n_outer = max(1, int(round(1.0 / (scn.outer_rate_hz * DT_S))))
     return max(1, int(round(1.0 / (scn.log_rate_hz * n_outer * DT_S))))
 
 
 def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     """The scenario ``initial`` block for the start of a built path (module docstring)."""
-    from fms_testbed.guidance.vertical import cas_band, leg_speed_limits, tas_target_mps
-
-    from fms_testbed.guidance.lateral import LateralGains, anticipation_m
-    from fms_testbed.core.geodesy import direct
-
     seg0 = fp.path.segments[0].geom
     crs = seg0.start_course_deg
     # start one roll-in anticipation before the path start on its initial course, so that a

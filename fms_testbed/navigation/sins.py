@@ -28,26 +28,30 @@ from pathlib import Path
 import numpy as np
 from numba import njit
 
+import fms_testbed.core.earth as _earth
 import fms_testbed.sensors.sins as _sins_pkg
-from fms_testbed.sensors.sins._numba_cache import invalidate_if_sources_changed
+from fms_testbed.core._numba_cache import invalidate_if_sources_changed
 
-# this module's kernel inlines the SINS package's kernels: clear its cache when either changes
-invalidate_if_sources_changed(Path(__file__).parent, also_hash=(Path(_sins_pkg.__file__).parent,))
+# this module's kernel inlines the SINS package's kernels and the Earth model's: clear its cache
+# when any of them changes
+invalidate_if_sources_changed(Path(__file__).parent, also_hash=(Path(_sins_pkg.__file__).parent,
+                                                                 Path(_earth.__file__)))
 
+from fms_testbed.core.earth import OMEGA_IE_RPS, radii_m
 from fms_testbed.core.errors import ConfigError, UserError
 from fms_testbed.core.state import AircraftState, NavSolution
+from fms_testbed.core.units import DPH_RPS, G0_MPS2
 from fms_testbed.sensors.sins.analysis import SinsOptions
 from fms_testbed.sensors.sins.discretize import (PICARD_MAX_ORDER, PICARD_MAX_RATE_DT, DiscretisationError,
                          _picard_sins, discretize)
-from fms_testbed.sensors.sins.model import A_M, E2, baro_gains, build_F
-from fms_testbed.sensors.sins.presets import G0_MPS2, ImuModel, load_imu
+from fms_testbed.sensors.sins.model import baro_gains, build_F
+from fms_testbed.sensors.sins.presets import ImuModel, load_imu
 from fms_testbed.sensors.sins.simulate import FACTOR_RTOL, IndefiniteCovarianceError, _psd_cholesky
+from fms_testbed.sensors.sins._blas import single_thread_blas
+from fms_testbed.sensors.sins.analysis import system_matrix, initial_map
 
 SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol",
              "matrices_dt_s", "alignment"}
-RAD2DPH = 180.0 / math.pi * 3600.0
-RAD2DEG = 180.0 / math.pi
-MPS2_TO_UG = 1e6 / G0_MPS2
 NOISE_BLOCK = 256   # navigation steps of process noise drawn at once
 
 
@@ -74,7 +78,7 @@ def _sins_step(x, noise, lat, alt, v, rpy, w_eb, f_b, decay, q_diag, k1, k2, dt,
     """Fused kernel: F at the true state → Picard (Φ, Q_k) → S → (Φ x + S N, Φ, S, status);
     status 0 ok, 1 Picard range, 2 no convergence, 3 indefinite Q_k."""
     c = _c_bn(rpy[0], rpy[1], rpy[2])
-    w_ie = np.array([0.0, 7.292115e-5 * math.cos(lat), 7.292115e-5 * math.sin(lat)])
+    w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(lat), OMEGA_IE_RPS * math.sin(lat)])
     w_ib = w_eb + c.T @ w_ie
     F = build_F(lat, alt, v, f_b, w_ib, c, decay, k1, k2)
     rate = 0.0
@@ -179,8 +183,6 @@ class SinsNavigation:
             if status == 3:
                 raise IndefiniteCovarianceError(f"navigation: Q_k indefinite at t = {prev.t_s} s")
         else:
-            from fms_testbed.sensors.sins._blas import single_thread_blas
-            from fms_testbed.sensors.sins.analysis import system_matrix
             F = system_matrix(prev.lat_rad, prev.alt_m, v, rpy, w_eb, f_b, self.imu, o)
             with single_thread_blas():
                 phi, qk = discretize(F, np.diag(self.imu.q_psd), dt, method=o.method)
@@ -197,7 +199,6 @@ class SinsNavigation:
         """Advance the error state to ``truth.t_s`` and return truth ⊕ errors."""
         prev = self._prev
         if prev is None:
-            from fms_testbed.sensors.sins.analysis import initial_map
             rpy = (truth.roll_rad, truth.pitch_rad, truth.heading_rad)
             self.x = initial_map(truth.lat_rad, rpy, self.imu, self.opts) @ self._z0
         else:
@@ -214,10 +215,7 @@ class SinsNavigation:
         x = self.x
         e, n, u, ve, vn, vu, eps_e, eps_n, eps_u, ba_x, _, _, bg_x, _, bg_z = x[:15].tolist()
         lat0, h0 = truth.lat_rad, truth.alt_m
-        s2 = math.sin(lat0) ** 2
-        w = 1.0 - E2 * s2                                   # WGS-84 radii (model.earth_radii)
-        rn = A_M / math.sqrt(w)
-        rm = A_M * (1.0 - E2) / (w * math.sqrt(w))
+        rm, rn = radii_m(lat0)
         # paper eq. 6.10 (scalar form of euler.eps_to_euler_errors, kept in math for speed)
         sp, cp = math.sin(truth.heading_rad), math.cos(truth.heading_rad)
         a = eps_e * sp + eps_n * cp
@@ -227,10 +225,10 @@ class SinsNavigation:
         errors = {
             "nse_east_m": e, "nse_north_m": n, "nse_up_m": u,
             "ve_err_mps": ve, "vn_err_mps": vn, "vu_err_mps": vu,
-            "att_err_roll_deg": d_roll * RAD2DEG, "att_err_pitch_deg": d_pitch * RAD2DEG,
-            "att_err_heading_deg": d_head * RAD2DEG,
-            "bias_accel_x_ug": ba_x * MPS2_TO_UG,
-            "bias_gyro_x_dph": bg_x * RAD2DPH, "bias_gyro_z_dph": bg_z * RAD2DPH,
+            "att_err_roll_deg": math.degrees(d_roll), "att_err_pitch_deg": math.degrees(d_pitch),
+            "att_err_heading_deg": math.degrees(d_head),
+            "bias_accel_x_ug": ba_x / G0_MPS2 * 1e6,
+            "bias_gyro_x_dph": bg_x / DPH_RPS, "bias_gyro_z_dph": bg_z / DPH_RPS,
         }
         return NavSolution(
             truth.t_s, lat0 + n / (rm + h0), truth.lon_rad + e / ((rn + h0) * math.cos(lat0)),

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from fms_testbed.core.errors import UserError
 from fms_testbed.core.jsonio import dumps
+from fms_testbed import __version__
 
 RUN_MARKER = "run.json"
 """Written last into a complete output folder; a folder holding it is a testbed run."""
@@ -119,8 +120,6 @@ class OutputFolder:
 
     def commit(self) -> Path:
         """Write ``run.json`` last, then move the folder into place (replacing a previous run)."""
-        from fms_testbed import __version__
-
         assert self.tmp is not None
         run = {"tool": "fms-testbed", "version": __version__,
                "command": self.info.pop("command", sys.argv),

@@ -25,8 +25,7 @@ between this system and :mod:`fms_testbed.sim.jsbsim_core`.
 """
 
 from __future__ import annotations
-
-import math
+from fms_testbed.core.atmosphere import isa
 
 #: Properties written from Python (inputs of the system).
 INPUT_PROPERTIES = (
@@ -174,8 +173,6 @@ def system_xml(n_engines: int, elevator_rate_max_ps: float, dt_s: float,
 def gain_properties(cfg) -> dict[str, float]:
     """Map an :class:`~fms_testbed.config.aircraft.AircraftConfig`'s inner-loop tuning to ``fms/*``
     properties (gains, limits, and the schedule's reference dynamic pressure)."""
-    from fms_testbed.core.atmosphere import isa
-
     gains = cfg.inner_loops
     _, _, rho = isa(cfg.default_condition.alt_m)
     qbar_pa = 0.5 * float(rho) * cfg.default_condition.tas_mps ** 2
@@ -190,8 +187,3 @@ def gain_properties(cfg) -> dict[str, float]:
         "fms/gain/nx-kff": gains.nx.kff, "fms/gain/ny-kff": gains.ny.kff,
         "fms/limit/throttle-min": gains.throttle_min, "fms/limit/throttle-max": gains.throttle_max,
     }
-
-
-def coordinated_turn_rate_rps(bank_rad: float, tas_mps: float, g_mps2: float = 9.80665) -> float:
-    """Yaw rate of a coordinated level turn, rad/s: r = g tan(φ) / V."""
-    return g_mps2 * math.tan(bank_rad) / max(tas_mps, 1.0)

@@ -50,7 +50,8 @@ def test_no_socket_and_no_stray_file(tmp_path):
     assert _tree(wheel) == wheel_before, "files appeared in the jsbsim package"
     new = _tree(tmp_path) - cwd_before
     assert all(p == "out" or p.startswith("out/") for p in new), sorted(new)
-    assert {p.name for p in (out / "global5000").iterdir()} == {"timeseries.parquet", "summary.json"}
+    assert {p.name for p in (out / "global5000").iterdir()} == {
+        "timeseries.parquet", "summary.json", "run.json", "track.geojson", "track.kml"}
 
 
 def test_sanitised_copies_are_removed_on_cleanup():

@@ -15,14 +15,15 @@ import numpy as np
 import pandas as pd
 from scipy.optimize import brentq
 
+from fms_testbed.core.earth import earth_rate_enu
 from fms_testbed.core.errors import UserError
 from fms_testbed.sensors.sins.discretize import METHODS, discretize, discretize_sins
-from fms_testbed.sensors.sins.model import (N_STATES, alignment_map, baro_gains, build_F, dcm_body_to_enu,
-                    earth_rate_enu)
+from fms_testbed.sensors.sins.model import N_STATES, alignment_map, baro_gains, build_F, dcm_body_to_enu
 from fms_testbed.sensors.sins.presets import ImuModel
 from fms_testbed.sensors.sins._blas import single_thread_blas
 from fms_testbed.sensors.sins.simulate import factor_psd
 from fms_testbed.sensors.sins.trajectory import Trajectory
+from fms_testbed.sensors.sins.model import STATE_NAMES
 
 VERTICAL_MODES = ("baro", "free")
 ALIGNMENT_MODES = ("stationary", "none")
@@ -130,7 +131,6 @@ class CovarianceResult:
 
     def to_frame(self) -> pd.DataFrame:
         """Columns t_s, h95_m, v95_m, sigma_<state> (state units)."""
-        from fms_testbed.sensors.sins.model import STATE_NAMES
         df = pd.DataFrame(self.sigma, columns=[f"sigma_{n}" for n in STATE_NAMES])
         df.insert(0, "v95_m", self.v95_m)
         df.insert(0, "h95_m", self.h95_m)
@@ -189,7 +189,6 @@ class MonteCarloResult:
     def realisations_frame(self) -> pd.DataFrame:
         """Long table of the kept realisations: t_s, realisation, and the 9 navigation errors
         (dp_*_m, dv_*_mps, eps_*_rad)."""
-        from fms_testbed.sensors.sins.model import STATE_NAMES
         n_t, _, n_keep = self.samples.shape
         cols = {"t_s": np.repeat(self.t_s, n_keep),
                 "realisation": np.tile(np.arange(n_keep), n_t)}
@@ -199,7 +198,6 @@ class MonteCarloResult:
 
     def to_frame(self) -> pd.DataFrame:
         """Columns t_s, h95_m, v95_m, sigma_<state>."""
-        from fms_testbed.sensors.sins.model import STATE_NAMES
         df = pd.DataFrame(self.sigma, columns=[f"sigma_{n}" for n in STATE_NAMES])
         df.insert(0, "v95_m", self.v95_m)
         df.insert(0, "h95_m", self.h95_m)
