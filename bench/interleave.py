@@ -13,7 +13,10 @@ from __future__ import annotations
 import math
 import time
 
-from fms_testbed.sim.jsbsim_core import DT_S, FT, KT, bare_fdm
+import jsbsim
+
+from fms_testbed.core.units import FT_M, KT_MPS
+from fms_testbed.sim.jsbsim_core import DT_S, bare_fdm
 
 CHUNK_S = 10.0
 
@@ -23,15 +26,15 @@ def trimmed_bare_fdm(cfg, alt_m: float, tas_mps: float):
     Python work per frame is added to it (the denominator of every ratio)."""
     fdm = bare_fdm(cfg.jsbsim_model)
     fdm["aero/alpha-max-rad"] = math.radians(cfg.trim.alpha_max_deg)
-    fdm["ic/h-sl-ft"] = alt_m / FT
-    fdm["ic/vt-kts"] = tas_mps / KT
+    fdm["ic/h-sl-ft"] = alt_m / FT_M
+    fdm["ic/vt-kts"] = tas_mps / KT_MPS
     fdm["ic/lat-geod-deg"] = 47.0
     fdm["gear/gear-cmd-norm"] = 0
     fdm.run_ic()
     fdm["propulsion/set-running"] = -1
     try:
         fdm["simulation/do_simple_trim"] = 1
-    except Exception:  # the timing does not need a perfect trim
+    except jsbsim.TrimFailureError:  # the timing does not need a perfect trim
         pass
     return fdm
 

@@ -87,6 +87,9 @@ def add_override_options(p, aircraft_default: str | None = None) -> None:
     p.add_argument("--nav", choices=("truth", "sins"), help="navigation source guidance flies on")
     p.add_argument("--imu", help="IMU preset of the SINS (with --nav sins)")
     p.add_argument("--rnp", type=float, help="RNP, NM, where the procedure's records code none")
+    p.add_argument("--allow-degraded", action="store_true",
+                   help="fly a procedure with a rejected or duplicated record of its own "
+                        "(refused by default; the summary lists what is in doubt)")
     p.add_argument("--seed", type=int, default=0,
                    help="seed for turbulence and sensor errors (default 0; a scenario's "
                         "navigation.seed seeds the navigation errors instead)")
@@ -108,8 +111,13 @@ def overrides_from_args(args) -> dict:
         raise UserError("--imu is only used with --nav sins")
     elif nav == "truth":
         out["navigation"] = {"source": "truth"}
+    proc: dict = {}
     if getattr(args, "rnp", None) is not None:
-        out["procedure"] = {"rnp_nm": args.rnp}
+        proc["rnp_nm"] = args.rnp
+    if getattr(args, "allow_degraded", False):
+        proc["allow_degraded"] = True
+    if proc:
+        out["procedure"] = proc
     return out
 
 

@@ -53,8 +53,9 @@ def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedPro
     if proc_over is not None:
         if isinstance(raw.get("procedure"), dict):
             raw["procedure"] = {**raw["procedure"], **proc_over}
-        elif set(proc_over) == {"rnp_nm"}:     # --rnp on a flight without a procedure
-            raw["rnp_nm"] = proc_over["rnp_nm"]
+        elif set(proc_over) <= {"rnp_nm", "allow_degraded"}:   # on a flight without a procedure
+            if "rnp_nm" in proc_over:
+                raw["rnp_nm"] = proc_over["rnp_nm"]
         else:
             raise UserError(f"{source}: procedure options need a scenario with a 'procedure:' "
                             "block")
@@ -74,6 +75,7 @@ def _procedure_summary(scn: Scenario, proc: PreparedProcedure) -> dict[str, Any]
         "legs": p.leg_types(), "length_nm": round(p.length_m() / NM_M, 2),
         "monitor_status": p.status, "navigation": scn.navigation_spec["source"],
         "findings": [f"leg {f.leg_index + 1}: {f.category}: {f.message}" for f in p.findings],
+        "degraded": list(getattr(proc.path, "degraded", ())),
     }
 
 

@@ -1,0 +1,90 @@
+"""The whole-database check's figures, from ``fms-testbed procedures check`` itself.
+
+Runs ``fms-testbed procedures check --db FILE --no-progress --out TMP`` and writes its
+``summary.json`` (counts by status, leg types coded/built, invariants, corrections by branch,
+flags) and the list of impossible transitions with their reasons from ``procedures_check.csv``
+as Markdown to ``docs/results/cifp_check.md``.
+
+    python bench/bench_check.py [--db FILE] [--aircraft 737] [--workers 1] [--md cifp_check.md]
+
+``--db`` defaults to the FAA CIFP beside the repository (``../shared/data/cifp/FAACIFP18_230126``).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import tempfile
+from pathlib import Path
+
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
+
+def markdown(summary: dict, table: pd.DataFrame, cmd: str, wall_s: float) -> str:
+    """The check's summary and its impossible transitions as Markdown."""
+    st = summary["by_status"]
+    n = summary["transitions"]
+    rows = [["lines", f"{summary['lines']:,}"],
+            ["rejected records", f"{summary['parse_issues']:,}"],
+            ["procedure transitions", f"{n:,}"]]
+    rows += [[status, f"{count:,}"] for status, count in sorted(st.items())]
+    rows += [["ok or corrected", f"**{summary['ok_or_corrected_pct']:.2f} %**"],
+             ["largest gap between consecutive segments", f"{summary['max_gap_m']:.3f} m"],
+             ["largest excess over a fix's allowance (≤ 0: every fix within its allowance)",
+              f"{summary['max_fix_excess_m']:.3f} m"],
+             ["largest RF radius error vs coded", f"{summary['max_rf_radius_err_nm']:.3f} NM"],
+             ["turns against the coded direction", f"{summary['turn_mismatches']}"],
+             ["leg types present but never built",
+              ", ".join(summary["leg_types_present_not_built"]) or "none"],
+             ["wall time, workers", f"{wall_s:.1f} s, {summary['workers']}"]]
+    legs = [[pt, f"{v['coded']:,}", f"{v['built']:,}"]
+            for pt, v in summary["by_leg_type"].items() if v["coded"]]
+    absent = [pt for pt, v in summary["by_leg_type"].items() if not v["coded"]]
+    branches = [[b, f"{c:,}"] for b, c in sorted(summary["branches"].items())]
+    flags = [[f, f"{c:,}"] for f, c in sorted(summary["flags"].items())]
+    imp = table[table["status"] == "impossible"]
+    imp_rows = [[f"{r.airport} {r.type} {r.procedure} {r.transition or '(common)'}",
+                 str(r.findings).split(";")[-1].strip()] for r in imp.itertuples()]
+    out = [report.table(["metric", "result"], rows), "",
+           "**Leg types, coded / built** (built: in transitions that are not impossible"
+           + (f"; never coded in this database: {', '.join(absent)}" if absent else "") + ")\n",
+           report.table(["leg type", "coded", "built"], legs), "",
+           "**Corrections by monitor branch**\n", report.table(["branch", "transitions"], branches),
+           "", "**Flags**\n", report.table(["flag", "transitions"], flags), "",
+           f"**Impossible transitions ({len(imp)})**, each with its last finding\n",
+           report.table(["transition", "reason"], imp_rows)]
+    return "\n".join(out)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--db", default=str(report.CIFP),
+                    help="ARINC-424 file (default: the FAA CIFP beside the repository)")
+    ap.add_argument("--aircraft", default="737")
+    ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--md", default="cifp_check.md",
+                    help="Markdown table in docs/results/ ('' to skip)")
+    args = ap.parse_args()
+    if not Path(args.db).exists():
+        raise SystemExit(f"{args.db}: no such ARINC-424 file (give --db)")
+    with tempfile.TemporaryDirectory() as tmp:
+        argv = ["procedures", "check", "--db", args.db, "--aircraft", args.aircraft,
+                "--workers", str(args.workers), "--no-progress", "--out", tmp]
+        _, wall, stdout = report.run_cli(argv, expect=Path(tmp) / "summary.json")
+        print(stdout)
+        summary = json.loads((Path(tmp) / "summary.json").read_text())
+        table = pd.read_csv(Path(tmp) / "procedures_check.csv", keep_default_na=False)
+    cmd = (f"fms-testbed procedures check --db {Path(args.db).name} --aircraft {args.aircraft} "
+           f"--workers {args.workers} --no-progress --out DIR")
+    report.write(args.md, markdown(summary, table, cmd, wall),
+                 note=f"`{cmd}`: every procedure transition of the database built and "
+                      "monitored.")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,101 @@
+"""Writing a benchmark's figures as a Markdown table into ``docs/results/`` (included by the docs).
+
+Every measured figure in the documentation comes from one of these files, and each file says
+the command that wrote it and the machine it ran on (cores and CPU model, no date): rerun the
+command to refresh it. Ratios are measured interleaved within one run, so they stay comparable
+on a shared machine; absolute times move with the load.
+"""
+
+from __future__ import annotations
+
+import os
+import platform
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Iterable, Sequence
+
+REPO = Path(__file__).resolve().parents[1]
+RESULTS = REPO / "docs" / "results"
+#: the FAA CIFP beside the repository (``../shared/data/cifp``); every CIFP bench defaults to it
+CIFP = REPO.parent / "shared" / "data" / "cifp" / "FAACIFP18_230126"
+
+
+def machine() -> str:
+    """Cores, CPU model and the versions that matter, without a date."""
+    model = platform.processor() or platform.machine()
+    try:
+        for line in Path("/proc/cpuinfo").read_text().splitlines():
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    except OSError:
+        pass
+    bits = [f"{os.cpu_count()} cores ({model})", f"Python {platform.python_version()}"]
+    try:
+        import jsbsim
+
+        bits.append(f"JSBSim {jsbsim.__version__}")
+    except ImportError:
+        pass
+    import numpy
+
+    bits.append(f"numpy {numpy.__version__}")
+    return ", ".join(bits)
+
+
+def command() -> str:
+    """The command line that ran this script, relative to the repository."""
+    script = Path(sys.argv[0]).resolve()
+    try:
+        script = script.relative_to(REPO)
+    except ValueError:
+        pass
+    return " ".join(["python", str(script), *map(shlex.quote, sys.argv[1:])])
+
+
+def table(header: Sequence[str], rows: Iterable[Sequence]) -> str:
+    """A Markdown table (cells are str()-ed; pipes escaped)."""
+    def cell(v) -> str:
+        return str(v).replace("|", "\\|")
+
+    out = ["| " + " | ".join(map(cell, header)) + " |",
+           "|" + "---|" * len(header)]
+    out += ["| " + " | ".join(map(cell, r)) + " |" for r in rows]
+    return "\n".join(out)
+
+
+def write(name: str | Path | None, body: str, note: str = "") -> Path | None:
+    """Write ``docs/results/NAME`` (or the given path): provenance lines, then ``body``.
+
+    ``name`` None or empty: write nothing (``--md ''`` on a bench's command line).
+    """
+    if not name:
+        return None
+    path = Path(name)
+    if not path.is_absolute() and path.parent == Path("."):
+        path = RESULTS / path
+    path.parent.mkdir(parents=True, exist_ok=True)
+    head = (f"<!-- written by {command()}; rerun it to refresh, do not edit by hand -->\n\n"
+            f"Command: `{command()}`  \nMachine: {machine()}.\n\n")
+    path.write_text(head + (note.strip() + "\n\n" if note else "") + body.strip() + "\n")
+    print(f"table written to {path}")
+    return path
+
+
+def run_cli(argv: Sequence[str], expect: Path | None = None, ok_codes=(0,)) -> tuple[int, float, str]:
+    """Run ``fms-testbed ARGV`` (this Python's package); return (exit code, wall s, stdout).
+
+    Stops the bench with the command's stderr when the exit code is not in ``ok_codes`` or the
+    file ``expect`` was not written (a crash exits 1 too, like a failed goal).
+    """
+    t0 = time.perf_counter()
+    proc = subprocess.run([sys.executable, "-m", "fms_testbed.cli", *argv],
+                          capture_output=True, text=True)
+    wall = time.perf_counter() - t0
+    if proc.returncode not in ok_codes or (expect is not None and not Path(expect).exists()):
+        raise SystemExit(f"fms-testbed {' '.join(argv)} failed ({proc.returncode}):\n"
+                         f"{proc.stderr[-2000:]}")
+    return proc.returncode, wall, proc.stdout
