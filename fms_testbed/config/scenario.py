@@ -73,14 +73,19 @@ Alt = Annotated[float, Field(ge=-400, le=25000)]
 class _AltSpeed(_Strict):
     """Altitude and speed keys in the user's unit (one of each at most)."""
 
-    alt_m: Alt | None = None
-    alt_ft: Annotated[float, Field(ge=-1300, le=82000)] | None = None
-    tas_mps: Speed | None = None
-    tas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = None
-    tas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = None
-    cas_mps: Speed | None = None
-    cas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = None
-    cas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = None
+    alt_m: Alt | None = Field(None, description="altitude above mean sea level, m")
+    alt_ft: Annotated[float, Field(ge=-1300, le=82000)] | None = Field(
+        None, description="altitude above mean sea level, ft")
+    tas_mps: Speed | None = Field(None, description="true airspeed, m/s")
+    tas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = Field(
+        None, description="true airspeed, km/h")
+    tas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = Field(
+        None, description="true airspeed, kt")
+    cas_mps: Speed | None = Field(None, description="calibrated airspeed, m/s")
+    cas_kt: Annotated[float, Field(gt=0, lt=2000)] | None = Field(
+        None, description="calibrated airspeed, kt")
+    cas_kmh: Annotated[float, Field(gt=0, lt=3600)] | None = Field(
+        None, description="calibrated airspeed, km/h")
 
     _required = False
 
@@ -101,9 +106,11 @@ class _AltSpeed(_Strict):
 class Initial(_AltSpeed):
     """Initial condition (trimmed straight and level); altitude and speed required."""
 
-    lat_deg: Annotated[float, Field(ge=-89, le=89)] = 45.0
-    lon_deg: Annotated[float, Field(ge=-180, le=360)] = 0.0
-    heading_deg: Annotated[float, Field(ge=0, le=360)] = 0.0
+    lat_deg: Annotated[float, Field(ge=-89, le=89)] = Field(
+        45.0, description="geodetic latitude (WGS-84), deg")
+    lon_deg: Annotated[float, Field(ge=-180, le=360)] = Field(0.0, description="longitude, deg")
+    heading_deg: Annotated[float, Field(ge=0, le=360)] = Field(
+        0.0, description="true heading, deg")
 
     _required = True
 
@@ -116,9 +123,12 @@ class Initial(_AltSpeed):
 class Wind(_Strict):
     """Steady wind: direction it blows from (true, deg) and speed."""
 
-    from_deg: Annotated[float, Field(ge=0, le=360)]
-    speed_mps: Annotated[float, Field(ge=0, le=100)] | None = None
-    speed_kt: Annotated[float, Field(ge=0, le=200)] | None = None
+    from_deg: Annotated[float, Field(ge=0, le=360)] = Field(
+        description="direction the wind blows from, deg true")
+    speed_mps: Annotated[float, Field(ge=0, le=100)] | None = Field(
+        None, description="wind speed, m/s (or speed_kt)")
+    speed_kt: Annotated[float, Field(ge=0, le=200)] | None = Field(
+        None, description="wind speed, kt (or speed_mps)")
 
     @model_validator(mode="after")
     def _one(self):
@@ -135,15 +145,17 @@ class Wind(_Strict):
 class Turbulence(_Strict):
     """JSBSim MIL-F-8785C / MIL-HDBK-1797 (Tustin) turbulence; seeded by the run's seed."""
 
-    severity: Literal["light", "moderate", "severe"] = "light"
+    severity: Literal["light", "moderate", "severe"] = Field(
+        "light", description="MIL-HDBK-1797 severity (wind at 20 ft 25 / 50 / 75 kt)")
 
 
 class When(_Strict):
     """Condition that fires an event once: altitude crossing and/or time."""
 
-    alt_m_above: float | None = None
-    alt_m_below: float | None = None
-    t_s_after: Annotated[float, Field(ge=0)] | None = None
+    alt_m_above: float | None = Field(None, description="fires once the altitude is above, m")
+    alt_m_below: float | None = Field(None, description="fires once the altitude is below, m")
+    t_s_after: Annotated[float, Field(ge=0)] | None = Field(
+        None, description="and only after this time, s")
 
     @model_validator(mode="after")
     def _some(self):
@@ -155,13 +167,18 @@ class When(_Strict):
 class Event(_AltSpeed):
     """A target change at time ``t_s`` (or when ``when`` is met). Unset fields are unchanged."""
 
-    t_s: Annotated[float, Field(ge=0)] | None = None
-    when: When | None = None
-    bank_deg: Annotated[float, Field(ge=-60, le=60)] | None = None
-    heading_deg: Annotated[float, Field(ge=0, le=360)] | None = None
-    nx: Annotated[float, Field(ge=-0.5, le=0.5)] | None = None
-    ny: Annotated[float, Field(ge=-1.0, le=3.0)] | None = None
-    throttle: Annotated[float, Field(ge=0, le=1)] | None = None
+    t_s: Annotated[float, Field(ge=0)] | None = Field(None, description="time it fires, s")
+    when: When | None = Field(None, description="condition it fires on (instead of t_s)")
+    bank_deg: Annotated[float, Field(ge=-60, le=60)] | None = Field(
+        None, description="bank-hold target, deg (right wing down positive)")
+    heading_deg: Annotated[float, Field(ge=0, le=360)] | None = Field(
+        None, description="heading-hold target, deg true (on the navigation heading)")
+    nx: Annotated[float, Field(ge=-0.5, le=0.5)] | None = Field(
+        None, description="tangential load-factor target for the n_x loop, g")
+    ny: Annotated[float, Field(ge=-1.0, le=3.0)] | None = Field(
+        None, description="normal (lift-axis) load-factor target, g")
+    throttle: Annotated[float, Field(ge=0, le=1)] | None = Field(
+        None, description="direct throttle 0..1 (disengages the n_x loop)")
 
     @model_validator(mode="after")
     def _check(self):
@@ -181,14 +198,19 @@ class Event(_AltSpeed):
 class Scenario(_Strict):
     """A validated scenario (SI inside; see the module docstring for the file format)."""
 
-    name: str = ""
-    description: str = ""
-    aircraft: str
-    initial: Initial
-    duration_s: Annotated[float, Field(gt=0, le=6 * 3600)]
-    wind: Wind | None = None
-    turbulence: Turbulence | None = None
-    vertical_law: Literal["coupled", "pi", "tecs"] = "coupled"
+    name: str = Field("", description="run name (default: the file's stem)")
+    description: str = Field("", description="free text")
+    aircraft: str = Field(description="a shipped aircraft (737, global5000, c172p) or a path to "
+                                      "an aircraft YAML file")
+    initial: Initial = Field(description="initial condition, trimmed straight and level (a "
+                                         "procedure flight defaults it to the path start)")
+    duration_s: Annotated[float, Field(gt=0, le=6 * 3600)] = Field(
+        description="simulated time to fly, s (a procedure flight ends when guidance completes)")
+    wind: Wind | None = Field(None, description="steady wind, ramped in over 20 s after trim")
+    turbulence: Turbulence | None = Field(None, description="JSBSim turbulence after trim")
+    vertical_law: Literal["coupled", "pi", "tecs"] = Field(
+        "coupled", description="law for altitude/speed targets: the coupled thrust/elevator law "
+                               "(Kulikov), separate PI channels, or TECS")
     hold: bool = Field(False, description="engage the vertical law at t=0 holding the initial "
                                           "altitude and speed")
     outer_rate_hz: Annotated[float, Field(ge=5, le=120)] = Field(
@@ -200,8 +222,9 @@ class Scenario(_Strict):
         None, description="RNP for the navigation error of a flight without a procedure, NM "
                           "(default: 2 NM when the navigation source is not truth; a procedure "
                           "flight takes its RNP from the procedure)")
-    procedure: dict[str, Any] | None = None
-    events: list[Event] = Field(default_factory=list)
+    procedure: dict[str, Any] | None = Field(
+        None, description="the ARINC-424 procedure to fly (see the procedure block)")
+    events: list[Event] = Field(default_factory=list, description="target changes, in order")
     source_file: str = ""
 
     @model_validator(mode="after")
