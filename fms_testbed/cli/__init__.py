@@ -3,6 +3,19 @@
 Each command group lives in its own module exposing ``register(subparsers)``; the handler it sets
 with ``set_defaults(func=...)`` returns an exit code. User errors (:class:`UserError`) print one
 line on stderr and exit 2, without a traceback.
+
+Units at the edges, the same in every command:
+
+* A wind is ``FROM_DEG/SPEED_KT`` everywhere it is taken (``run``, ``fly``, ``compare``), parsed by
+  :func:`fms_testbed.cli.common.parse_wind`; a suffix selects another unit (``270/10mps``,
+  ``270/36kmh``). Every other option names its unit in its help (``--rnp`` NM, ``--manual-nm``
+  NM; the coupled-law commands' ``--speed``/``--dv`` km/h and ``--alt``/``--dh`` m, as the paper).
+* Files are SI, with the unit in every column or key name (``alt_m``, ``tas_mps``, ``settle_s``).
+* Printed figures state their unit. Flight commands (``run``, ``demo``, ``fly``, ``procedures``)
+  print aviation units — NM, ft, kt — with path errors (FTE/TSE/NSE) in m; the engineering
+  commands (``inner``, ``compare``, ``analyse``, ``tune``, ``ins``) print SI — m, s, deg, g — with
+  speeds in km/h as the coupled-law paper does. Plots follow the same split
+  (:mod:`fms_testbed.viz.run` states the rule).
 """
 
 from __future__ import annotations
@@ -26,6 +39,7 @@ COMMAND_MODULES = (
     "fms_testbed.cli.fly",          # fly
     "fms_testbed.cli.coupled",      # tune, compare, analyse
     "fms_testbed.cli.ins",         # ins
+    "fms_testbed.cli.imu_test",     # imu-test
 )
 
 

@@ -21,7 +21,9 @@ import numpy as np
 import pandas as pd
 
 from fms_testbed.config.aircraft import load_aircraft
+from fms_testbed.cli.common import WIND_HELP, markdown_table, parse_wind
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.units import KMH_MPS
 from fms_testbed.data import results_dir, scenarios_dir
 
 DEFAULT_SCENARIOS = ("coupled-altitude-step", "coupled-speed-step", "paper-fig2")
@@ -44,21 +46,6 @@ def _scenario_path(name: str) -> Path:
     return cand
 
 
-def _fmt(v) -> str:
-    if isinstance(v, float):
-        return "—" if not math.isfinite(v) else f"{v:.3g}" if abs(v) < 1000 else f"{v:.0f}"
-    return str(v)
-
-
-def markdown_table(df: pd.DataFrame) -> str:
-    """A DataFrame as a GitHub Markdown table (floats to 3 significant digits)."""
-    cols = list(df.columns)
-    lines = ["| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
-    for _, r in df.iterrows():
-        lines.append("| " + " | ".join(_fmt(r[c]) for c in cols) + " |")
-    return "\n".join(lines)
-
-
 # --- compare -----------------------------------------------------------------------------------
 
 def cmd_compare(args) -> int:
@@ -67,6 +54,7 @@ def cmd_compare(args) -> int:
     from fms_testbed.evaluation.law_comparison import check_goals, comparison_rows, run_comparison
     from fms_testbed.control.coupled_law import params_from_config
     from fms_testbed.viz.control import plot_comparison, plot_paper_fig2
+    from fms_testbed.viz.figure import save
     from fms_testbed.config.scenario import load_scenario
 
     laws = tuple(s.strip() for s in args.laws.split(",") if s.strip())
@@ -80,11 +68,7 @@ def cmd_compare(args) -> int:
     if args.turbulence:
         overrides["turbulence"] = {"severity": args.turbulence}
     if args.wind:
-        try:
-            frm, spd = (float(x) for x in args.wind.split("/"))
-        except ValueError:
-            raise UserError(f"--wind {args.wind!r}: expected FROM_DEG/SPEED_MPS, e.g. 270/15") from None
-        overrides["wind"] = {"from_deg": frm, "speed_mps": spd}
+        overrides["wind"] = parse_wind(args.wind)
     scns = [load_scenario(_scenario_path(n), overrides) for n in names]
     if args.small_step and not args.scenarios:
         s0 = scns[0]
@@ -99,15 +83,18 @@ def cmd_compare(args) -> int:
         cfg = load_aircraft(scn.aircraft)
         params = _with_settings(params_from_config(cfg), args.set or [])
         cmp = run_comparison(scn, cfg, laws, params, seed=args.seed)
-        rows.extend(comparison_rows(cmp, cfg))
+        scn_rows = comparison_rows(cmp, cfg)
+        rows.extend(scn_rows)
         runs = dict(cmp.runs)
         runs["ideal"] = cmp.ideal
-        title = f"{scn.name} — {cfg.name}: {scn.description or ''}"
-        plot_comparison(runs, title, out / f"{scn.name}-comparison.png")
+        head = _headline(scn_rows)
+        title = f"{scn.name} — {cfg.name}: {scn.description or ''}" + (f"\n{head}" if head else "")
+        save(plot_comparison(runs, title), out / f"{scn.name}-comparison.png")
         if args.paper_plot or scn.name == "paper-fig2":
             fig2 = {k: runs[k] for k in ("coupled", "ideal", "pi") if k in runs}
-            plot_paper_fig2(fig2, f"{scn.name} — {cfg.name} (layout of the paper's Fig. 2)",
-                            out / f"{scn.name}-paper-fig2.png")
+            save(plot_paper_fig2(fig2, f"{scn.name} — {cfg.name} (layout of the paper's Fig. 2)"
+                                 + (f"\n{head}" if head else "")),
+                 out / f"{scn.name}-paper-fig2.png")
         for law, df in cmp.runs.items():
             df.to_parquet(out / f"{scn.name}-{law}.parquet", index=False)
     table = pd.DataFrame(rows)
@@ -125,6 +112,19 @@ def cmd_compare(args) -> int:
         print("\nGoals:\n" + gl)
     print(f"\nwritten to {out}/ (comparison.csv, comparison.md, *.png, *.parquet)")
     return 0 if all(g.ok for g in goals) else 1
+
+
+def _headline(rows: list[dict]) -> str:
+    """The figures that matter of one scenario's comparison rows: each law's cross deviation
+    (max |ΔV| in an altitude step, km/h; max |ΔH| in a speed step, m)."""
+    parts = []
+    for key, what, unit in (("max_dV_kmh", "max|ΔV| in the altitude step", "km/h"),
+                            ("max_dH_m", "max|ΔH| in the speed step", "m")):
+        vals = [(r["law"], r[key]) for r in rows if math.isfinite(r.get(key, math.nan))]
+        if vals:
+            parts.append(f"{what}: " + ", ".join(f"{law} {v:.3g}" for law, v in vals)
+                         + f" {unit}")
+    return "; ".join(parts)
 
 
 def _with_settings(params, settings: list[str]):
@@ -185,10 +185,11 @@ def cmd_analyse(args) -> int:
     from fms_testbed.control import linear
     from fms_testbed.control.coupled_law import params_from_config
     from fms_testbed.viz.control import plot_bode_coupling, plot_linear_steps
+    from fms_testbed.viz.figure import save
 
     cfg = load_aircraft(args.aircraft)
     p = params_from_config(cfg)
-    V0 = args.speed / 3.6 if args.speed else cfg.default_condition.tas_mps
+    V0 = args.speed * KMH_MPS if args.speed else cfg.default_condition.tas_mps
     out = _out_dir(args.out, f"analyse-{cfg.name}")
     out.mkdir(parents=True, exist_ok=True)
     if args.identify:
@@ -207,19 +208,19 @@ def cmd_analyse(args) -> int:
     t = np.linspace(0.0, 120.0, 2401)
     freq, steps, report = {}, {}, {}
     print(f"{cfg.name}: T_V {p.T_V_s} s, xi_V {p.xi_V}, T_H {p.T_H_s} s, xi_H {p.xi_H}, "
-          f"V0 {V0 * 3.6:.0f} km/h")
+          f"V0 {V0 / KMH_MPS:.0f} km/h")
     for label, (tx, ty, meas) in cases.items():
         sys = linear.closed_loop(p, V0, tx, ty, use_measured_nx=meas)
         r = linear.decoupling_report(sys, p, w)
         freq[label] = linear.frequency_response(sys, w)
-        sv, sh = linear.step_responses(sys, t, args.dv / 3.6, args.dh)
+        sv, sh = linear.step_responses(sys, t, args.dv * KMH_MPS, args.dh)
         steps[label] = (sv, sh)
         report[label] = {
             "max|W_V,Hcmd|/max|W_V,Vcmd|": r.off_V_from_H, "max|W_H,Vcmd|/max|W_H,Hcmd|":
                 r.off_H_from_V, "pole_error_rps": r.pole_error,
             "poles_rps": [complex(x) for x in np.sort_complex(r.poles)],
             "dc_gain": r.dc_gain.tolist(),
-            f"max|dV| in {args.dh:g} m step, km/h": float(np.abs(sh[0]).max() * 3.6),
+            f"max|dV| in {args.dh:g} m step, km/h": float(np.abs(sh[0]).max() / KMH_MPS),
             f"max|dH| in {args.dv:g} km/h step, m": float(np.abs(sv[1]).max())}
         print(f"\n[{label}]")
         print(f"  cross terms: |W_V,Hcmd|/|W_V,Vcmd| = {r.off_V_from_H:.3g}, "
@@ -228,13 +229,20 @@ def cmd_analyse(args) -> int:
         print(f"  desired (T, xi) poles: "
               f"{', '.join(f'{x.real:.4f}{x.imag:+.4f}j' for x in np.sort_complex(r.desired_poles))}"
               f"  -> max distance {r.pole_error:.2g} rad/s")
-        print(f"  max|dV| during a {args.dh:g} m step: {np.abs(sh[0]).max() * 3.6:.3g} km/h; "
+        print(f"  max|dV| during a {args.dh:g} m step: {np.abs(sh[0]).max() / KMH_MPS:.3g} km/h; "
               f"max|dH| during a {args.dv:g} km/h step: {np.abs(sv[1]).max():.3g} m")
-    plot_bode_coupling(w, freq, out / "bode.png",
-                       f"{cfg.name}: closed-loop W(jω) at {V0 * 3.6:.0f} km/h — "
-                       "diagonal and cross terms")
-    plot_linear_steps(t, steps, args.dv / 3.6, args.dh, out / "steps.png",
-                      f"{cfg.name}: linear closed-loop steps, with and without inner-loop lags")
+    worst = max(report.values(), key=lambda r: r["max|W_V,Hcmd|/max|W_V,Vcmd|"])
+    lag_label = max(report, key=lambda k: report[k]["max|W_V,Hcmd|/max|W_V,Vcmd|"])
+    save(plot_bode_coupling(w, freq, f"{cfg.name}: closed-loop W(jω) at {V0 / KMH_MPS:.0f} km/h "
+                            f"— diagonal and cross terms\nlargest cross term |W_V,Hcmd|/|W_V,Vcmd| "
+                            f"= {worst['max|W_V,Hcmd|/max|W_V,Vcmd|']:.2g} ({lag_label})"),
+         out / "bode.png")
+    dv_key = f"max|dV| in {args.dh:g} m step, km/h"
+    save(plot_linear_steps(t, steps, args.dv * KMH_MPS, args.dh,
+                           f"{cfg.name}: linear closed-loop steps, with and without inner-loop "
+                           f"lags\nmax|ΔV| in the {args.dh:g} m step: " + ", ".join(
+                               f"{r[dv_key]:.2g}" for r in report.values()) + " km/h"),
+         out / "steps.png")
     (out / "analysis.json").write_text(json.dumps(report, indent=2, default=str))
     print(f"\nwritten to {out}/ (bode.png, steps.png, analysis.json)")
     return 0
@@ -245,21 +253,22 @@ def cmd_analyse(args) -> int:
 def cmd_tune(args) -> int:
     """Optimise the law's (T, ξ) on JSBSim; write gains, report and plots."""
     from fms_testbed.viz.control import plot_tuning_overlay
+    from fms_testbed.viz.figure import save
     from fms_testbed.evaluation.law_tuning import (OperatingPoint, gains_yaml, linear_prediction, tune,
                                  write_gains_to_config)
 
     cfg = load_aircraft(args.aircraft)
     alt = args.alt if args.alt is not None else cfg.default_condition.alt_m
-    tas = args.speed / 3.6 if args.speed else cfg.default_condition.tas_mps
+    tas = args.speed * KMH_MPS if args.speed else cfg.default_condition.tas_mps
     budget = 8 if args.quick else args.max_evals
     if budget > 60:
         raise UserError("tune: --max-evals is capped at 60 JSBSim evaluations")
     duration = 60.0 if args.quick else 100.0
-    op = OperatingPoint(alt, tas, dH_m=args.dh, dV_mps=args.dv / 3.6 if args.dv else 0.0)
+    op = OperatingPoint(alt, tas, dH_m=args.dh, dV_mps=args.dv * KMH_MPS if args.dv else 0.0)
     out = _out_dir(args.out, f"tune-{cfg.name}")
     out.mkdir(parents=True, exist_ok=True)
-    print(f"tuning {cfg.name} at {alt:.0f} m / {tas * 3.6:.0f} km/h TAS: {op.dH_m:g} m and "
-          f"{op.speed_step_mps * 3.6:.0f} km/h steps, budget {budget} evaluations ({args.plant})")
+    print(f"tuning {cfg.name} at {alt:.0f} m / {tas / KMH_MPS:.0f} km/h TAS: {op.dH_m:g} m and "
+          f"{op.speed_step_mps / KMH_MPS:.0f} km/h steps, budget {budget} evaluations ({args.plant})")
 
     def show(ev):
         r = ev.row()
@@ -272,18 +281,22 @@ def cmd_tune(args) -> int:
     hist.to_csv(out / "history.csv", index=False)
     (out / "gains.yaml").write_text(
         f"# tuned by `fms-testbed tune --aircraft {args.aircraft}` at {alt:.0f} m / "
-        f"{tas * 3.6:.0f} km/h; paste into aircraft/{cfg.name}.yaml\n{gains_yaml(b.params)}\n")
+        f"{tas / KMH_MPS:.0f} km/h; paste into aircraft/{cfg.name}.yaml\n{gains_yaml(b.params)}\n")
     lin = linear_prediction(b.params, op, res.lags_s[0], res.lags_s[1], duration)
-    plot_tuning_overlay(b.runs, lin, out / "tuned-vs-linear.png",
-                        f"{cfg.name}: tuned law on {args.plant} vs linear prediction "
-                        f"(lags nx {res.lags_s[0]:.2f} s, ny {res.lags_s[1]:.2f} s)")
+    save(plot_tuning_overlay(b.runs, lin,
+                             f"{cfg.name}: tuned law on {args.plant} vs linear prediction "
+                             f"(lags nx {res.lags_s[0]:.2f} s, ny {res.lags_s[1]:.2f} s)\n"
+                             f"cost {b.cost:.3f} (start {res.start.cost:.3f}): T_V "
+                             f"{b.params.T_V_s:.2f} s, ξ_V {b.params.xi_V:.2f}, T_H "
+                             f"{b.params.T_H_s:.2f} s, ξ_H {b.params.xi_H:.2f}"),
+         out / "tuned-vs-linear.png")
     start, best = res.start.row(), b.row()
     keys = [k for k in best if k not in ("note",)]
     tab = pd.DataFrame({"start": [start.get(k) for k in keys], "tuned": [best.get(k) for k in keys]},
                        index=keys)
     report = (f"# Tuning of the coupled law — {cfg.name}\n\n"
-              f"Operating point {alt:.0f} m, {tas * 3.6:.0f} km/h TAS; altitude step {op.dH_m:g} m, "
-              f"speed step {op.speed_step_mps * 3.6:.0f} km/h; {len(res.history)} evaluations on "
+              f"Operating point {alt:.0f} m, {tas / KMH_MPS:.0f} km/h TAS; altitude step {op.dH_m:g} m, "
+              f"speed step {op.speed_step_mps / KMH_MPS:.0f} km/h; {len(res.history)} evaluations on "
               f"{args.plant} (bounded Nelder-Mead). Criteria: see `fms_testbed/control/tuning.py`."
               f"\n\nIdentified inner-loop lags: n_x {res.lags_s[0]:.2f} s, n_y "
               f"{res.lags_s[1]:.2f} s.\n\n```yaml\n{gains_yaml(b.params)}\n```\n\n"
@@ -324,7 +337,7 @@ def register(subparsers) -> None:
                         "e.g. form=paper, use_measured_nx=false, ny_trim_tau_s=0, T_V_s=8")
     p.add_argument("--turbulence", choices=("light", "moderate", "severe"),
                    help="fly the scenarios in turbulence (seeded by --seed)")
-    p.add_argument("--wind", metavar="FROM_DEG/SPEED_MPS", help="steady wind, e.g. 270/15")
+    p.add_argument("--wind", metavar="FROM_DEG/SPEED_KT", help=WIND_HELP)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", help="output folder (default results/compare-<time>)")
     p.set_defaults(func=cmd_compare)

@@ -5,7 +5,9 @@
     fms-testbed fly --scenario scenarios/demo-sid.yaml [--out DIR]
 
 Prints one line per result group (status, errors, RNP, constraints, sequencing) and writes
-``timeseries.parquet``, ``summary.json`` and the plots into ``--out``. Exit code 0 when the
+``timeseries.parquet``, ``summary.json``, the plots (NM, ft, kt) and, for Google Earth/QGIS,
+``track.geojson`` and ``track.kml`` (the designed path leg by leg, the flown 3-D track, the
+navigation track where it differs) into ``--out``. Exit code 0 when the
 procedure was flown to its end, 1 otherwise, 2 on a user error.
 """
 

@@ -44,6 +44,7 @@ def _trajectory(args):
 
 def _handler(args) -> int:
     from fms_testbed.sensors.sins.analysis import SinsOptions, covariance_run, error_table, montecarlo_run
+    from fms_testbed.viz.figure import save
     from fms_testbed.viz.sins import plot_envelopes, plot_p95
     from fms_testbed.sensors.sins.presets import load_imu
 
@@ -79,8 +80,12 @@ def _handler(args) -> int:
     table.to_csv(out / "ins_p95_table.csv", index=False)
     title = (f"{imu.name} along {traj.label} — {args.mode}, vertical {args.vertical}, "
              f"alignment {args.alignment}, {args.method}")
-    plots = [plot_envelopes(cov, mc, out, "position", title),
-             plot_envelopes(cov, mc, out, "attitude", title), plot_p95(results, out, title)]
+    h95 = main.h95_m[-1]
+    end_min = (main.t_s[-1] - main.t_s[0]) / 60.0
+    head = f"{title}\n95 % horizontal error {h95:.0f} m after {end_min:.0f} min"
+    plots = [save(plot_envelopes(cov, mc, "position", head), out / "ins_position.png"),
+             save(plot_envelopes(cov, mc, "attitude", head), out / "ins_attitude.png"),
+             save(plot_p95(results, head), out / "ins_p95.png")]
     print(f"{imu.summary()}; covariance {t_cov:.1f} s")
     print(table.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
     print("wrote " + ", ".join(str(p) for p in plots))

@@ -1,8 +1,11 @@
 """CLI: ``fms-testbed procedures build`` and ``fms-testbed procedures check``.
 
 ``build`` writes, per procedure transition, a GeoJSON FeatureCollection and a Fig.-2-style PNG
-plus a one-line monitor outcome; ``check`` runs the whole database (or some airports) and writes
-``procedures_check.parquet``/``.csv`` (one row per transition) and ``summary.json``.
+plus a one-line monitor outcome; a degraded transition (a rejected, duplicated or misplaced
+record of its own) is refused with exit 2 unless ``--allow-degraded``. ``check`` runs the whole
+database (or some airports) and writes ``procedures_check.parquet``/``.csv`` (one row per
+transition), ``rejected_records.csv`` (file, line, columns, field, reason, record) and
+``summary.json``.
 """
 
 from __future__ import annotations
@@ -11,7 +14,9 @@ import json
 import math
 from pathlib import Path
 
+from fms_testbed.cli.procedures_list import register as register_list
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.units import NM_M
 
 
 def _perf(name: str):
@@ -19,9 +24,16 @@ def _perf(name: str):
     return perf_for(name)
 
 
+MANUAL_NM_MAX = 50.0
+"""Largest --manual-nm, NM (as the scenario key ``procedure.manual_leg_nm``)."""
+
+
 def _params(args):
     from fms_testbed.legs.model import BuildParams
-    return BuildParams(manual_leg_m=args.manual_nm * 1852.0)
+    if not (math.isfinite(args.manual_nm) and 0.0 < args.manual_nm <= MANUAL_NM_MAX):
+        raise UserError(f"--manual-nm must be a finite distance in (0, {MANUAL_NM_MAX:g}] NM, "
+                        f"got {args.manual_nm!r}")
+    return BuildParams(manual_leg_m=args.manual_nm * NM_M)
 
 
 def cmd_build(args) -> int:
@@ -30,29 +42,46 @@ def cmd_build(args) -> int:
     from fms_testbed.viz.geojson import safe_name, write_geojson
     from fms_testbed.path.monitor import check_path
     from fms_testbed.viz.path import plot_path
+    from fms_testbed.viz.figure import save
     from fms_testbed.path.segmentation import build_sequence
     from fms_testbed.core.geodesy import gravity_mps2
 
+    from fms_testbed.procedures.integrity import refusal
+
+    params = _params(args)
     db = load_database(args.db)
     perf = _perf(args.aircraft)
-    params = _params(args)
     seqs = db.select(args.airport.upper(), args.procedure, args.transition)
+    degraded = [s for s in seqs if s.degraded]
+    if degraded and not args.allow_degraded:
+        more = f" ({len(degraded)} of {len(seqs)} transitions degraded)" if len(seqs) > 1 else ""
+        raise UserError(refusal(degraded[0].name, degraded[0].defects) + more)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     apt = db.airports.get(args.airport.upper())
     g = gravity_mps2(apt.lat_deg if apt else 45.0)
     for seq in seqs:
+        if not seq.legs:
+            print(f"{seq.name}: degraded (no legs: every record rejected)")
+            for d in seq.defects:
+                print(f"    {d.finding}")
+            continue
         path = check_path(build_sequence(db, seq, perf, params), perf, params, g)
         gj = write_geojson(path, out)
-        png = plot_path(path, out / f"{safe_name(path)}.png") if path.segments else None
-        print(f"{path.name}: {path.status} ({len(path.legs)} legs, {len(path.segments)} "
-              f"segments, {path.length_m() / 1852:.1f} NM) -> {gj.name}"
+        png = save(plot_path(path), out / f"{safe_name(path)}.png") if path.segments else None
+        status = f"degraded (monitor: {path.status})" if seq.degraded else path.status
+        print(f"{path.name}: {status} ({len(path.legs)} legs, {len(path.segments)} "
+              f"segments, {path.length_m() / NM_M:.1f} NM) -> {gj.name}"
               f"{', ' + png.name if png else ''}")
+        for d in seq.defects:
+            print(f"    {d.finding}")
         for f in path.findings:
             print(f"    leg {f.leg_index + 1}: {f.category}"
                   f"{' [' + f.branch + ']' if f.branch else ''}: {f.message}")
     for issue in db.issues[:20]:
         print(f"    rejected record: {issue}")
+    if len(db.issues) > 20:
+        print(f"    ... {len(db.issues) - 20} more rejected records")
     return 0
 
 
@@ -60,26 +89,35 @@ def cmd_check(args) -> int:
     """Check every procedure transition of a database; write the table and the summary."""
     import pandas as pd
 
-    from fms_testbed.evaluation.check import check_database
+    from fms_testbed.evaluation.check import ROW_COLUMNS, merge_airports, run_check
+    from fms_testbed.procedures.fields import REJECTED_COLUMNS
 
-    perf = _perf(args.aircraft)
-    airports = [a.upper() for a in args.airports] if args.airports else None
     if args.workers < 1:
         raise UserError(f"--workers must be at least 1, got {args.workers}")
-    rows, summary = check_database(args.db, perf, airports, args.workers, _params(args),
-                                   progress=not args.no_progress)
+    params = _params(args)
+    perf = _perf(args.aircraft)
+    res = run_check(args.db, perf, merge_airports(args.airports), args.workers, params,
+                    progress=not args.no_progress)
+    rows, summary = res.rows, res.summary
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    df = pd.DataFrame(rows).drop(columns=["order"])
+    df = pd.DataFrame(rows, columns=list(rows[0]) if rows else list(ROW_COLUMNS))
+    df = df.drop(columns=["order"])
     df.to_parquet(out / "procedures_check.parquet", index=False)
     df.to_csv(out / "procedures_check.csv", index=False)
+    pd.DataFrame([e.row() for e in res.rejected], columns=list(REJECTED_COLUMNS)).to_csv(
+        out / "rejected_records.csv", index=False)
     (out / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
     st = summary["by_status"]
     print(f"{summary['transitions']} procedure transitions from {summary['database']} "
           f"({summary['lines']} lines, {summary['parse_issues']} rejected records) in "
           f"{summary['elapsed_s']:.1f} s with {summary['workers']} worker(s)")
     print("  status: " + ", ".join(f"{k} {v}" for k, v in sorted(st.items()))
-          + f"  -> ok or corrected {summary['ok_or_corrected_pct']:.2f}%")
+          + f"  -> ok or corrected {summary['ok_or_corrected_pct']:.2f}% of all transitions")
+    print(f"  {summary['rejected_records']} rejected records -> "
+          f"{out / 'rejected_records.csv'}; degraded transitions by defect: "
+          f"{summary['degraded_by_defect'] or 'none'}; internal errors: "
+          f"{summary['internal_errors']}")
     print("  leg types (coded/built): " + ", ".join(
         f"{pt} {v['coded']}/{v['built']}" for pt, v in summary["by_leg_type"].items()
         if v["coded"]))
@@ -96,7 +134,8 @@ def cmd_check(args) -> int:
 
 def register(subparsers) -> None:
     """Add ``procedures build`` and ``procedures check``."""
-    p = subparsers.add_parser("procedures", help="ARINC-424 procedures: build paths, check a database")
+    p = subparsers.add_parser("procedures",
+                              help="ARINC-424 procedures: list, build paths, check a database")
     sub = p.add_subparsers(dest="procedures_command", metavar="SUBCOMMAND")
     common = dict(default=None, help="ARINC-424 file (default: the embedded excerpt "
                                      "procedures/cifp_excerpt.dat)")
@@ -109,6 +148,9 @@ def register(subparsers) -> None:
     b.add_argument("--aircraft", default="737", help="aircraft name or YAML (default 737)")
     b.add_argument("--manual-nm", type=float, default=5.0,
                    help="distance flown on FM/VM legs, NM (default 5)")
+    b.add_argument("--allow-degraded", action="store_true",
+                   help="build transitions with rejected, duplicated or misplaced records too "
+                        "(refused by default, exit 2)")
     b.add_argument("--out", required=True, help="output folder")
     b.set_defaults(func=cmd_build)
     c = sub.add_parser("check", help="build and monitor every procedure transition")
@@ -121,4 +163,5 @@ def register(subparsers) -> None:
     c.add_argument("--no-progress", action="store_true", help="no progress bar")
     c.add_argument("--out", required=True, help="output folder")
     c.set_defaults(func=cmd_check)
+    register_list(sub, common)
     p.set_defaults(func=lambda a: (p.print_help(), 2)[1])

@@ -1,4 +1,5 @@
-"""``fms-testbed run`` / ``demo``: fly scenario files (``inner`` is :mod:`fms_testbed.cli.inner`)."""
+"""``fms-testbed run`` / ``demo``: fly scenario files (plain or procedure flights); the outputs
+of :meth:`fms_testbed.run.results.Results.save` (timeseries, summary, plots, tracks)."""
 
 from __future__ import annotations
 

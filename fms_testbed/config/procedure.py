@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError
+from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError
 
 from fms_testbed.core.errors import ConfigError
 
@@ -33,6 +33,10 @@ class ProcedureSpec(BaseModel):
     climb_top_ft: Annotated[float, Field(ge=1000, le=45000)] = Field(
         15000.0, description="SID/missed-approach climbs stop here (raised to the highest "
                              "'at or above' constraint when that is higher), ft")
+    allow_degraded: StrictBool = Field(
+        False, description="build and fly a procedure with a rejected, duplicated or misplaced "
+                           "record of its own (refused by default); what is in doubt is "
+                           "listed with the built path")
     start_alt_ft: Annotated[float, Field(ge=-1000, le=45000)] | None = Field(
         None, description="start altitude, ft (default: the build's planned start; a SID "
                           "that starts at a fix starts at that fix's 'at or above' altitude)")

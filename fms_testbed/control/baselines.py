@@ -32,7 +32,8 @@ from dataclasses import dataclass
 
 from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.core.state import AircraftState
-from fms_testbed.control.coupled_law import (G_MPS2, CoupledLawParams, altitude_channel_ny, clip_altitude_error,
+from fms_testbed.core.units import G0_MPS2
+from fms_testbed.control.coupled_law import (CoupledLawParams, altitude_channel_ny, clip_altitude_error,
                           gravity_ratio, params_from_config)
 
 
@@ -73,10 +74,10 @@ class SeparateChannelsLaw:
         dV = V - tas_cmd_mps
         sat_hi = state.throttle >= p.throttle_max - 0.005
         sat_lo = state.throttle <= p.throttle_min + 0.005
-        di = -dV / (G_MPS2 * p.T_V_s ** 2)
+        di = -dV / (G0_MPS2 * p.T_V_s ** 2)
         if not ((sat_hi and di > 0) or (sat_lo and di < 0)):
             st.i1 += di * dt_s
-        nx = st.i1 - 2.0 * p.xi_V / (G_MPS2 * p.T_V_s) * dV
+        nx = st.i1 - 2.0 * p.xi_V / (G0_MPS2 * p.T_V_s) * dV
         dH = clip_altitude_error(float(state.alt_m) - alt_cmd_m, p.dH_limit_m)
         gr = gravity_ratio(float(state.lat_rad), float(state.alt_m), float(state.v_enu_mps[0]),
                            float(state.v_enu_mps[1]))
@@ -116,7 +117,7 @@ class TecsLaw:
         V = max(float(state.tas_mps), 1.0)
         dH = clip_altitude_error(float(state.alt_m) - alt_cmd_m, p.dH_limit_m)
         gamma_c = math.asin(max(-0.3, min(0.3, -dH / (2.0 * p.xi_H * p.T_H_s * V))))
-        acc_c = -(V - tas_cmd_mps) / (2.0 * p.xi_V * p.T_V_s * G_MPS2)
+        acc_c = -(V - tas_cmd_mps) / (2.0 * p.xi_V * p.T_V_s * G0_MPS2)
         return gamma_c, acc_c
 
     def update(self, dt_s: float, state: AircraftState, alt_cmd_m: float, tas_cmd_mps: float
@@ -131,7 +132,7 @@ class TecsLaw:
                            float(state.v_enu_mps[1]))
         acc = float(state.nx) - gr * math.sin(gam)     # V'/g0 from the measured n_x
         gamma_c, acc_c = self.demands(state, alt_cmd_m, tas_cmd_mps)
-        step = 0.1 * G_MPS2 / V * dt_s
+        step = 0.1 * G0_MPS2 / V * dt_s
         gamma_c = self.gamma_c_rad = min(max(gamma_c, self.gamma_c_rad - step),
                                          self.gamma_c_rad + step)
         e_err = (gamma_c + acc_c) - (gam + acc)
@@ -142,7 +143,7 @@ class TecsLaw:
         if not ((sat_hi and e_err > 0) or (sat_lo and e_err < 0)):
             st.i1 += self.k_TI_ps * e_err * dt_s
         nx = math.sin(gamma_c) + acc_c + self.k_T * e_err + st.i1
-        dny = (V / G_MPS2) * (k * l_err + st.i2)
+        dny = (V / G0_MPS2) * (k * l_err + st.i2)
         ny = gr * math.cos(gam) + dny
         ny_c = min(max(ny, p.ny_min), p.ny_max)
         if ny_c == ny:

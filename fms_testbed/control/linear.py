@@ -22,7 +22,8 @@ from dataclasses import dataclass
 import control as ct
 import numpy as np
 
-from fms_testbed.control.coupled_law import G_MPS2, CoupledLawParams
+from fms_testbed.control.coupled_law import CoupledLawParams
+from fms_testbed.core.units import G0_MPS2
 
 OUTPUTS = ("V", "H", "theta", "nxa")
 """Closed-loop outputs: airspeed (m/s), altitude (m), flight-path angle (rad), n_xa command (g)."""
@@ -42,7 +43,7 @@ def plant_ss(V0_mps: float, tau_nx_s: float = 0.0, tau_ny_s: float = 0.0) -> ct.
     -------
     StateSpace with inputs (nx_cmd, dny_cmd) in g and outputs (V, theta, H, nx) in m/s, rad, m, g.
     """
-    g = G_MPS2
+    g = G0_MPS2
     # states: V, theta, H, [nx], [dny]
     names = ["V", "theta", "H"]
     lag_x, lag_y = tau_nx_s > 0, tau_ny_s > 0
@@ -92,7 +93,7 @@ def law_ss(p: CoupledLawParams, V0_mps: float, use_measured_nx: bool | None = No
     -------
     StateSpace with inputs (V_cmd, H_cmd, V, theta, H, nx) and outputs (nx_cmd, dny_cmd).
     """
-    g = G_MPS2
+    g = G0_MPS2
     meas = p.use_measured_nx if use_measured_nx is None else use_measured_nx
     a_d, a_p = 2 * p.xi_H / (g * p.T_H_s), 1.0 / (g * p.T_H_s ** 2)
     b_d, b_p = 2 * p.xi_V / p.T_V_s, 1.0 / (g * p.T_V_s ** 2)

@@ -12,8 +12,6 @@ from dataclasses import asdict, dataclass
 import numpy as np
 import pandas as pd
 
-KMH_PER_MPS = 3.6
-
 
 @dataclass(frozen=True, slots=True)
 class StepMetrics:

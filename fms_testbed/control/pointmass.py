@@ -19,8 +19,9 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from fms_testbed.control.coupled_law import gravity_ratio
 from fms_testbed.core.state import AircraftState
-from fms_testbed.control.coupled_law import G_MPS2, gravity_ratio
+from fms_testbed.core.units import G0_MPS2
 
 _ZERO3 = np.zeros(3)
 
@@ -87,8 +88,8 @@ def _derivs(x: np.ndarray, nx_cmd: float, ny_cmd: float, pm: PointMassParams) ->
     V, th, H, nx, ny = x
     gr = gravity_ratio(0.0, H)
     d = np.empty(5)
-    d[0] = G_MPS2 * (nx - gr * math.sin(th))
-    d[1] = G_MPS2 / V * (ny - gr * math.cos(th))
+    d[0] = G0_MPS2 * (nx - gr * math.sin(th))
+    d[1] = G0_MPS2 / V * (ny - gr * math.cos(th))
     d[2] = V * math.sin(th)
     d[3] = (nx_cmd - nx) / pm.tau_nx_s if pm.tau_nx_s > 0 else 0.0
     d[4] = (ny_cmd - ny) / pm.tau_ny_s if pm.tau_ny_s > 0 else 0.0

@@ -6,13 +6,14 @@ import math
 
 import numpy as np
 
+from fms_testbed.core.units import G0_MPS2
+
 T0_K = 288.15
 P0_PA = 101325.0
 RHO0_KGPM3 = 1.225
 LAPSE_KPM = 0.0065
 R_JPKGK = 287.05287
 GAMMA = 1.4
-G0_MPS2 = 9.80665
 H_TROP_M = 11000.0
 A0_MPS = float(np.sqrt(GAMMA * R_JPKGK * T0_K))
 

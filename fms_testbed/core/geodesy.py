@@ -14,16 +14,12 @@ import math
 
 from geographiclib.geodesic import Geodesic
 
+from fms_testbed.core.earth import normal_gravity_mps2
 from fms_testbed.core.vincenty import vincenty_direct, vincenty_inverse
 
 WGS84 = Geodesic.WGS84
 _INV_MASK = Geodesic.DISTANCE | Geodesic.AZIMUTH
 _DIR_MASK = Geodesic.LATITUDE | Geodesic.LONGITUDE | Geodesic.AZIMUTH
-
-#: Normal gravity constants (Somigliana, WGS-84).
-_GE = 9.7803253359
-_K = 0.00193185265241
-_E2 = 0.00669437999013
 
 
 def inverse(lat1_deg: float, lon1_deg: float, lat2_deg: float, lon2_deg: float
@@ -56,10 +52,11 @@ def direct(lat_deg: float, lon_deg: float, az_deg: float, s_m: float
     return r["lat2"], r["lon2"], r["azi2"]
 
 
-def gravity_mps2(lat_deg: float) -> float:
-    """Normal gravity on the WGS-84 ellipsoid (Somigliana), m/s^2, at latitude ``lat_deg``."""
-    s2 = math.sin(math.radians(lat_deg)) ** 2
-    return _GE * (1.0 + _K * s2) / math.sqrt(1.0 - _E2 * s2)
+def gravity_mps2(lat_deg: float, alt_m: float = 0.0) -> float:
+    """Normal gravity of WGS-84, m/s², at geodetic latitude ``lat_deg`` (deg) and height ``alt_m``
+    (m, default on the ellipsoid): :func:`fms_testbed.core.earth.normal_gravity_mps2` (TR8350.2
+    eq. 4-1, 4-3) in the degree convention of this module."""
+    return float(normal_gravity_mps2(math.radians(lat_deg), float(alt_m)))
 
 
 def wrap180(a_deg: float) -> float:

@@ -13,12 +13,18 @@ application of nested equations", Survey Review 23 (176), 1975, eqs. (1)-(18).
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 from numba import njit
 
-A_M = 6378137.0
-F = 1.0 / 298.257223563
-B_M = A_M * (1.0 - F)
+from fms_testbed.core._numba_cache import invalidate_if_sources_changed
+from fms_testbed.core.earth import A_M, B_M
+from fms_testbed.core.earth import FLATTENING as F
+
+# the kernels below read earth.py's WGS-84 constants as compile-time constants, which numba's
+# cache does not track: clear core's numba cache when a core source changes (numba loads a kernel
+# from the cache at its first call, so this runs before)
+invalidate_if_sources_changed(Path(__file__).parent)
 
 
 @njit(cache=True)

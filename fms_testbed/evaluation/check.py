@@ -7,6 +7,7 @@ table does not depend on the number of workers.
 
 from __future__ import annotations
 
+import logging
 import math
 import time
 from collections import Counter
@@ -20,9 +21,11 @@ from fms_testbed.core.units import NM_M
 from fms_testbed.procedures.database import Database, load_database
 from fms_testbed.procedures.legrecord import PATH_TERMINATORS, PROC_TYPES
 from fms_testbed.legs.model import BuildParams, Performance, ProcedurePath
+from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.monitor import check_path, leg_end_checks
 from fms_testbed.path.segmentation import build_sequence
 
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -52,10 +55,11 @@ def invariants(path: ProcedurePath) -> Invariants:
     rf_err = 0.0
     mism = leg_turn_mismatches(path)
     for seg in segs:
-        if seg.role != "leg" or not isinstance(seg.geom, Arc) or seg.path_term not in ("RF", "AF"):
+        kind = LEG_TYPES[seg.path_term]
+        if seg.role != "leg" or not isinstance(seg.geom, Arc) or kind.arc_centre is None:
             continue
         rec = path.legs[seg.leg_index].record
-        if seg.path_term == "RF" and rec.arc_radius_m:
+        if kind.arc_centre == "fix" and rec.arc_radius_m:
             rf_err = max(rf_err, abs(seg.geom.radius_m - rec.arc_radius_m))
         if rec.turn_dir in ("L", "R") and seg.geom.turn != rec.turn_dir:
             mism += 1
@@ -77,8 +81,9 @@ def leg_turn_mismatches(path: ProcedurePath) -> int:
     bad = 0
     for lg in path.legs:
         d = lg.record.turn_dir
-        if d not in ("L", "R") or lg.path_term in ("HA", "HF", "HM", "PI", "RF", "AF", "IF"):
-            continue
+        kind = LEG_TYPES[lg.path_term]
+        if d not in ("L", "R") or kind.course_reversal or kind.arc_centre or kind.initial:
+            continue  # the coded direction is the hold's / PT's or the arc's, or no path
         k = first.get(lg.index)
         if k is None:
             continue
@@ -100,31 +105,75 @@ def perf_for(aircraft: str) -> Performance:
     return Performance.from_aircraft(load_aircraft(aircraft))
 
 
+def _lines(seq) -> str:
+    """'first-last' file lines of a transition's records ('' when it has none)."""
+    return f"{seq.lines[0]}-{seq.lines[-1]}" if seq.lines else ""
+
+
+def check_transition(db: Database, seq, perf: Performance, params: BuildParams):
+    """Build and monitor one transition.
+
+    Returns
+    -------
+    (path or None, invariants or None, internal error text or '')
+        an exception from the builder or the monitor is a bug, not a verdict on the
+        procedure: it is returned as 'internal error: <type>: <message> (records at lines
+        a-b)' and the row is ``degraded``, counted apart (``internal_errors``), never
+        'impossible'.
+    """
+    try:
+        path = build_sequence(db, seq, perf, params)
+        apt = db.airports.get(seq.airport)
+        path = check_path(path, perf, params, gravity_mps2(apt.lat_deg if apt else 45.0))
+        return path, invariants(path), ""
+    except Exception as exc:  # noqa: BLE001 -- recorded with its type and lines, counted apart
+        log.warning("%s: internal error building %s (lines %s)", db.path, seq.name,
+                    _lines(seq), exc_info=True)
+        return None, None, (f"internal error: {type(exc).__name__}: {exc} "
+                            f"(records at lines {_lines(seq) or 'none'})")
+
+
+ROW_COLUMNS = ("airport", "order", "procedure", "transition", "type", "route_type", "legs",
+               "n_legs", "status", "findings", "branches", "flags", "n_segments", "length_nm",
+               "max_gap_m", "fix_excess_m", "rf_radius_err_nm", "turn_mismatch", "built_legs",
+               "monitor_status", "defects", "lines")
+"""Columns of a check row (:func:`check_airport`), in order."""
+
+
 def check_airport(db: Database, airport: str, perf: Performance,
                   params: BuildParams | None = None) -> list[dict]:
-    """Build and monitor every transition of one airport; one row (dict) per transition."""
+    """Build and monitor every transition of one airport; one row (dict) per transition.
+
+    ``status`` is the monitor's ('ok', 'corrected', 'impossible') for a transition whose
+    records are all sound, and ``degraded`` for one with a rejected, duplicated or misplaced
+    record of its own (:mod:`fms_testbed.procedures.integrity`) or an internal error;
+    ``monitor_status`` keeps what the monitor said ('' when nothing was built,
+    'internal-error'), ``defects`` the defect kinds, ``lines`` the file lines of its records.
+    """
     rows = []
     params = params or BuildParams()
     for order, seq in enumerate(db.sequences(airport)):
-        try:
-            path = build_sequence(db, seq, perf, params)
-            apt = db.airports.get(airport)
-            path = check_path(path, perf, params, gravity_mps2(apt.lat_deg if apt else 45.0))
-            inv = invariants(path)
-            crash = ""
-        except Exception as exc:  # one bad transition never kills the batch
-            path, inv, crash = None, None, f"internal error: {type(exc).__name__}: {exc}"
+        path = inv = None
+        crash = ""
+        if seq.legs:
+            path, inv, crash = check_transition(db, seq, perf, params)
         legs = [lg.path_term for lg in seq.legs]
-        findings = [] if path is None else [
-            f"leg {f.leg_index + 1} {f.category}{' [' + f.branch + ']' if f.branch else ''}: "
-            f"{f.message}" for f in path.findings]
+        findings = [d.finding for d in seq.defects]
+        if crash:
+            findings.append(crash)
+        if path is not None:
+            findings += [f"leg {f.leg_index + 1} {f.category}"
+                         f"{' [' + f.branch + ']' if f.branch else ''}: {f.message}"
+                         for f in path.findings]
+        kinds = sorted({d.kind for d in seq.defects} | ({"internal-error"} if crash else set()))
+        monitor = path.status if path is not None else ("internal-error" if crash else "")
         rows.append({
             "airport": airport, "order": order,
             "procedure": seq.proc_id, "transition": seq.transition,
             "type": PROC_TYPES.get(seq.proc_type, seq.proc_type),
             "route_type": seq.route_type, "legs": " ".join(legs), "n_legs": len(legs),
-            "status": "impossible" if path is None else path.status,
-            "findings": "; ".join(findings) if not crash else crash,
+            "status": "degraded" if kinds else monitor,
+            "findings": "; ".join(findings),
             "branches": "" if path is None else "|".join(
                 sorted({f.branch for f in path.findings if f.branch})),
             "flags": "" if path is None else ",".join(
@@ -137,6 +186,7 @@ def check_airport(db: Database, airport: str, perf: Performance,
             "rf_radius_err_nm": float("nan") if inv is None else inv.rf_radius_err_m / NM_M,
             "turn_mismatch": -1 if inv is None else inv.turn_mismatch,
             "built_legs": "" if path is None else " ".join(lg.path_term for lg in path.legs),
+            "monitor_status": monitor, "defects": ",".join(kinds), "lines": _lines(seq),
         })
     return rows
 
@@ -158,15 +208,35 @@ def _work(airport: str) -> tuple[list[dict], list]:
     return rows, db.issues[n0:]
 
 
-def check_database(db_path: str | None, perf: Performance, airports: list[str] | None = None,
-                   workers: int = 1, params: BuildParams | None = None, progress: bool = True
-                   ) -> tuple[list[dict], dict]:
-    """Check a database; return (rows sorted by airport and file order, summary dict)."""
+@dataclass
+class CheckResult:
+    """What a database check found: ``rows`` (one per transition, sorted by airport and file
+    order), ``summary`` (:func:`summarise`), ``rejected`` (every rejected record read, as
+    :class:`~fms_testbed.procedures.fields.RecordError`, sorted by line)."""
+
+    rows: list[dict]
+    summary: dict
+    rejected: list
+
+
+def merge_airports(airports: list[str] | None) -> list[str] | None:
+    """Airport idents upper-cased, repeats merged (first occurrence kept): 'KBFI KBFI kbfi'
+    is one airport."""
+    if not airports:
+        return None
+    return list(dict.fromkeys(a.upper() for a in airports))
+
+
+def run_check(db_path: str | None, perf: Performance, airports: list[str] | None = None,
+              workers: int = 1, params: BuildParams | None = None, progress: bool = True
+              ) -> CheckResult:
+    """Check a database (every airport, or ``airports``, repeats merged case-insensitively)."""
     t0 = time.perf_counter()
     params = params or BuildParams()
     db = load_database(db_path)
-    todo = airports or db.airport_idents()
-    missing = [a for a in todo if a not in db._raw_procs]
+    known = set(db.airport_idents())
+    todo = merge_airports(airports) or sorted(known)
+    missing = [a for a in todo if a not in known]
     if missing:
         from fms_testbed.core.errors import UserError
         raise UserError(f"{db.path}: no procedures for airport(s) {', '.join(missing)}")
@@ -192,25 +262,45 @@ def check_database(db_path: str | None, perf: Performance, airports: list[str] |
     if bar:
         bar.close()
     rows.sort(key=lambda r: (r["airport"], r["order"]))
-    return rows, summarise(rows, db, time.perf_counter() - t0, workers)
+    db.issues.sort(key=lambda e: (e.line, e.column))
+    return CheckResult(rows, summarise(rows, db, time.perf_counter() - t0, workers), db.issues)
+
+
+def check_database(db_path: str | None, perf: Performance, airports: list[str] | None = None,
+                   workers: int = 1, params: BuildParams | None = None, progress: bool = True
+                   ) -> tuple[list[dict], dict]:
+    """:func:`run_check`; return (rows sorted by airport and file order, summary dict)."""
+    res = run_check(db_path, perf, airports, workers, params, progress)
+    return res.rows, res.summary
 
 
 def summarise(rows: list[dict], db: Database, elapsed_s: float, workers: int) -> dict:
-    """Counts by status and by leg type; leg types built at least once; invariant maxima."""
+    """Counts by status and by leg type; leg types built at least once; invariant maxima.
+
+    ``ok_or_corrected_pct`` is over every transition, degraded ones included; degraded rows
+    are left out of the leg types built and of the invariant maxima (their geometry comes from
+    records in doubt), and counted by defect kind in ``degraded_by_defect``;
+    ``internal_errors`` counts the transitions whose build raised (a bug, never 'impossible').
+    """
     by_status = Counter(r["status"] for r in rows)
     leg_all: Counter = Counter()
     leg_built: Counter = Counter()
     for r in rows:
         leg_all.update(r["legs"].split())
-        if r["status"] != "impossible":
+        if r["status"] not in ("impossible", "degraded"):
             leg_built.update(r["built_legs"].split())
     n = len(rows)
     good = by_status.get("ok", 0) + by_status.get("corrected", 0)
-    finite = [r for r in rows if r["max_gap_m"] == r["max_gap_m"]]
+    sound = [r for r in rows if r["status"] != "degraded"]
+    finite = [r for r in sound if r["max_gap_m"] == r["max_gap_m"]]
     return {
         "database": db.path, "lines": db.n_lines, "parse_issues": len(db.issues),
+        "rejected_records": len(db.issues),
         "transitions": n, "by_status": dict(by_status),
         "ok_or_corrected_pct": 100.0 * good / n if n else float("nan"),
+        "degraded_by_defect": dict(Counter(k for r in rows for k in r["defects"].split(",")
+                                           if k)),
+        "internal_errors": sum(r["monitor_status"] == "internal-error" for r in rows),
         "by_leg_type": {pt: {"coded": leg_all.get(pt, 0), "built": leg_built.get(pt, 0)}
                         for pt in PATH_TERMINATORS},
         "leg_types_present_not_built": [pt for pt in PATH_TERMINATORS
@@ -218,7 +308,7 @@ def summarise(rows: list[dict], db: Database, elapsed_s: float, workers: int) ->
         "max_gap_m": max((r["max_gap_m"] for r in finite), default=0.0),
         "max_fix_excess_m": max((r["fix_excess_m"] for r in finite), default=0.0),
         "max_rf_radius_err_nm": max((r["rf_radius_err_nm"] for r in finite), default=0.0),
-        "turn_mismatches": sum(max(r["turn_mismatch"], 0) for r in rows),
+        "turn_mismatches": sum(max(r["turn_mismatch"], 0) for r in sound),
         "branches": dict(Counter(b for r in rows for b in r["branches"].split("|") if b)),
         "flags": dict(Counter(f for r in rows for f in r["flags"].split(",") if f)),
         "elapsed_s": elapsed_s, "workers": workers,

@@ -5,9 +5,14 @@ Definitions (RNP, ICAO Doc 9613; ``shared/notes/navigation-monitoring.md``), all
 * FTE — flight technical error: the navigation solution's cross-track from the path guidance
   flies (``nav_xtk_m``);
 * NSE — navigation system error: distance between the navigation solution and the true position;
-* PDE — path definition error: distance of the built path from the ideal coded path where that
-  is defined (TF: geodesic between the fixes; CF: coded course line; RF: coded centre/radius),
-  evaluated per built segment (``pde_m``);
+* PDE — path definition error: distance of the built path guidance flies from the path the
+  record codes, per segment of the leg's own path (``pde_m``, :mod:`fms_testbed.guidance.pde`):
+  TF the geodesic between the fixes; CF the course line into the fix; FA/FC/FD/FM the course
+  line out of the fix; RF the circle of the coded radius about the centre fix; AF the DME arc
+  at rho; HA/HF/HM the racetrack on the inbound course. NaN on transitions (fly-by arcs, turns
+  and intercepts onto a leg, connectors) and on leg types that code no path (IF, DF, PI, the
+  C*/V* legs from the present position): each leg class says which
+  (:attr:`fms_testbed.legs.base.Leg.pde_reference`);
 * TSE — total system error: the true position's cross-track from the path (``xtk_m``).
 
 The straight parts of heading legs (VA/VD/VI/VM/VR, flown as a heading; ``heading_leg`` = 1)
@@ -30,6 +35,7 @@ import pandas as pd
 
 from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.profile import window
 
 ALT_TOL_FT = 50.0
@@ -130,7 +136,7 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
                 i = int(after[0])
                 row["where"] = "leg end (ended within one logged step)"
         else:
-            if term is None or term.lat_deg is None or k == 0 and rec.path_term == "IF" \
+            if term is None or term.lat_deg is None or k == 0 and LEG_TYPES[rec.path_term].initial \
                     and not len(df):
                 row.update(ok=None, why="no fix position to check against")
                 out.append(row)

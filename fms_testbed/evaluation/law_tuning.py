@@ -30,6 +30,7 @@ from scipy.optimize import minimize
 
 from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.units import mps_to_kmh
 from fms_testbed.config.scenario import parse_scenario
 from fms_testbed.loop.flight import fly
 from fms_testbed.control.coupled_law import CoupledLaw, CoupledLawParams, params_from_config
@@ -76,7 +77,7 @@ class Evaluation:
              "cost": self.cost, "note": self.note}
         if self.alt and self.speed:
             d.update(alt_settling_s=self.alt.settling_s, alt_overshoot_pct=self.alt.overshoot_pct,
-                     max_dV_kmh=self.alt.max_cross_dev * 3.6,
+                     max_dV_kmh=mps_to_kmh(self.alt.max_cross_dev),
                      speed_settling_s=self.speed.settling_s,
                      speed_overshoot_pct=self.speed.overshoot_pct,
                      max_dH_m=self.speed.max_cross_dev,
@@ -145,7 +146,7 @@ def cost(alt: StepMetrics, speed: StepMetrics, cfg: AircraftConfig) -> tuple[flo
         else:
             j += m.settling_s / ref
         j += max(0.0, m.overshoot_pct - 2.0) / 2.0
-    j += (alt.max_cross_dev * 3.6 / 0.5) ** 2 + (speed.max_cross_dev / 0.75) ** 2
+    j += (mps_to_kmh(alt.max_cross_dev) / 0.5) ** 2 + (speed.max_cross_dev / 0.75) ** 2
     j += max(alt.throttle_activity_ps, speed.throttle_activity_ps) / 0.01
     if alt.throttle_sat_frac > 0.0 or speed.throttle_sat_frac > 0.0:
         j += 100.0

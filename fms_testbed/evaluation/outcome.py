@@ -29,6 +29,7 @@ import numpy as np
 import pandas as pd
 
 from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
 
 ORDER = ("diverged", "incomplete", "envelope_exceeded", "not_contained", "constraints_missed")
@@ -77,10 +78,6 @@ def envelope_violations(df: pd.DataFrame, cfg: AircraftConfig) -> list[str]:
     return out
 
 
-MEAN_EARTH_RADIUS_M = 6371008.8
-"""Mean Earth radius (IUGG), m: haversine distances are within 0.5 % of the geodesic."""
-
-
 def horizontal_distance_m(lat1_deg, lon1_deg, lat2_deg, lon2_deg) -> np.ndarray:
     """Great-circle (haversine) distance between two tracks, vectorised, m — good to 0.5 % of the
     WGS-84 geodesic at any distance (enough for a containment verdict, unlike a flat-Earth
@@ -93,7 +90,7 @@ def horizontal_distance_m(lat1_deg, lon1_deg, lat2_deg, lon2_deg) -> np.ndarray:
     p1, p2 = np.radians(lat1_deg), np.radians(lat2_deg)
     dl = np.radians(np.asarray(lon2_deg) - np.asarray(lon1_deg))
     h = np.sin(0.5 * (p2 - p1)) ** 2 + np.cos(p1) * np.cos(p2) * np.sin(0.5 * dl) ** 2
-    return 2.0 * MEAN_EARTH_RADIUS_M * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0)))
+    return 2.0 * MEAN_RADIUS_M * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0)))
 
 
 def navigation_containment(df: pd.DataFrame, rnp_nm: float) -> dict:

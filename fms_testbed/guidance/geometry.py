@@ -19,19 +19,11 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from fms_testbed.core.earth import radii_m
 from fms_testbed.core.segments import Arc, Line
 
-_A_M = 6378137.0
-_E2 = 6.69437999014e-3
 CHUNK_M = 4000.0
 """Longest straight piece with one tangent plane, m (keeps the plane's error below 1 m)."""
-
-
-def radii_m(lat_rad: float) -> tuple[float, float]:
-    """Meridian (M) and prime-vertical (N) radii of curvature of WGS-84 at a latitude, m."""
-    s2 = math.sin(lat_rad) ** 2
-    w = math.sqrt(1.0 - _E2 * s2)
-    return _A_M * (1.0 - _E2) / w ** 3, _A_M / w
 
 
 @dataclass(frozen=True, slots=True)

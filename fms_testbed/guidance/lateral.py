@@ -24,7 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-G_MPS2 = 9.80665
+from fms_testbed.core.units import G0_MPS2
 
 
 @dataclass(frozen=True, slots=True)
@@ -54,7 +54,7 @@ class LateralGains:
 
 def feedforward_bank_rad(gs_mps: float, curvature_1pm: float) -> float:
     """Bank that flies curvature κ (1/m, + right) at ground speed V_g: atan(V_g² κ / g), rad."""
-    return math.atan(gs_mps * gs_mps * curvature_1pm / G_MPS2)
+    return math.atan(gs_mps * gs_mps * curvature_1pm / G0_MPS2)
 
 
 def anticipation_m(gs_mps: float, bank_change_rad: float, gains: LateralGains) -> float:
@@ -95,7 +95,7 @@ def bank_command_rad(xtk_m: float, track_err_rad: float, gs_mps: float, curvatur
         e = math.pi / 2
     elif e < -math.pi / 2:
         e = -math.pi / 2
-    tan_phi = v * v * curvature_1pm / G_MPS2 + 2.0 * z * w * v / G_MPS2 * math.sin(e)
+    tan_phi = v * v * curvature_1pm / G0_MPS2 + 2.0 * z * w * v / G0_MPS2 * math.sin(e)
     phi = math.atan(tan_phi)
     lim = math.radians(gains.bank_max_deg)
     return lim if phi > lim else (-lim if phi < -lim else phi)

@@ -9,7 +9,7 @@ aircraft's gradient, levels off under 'at or below' constraints and descends at 
 
 (a second-order altitude loop follows a ramp with a lag of 2 ξ_H T_H; reading the plan that far
 ahead removes it). Speed is also capped ahead of arcs too tight for the planned TAS within the
-bank limit (``fms.ProcedureGuidance._arc_speed_cap``). In a climb phase (SID, missed approach) the target is instead the top of the
+bank limit (:func:`.speed_plan.arc_speed_cap_mps`). In a climb phase (SID, missed approach) the target is instead the top of the
 climb — the highest planned altitude of the phase capped by every 'at or below' constraint
 ahead — flown at the law's level-change rate, set to the aircraft's sustained climb rate
 (:func:`procedure_law`): an FMS climbs at the best rate, not along a geometric path, so 'at or
@@ -27,8 +27,8 @@ import math
 from dataclasses import dataclass
 
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
+from fms_testbed.core.units import KT_MPS
 
-KT_MPS = 1852.0 / 3600.0
 MIN_CAS_FACTOR = 1.15
 """The TAS target never gives a CAS below this multiple of the aircraft's minimum clean CAS
 (the planned TAS is constant, so high in a SID or STAR the CAS would otherwise fall toward the
@@ -175,3 +175,29 @@ def profile_nodes_at_fixes(path, prof) -> list[float]:
     for j in range(1, len(s)):  # keep the nodes ordered
         s[j] = max(s[j], s[j - 1])
     return s
+
+
+def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list[float | None],
+                       s_path_m: float, gs_mps: float, lead_s: float, t2_s2: float,
+                       top_m: float, approach: bool) -> float:
+    """Altitude command at path distance ``s_path_m``, m.
+
+    Along the blended planned profile (:func:`blended_profile`, blend ±``gs BLEND_S``) the
+    command inverts the coupled law's altitude dynamics,
+    ``H_cmd = h + 2 ξ_H T_H V dh/ds + T_H² V² d²h/ds²``; in a climb phase it is instead the
+    climb target of the node ahead (:func:`climb_targets`), never above ``top_m``.
+
+    Parameters
+    ----------
+    prof_s, prof_h : profile node distances (m, on the active path) and altitudes (m)
+    climb_tgt : climb target per node, m (None outside climbs)
+    s_path_m : distance along the active path, m; gs_mps : ground speed, m/s
+    lead_s : read-ahead time 2 ξ_H T_H, s (:func:`altitude_lead_s`); t2_s2 : T_H², s²
+    top_m : the flight's climb top, m; approach : the last slope continues to the runway
+    """
+    h, dh, ddh = blended_profile(prof_s, prof_h, s_path_m, gs_mps * BLEND_S, approach)
+    alt_cmd = h + lead_s * gs_mps * dh + t2_s2 * gs_mps * gs_mps * ddh
+    jn = bisect.bisect_right(prof_s, s_path_m)
+    if 0 < jn < len(prof_s) and climb_tgt[jn] is not None:  # climb: at the law's rate
+        alt_cmd = min(max(alt_cmd, climb_tgt[jn]), top_m)
+    return alt_cmd

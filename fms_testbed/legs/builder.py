@@ -1,6 +1,6 @@
 """The leg builder's working state: emits tagged segments and offers the moves legs are made of.
 
-A leg class (``legs.py``) calls these moves: start a course (as a fly-by corner when the
+A leg class (:mod:`.types`) calls these moves: start a course (as a fly-by corner when the
 previous fix allows it, else as a turn from the present position), fly straight, go direct to a
 fix, join a course line with a 45° intercept, climb along the distance flown. Every move appends
 :class:`~.model.PathSegment` objects and returns the new :class:`~.model.FlightState`.
@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 
 from fms_testbed.core.geodesy import direct, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line
+from fms_testbed.core.units import NM_M
 from fms_testbed.legs.construct import _foot, direct_to_arc, ray_geodesic_intersection, turn_to_course
 from fms_testbed.procedures.legrecord import LegRecord
 from fms_testbed.legs.model import BuildParams, Finding, FlightState, PathSegment, Performance
@@ -113,6 +114,13 @@ class LegBuilder:
             alt += dist_m * self.gradient
         return replace(state, alt_m=alt, **changes)
 
+    def as_transition(self, first: int) -> None:
+        """Tag the segments emitted since index ``first`` as a transition onto the leg's coded
+        path (role 'turn': a direct-to the leg's fix, a hold entry): they have no PDE."""
+        for k in range(first, len(self.segments)):
+            if self.segments[k].role in ("leg", "hold"):
+                self.segments[k] = replace(self.segments[k], role="turn")
+
     def settle(self, state: FlightState) -> FlightState:
         """End of a leg: a fly-by corner that no line consumed (a zero-length leg) is dropped,
         and the planned track goes back to the track actually flown."""
@@ -130,12 +138,13 @@ class LegBuilder:
         return self.advance(state, arc.length_m(), lat_deg=lat, lon_deg=lon,
                             track_deg=arc.end_course_deg, flyby=False, fix_ident="")
 
-    def straight(self, state: FlightState, course_deg: float, dist_m: float) -> FlightState:
+    def straight(self, state: FlightState, course_deg: float, dist_m: float,
+                 role: str = "leg") -> FlightState:
         """Fly ``dist_m`` along the geodesic leaving the present position on ``course_deg``."""
         if dist_m <= 0.01:
             return replace(state, track_deg=course_deg)
         lat, lon, az2 = direct(state.lat_deg, state.lon_deg, course_deg, dist_m)
-        self.emit(Line(state.lat_deg, state.lon_deg, lat, lon))
+        self.emit(Line(state.lat_deg, state.lon_deg, lat, lon), role)
         return self.advance(state, dist_m, lat_deg=lat, lon_deg=lon, track_deg=wrap360(az2),
                             flyby=False, fix_ident="")
 
@@ -204,8 +213,8 @@ class LegBuilder:
         """Join the course line into ``fix`` (course ``course_deg`` at the fix), then fly it.
 
         On the line already: straight to the fix. Otherwise turn to a 45° intercept heading,
-        fly to the line and turn onto it (fly-by); if the intercept would fall beyond the fix,
-        fly direct to the fix instead (recorded as a finding).
+        fly to the line (role 'turn') and turn onto it (fly-by); if the intercept would fall
+        beyond the fix, fly direct to the fix instead (recorded as a finding).
         """
         along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
                                  state.lon_deg)
@@ -254,7 +263,8 @@ class LegBuilder:
                 self._corner_pending = False
                 state = self.arc(state, arc)
             return self.direct_to(state, fix, None, flyby_end)
-        state = self.straight(state, state.track_deg, hit[0])
+        # the 45° intercept is a transition onto the course line (no PDE); the course is the leg
+        state = self.straight(state, state.track_deg, hit[0], role="turn")
         state = replace(state, flyby=True)
         self._corner_pending = True
         return self.line_to(state, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
@@ -265,8 +275,8 @@ class LegBuilder:
         s, _, _ = inverse(state.lat_deg, state.lon_deg, lat, lon)
         if s <= 0.01:
             return replace(state, lat_deg=lat, lon_deg=lon)
-        if s > 0.05 * 1852.0:
-            self.finding("discontinuity", f"{why}: gap of {s / 1852.0:.2f} NM bridged")
+        if s > 0.05 * NM_M:
+            self.finding("discontinuity", f"{why}: gap of {s / NM_M:.2f} NM bridged")
         seg = Line(state.lat_deg, state.lon_deg, lat, lon)
         self.emit(seg, "connector")
         return self.advance(state, s, lat_deg=lat, lon_deg=lon, track_deg=seg.end_course_deg)

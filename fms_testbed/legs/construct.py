@@ -13,9 +13,10 @@ import math
 
 from fms_testbed.core.geodesy import LocalFrame, direct, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, turn_angle_deg
+from fms_testbed.core.units import NM_M
 
 #: Search bound for intercepts, radials and DME distances, m (100 NM).
-MAX_SEARCH_M = 100 * 1852.0
+MAX_SEARCH_M = 100 * NM_M
 
 
 def turn_arc(lat_deg: float, lon_deg: float, track_deg: float, sweep_deg: float,

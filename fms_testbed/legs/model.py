@@ -12,9 +12,9 @@ import math
 from dataclasses import dataclass
 
 from fms_testbed.core.segments import Arc, Line
+from fms_testbed.core.units import KT_MPS, NM_M
+from fms_testbed.legs.coded import CodedPath
 from fms_testbed.procedures.legrecord import LegRecord
-
-KT_MPS = 1852.0 / 3600.0
 
 
 @dataclass(frozen=True, slots=True)
@@ -32,7 +32,7 @@ class BuildParams:
 
     bank_plan_deg: float = 20.0
     bank_limit_deg: float = 25.0
-    manual_leg_m: float = 5 * 1852.0
+    manual_leg_m: float = 5 * NM_M
     timed_speed_mps: float = 210 * KT_MPS
     flyby_max_deg: float = 120.0
     climb_min_gradient: float = 0.033
@@ -101,7 +101,8 @@ class Termination:
     kind: 'fix' | 'altitude' | 'dme' | 'radial' | 'intercept' | 'manual' | 'distance' | 'time'
     | 'circuit'. Only the fields of that kind are set: ``lat_deg/lon_deg`` (fix or computed end
     point), ``alt_m`` (altitude terminations), ``dme_m`` and ``navaid_lat_deg/lon_deg`` (DME),
-    ``radial_deg`` (true, with the navaid), ``distance_m``/``time_s``, ``next_leg`` (intercept).
+    ``radial_deg`` (true, with the navaid), ``distance_m``/``time_s``, ``next_leg`` (intercept);
+    holds (HA/HF/HM) also give ``distance_m``, the racetrack's straight-leg length.
     """
 
     kind: str
@@ -122,10 +123,12 @@ class Termination:
 class PathSegment:
     """One Line or Arc of a built path with its tags.
 
-    role: 'leg' (the leg's own path), 'turn' (turn flown from the present position onto the
-    leg), 'flyby' (fly-by transition arc, tagged with the leg it ends), 'hold', 'connector'
-    (bridge over a discontinuity); speed_mps: planned TAS; bank_deg: planned bank (arcs);
-    lead_m: turn anticipation of a fly-by arc.
+    role: 'leg' (the leg's own path), 'turn' (a transition flown from the present position onto
+    the leg's path: a turn, a 45° intercept of a course, a direct-to the leg's fix, a hold
+    entry), 'flyby' (fly-by transition arc, tagged with the leg it ends), 'hold' (the turns of
+    the racetrack circuits), 'connector' (bridge over a discontinuity); speed_mps: planned TAS;
+    bank_deg: planned bank (arcs); lead_m: turn anticipation of a fly-by arc. The path
+    definition error is scored on 'leg' and 'hold' segments only.
     """
 
     geom: Line | Arc
@@ -151,7 +154,9 @@ class Finding:
 
 @dataclass(frozen=True, slots=True)
 class BuiltLeg:
-    """One interpreted leg: its record, where it starts and ends, and its termination."""
+    """One interpreted leg: its record, where it starts and ends, its termination, and the path
+    its record codes (``coded``, for the path definition error; None when the leg type has
+    none, see :attr:`fms_testbed.legs.base.Leg.pde_reference`)."""
 
     index: int
     record: LegRecord
@@ -162,6 +167,7 @@ class BuiltLeg:
     speed_mps: float
     seg_first: int = 0
     seg_count: int = 0
+    coded: CodedPath | None = None
 
 
 @dataclass(frozen=True)

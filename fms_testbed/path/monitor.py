@@ -17,19 +17,17 @@ from dataclasses import dataclass, replace
 
 from fms_testbed.core.geodesy import inverse, wrap180
 from fms_testbed.core.segments import Arc, project
+from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
 from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
+from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.profile import plan_profile
 
-NM_M = 1852.0
-KT = 1852.0 / 3600.0
-#: Tolerances: RF radius vs coded (the FAA data agree within 0.049 NM), fly-over pass, gaps.
-RF_RADIUS_TOL_M = 0.05 * NM_M
+#: Tolerances: fly-over pass, gaps (the coded-arc radius tolerances are the leg classes'
+#: ``radius_tol_m``).
 FIX_TOL_M = 1.0
 GAP_TOL_M = 1.0
 #: Largest track change between consecutive segments not flagged as a kink, deg.
 KINK_TOL_DEG = 10.0
-#: Legs whose end is a database fix the path must honour.
-FIX_LEGS = frozenset({"TF", "CF", "DF", "IF", "RF", "AF"})
 
 
 @dataclass(frozen=True, slots=True)
@@ -44,14 +42,16 @@ class FixCheck:
 
 
 def leg_end_checks(path: ProcedurePath) -> list[FixCheck]:
-    """(φ, λ) check: every TF/CF/DF/IF/RF/AF leg ends at its fix — over it when fly-over,
-    within the turn anticipation L = R tan(Ω/2) of the fly-by arc that replaces the corner."""
+    """(φ, λ) check: every leg that ends at its database fix with a 'fix' termination
+    (TF/CF/DF/IF/RF/AF; holds end over their fix by construction) ends there — over it when
+    fly-over, within the turn anticipation L = R tan(Ω/2) of the fly-by arc that replaces the
+    corner."""
     out = []
     own: dict[int, int] = {}
     for k, seg in enumerate(path.segments):
         own[seg.leg_index] = k
     for lg in path.legs:
-        if lg.path_term not in FIX_LEGS or lg.termination.kind != "fix":
+        if not LEG_TYPES[lg.path_term].ends_at_fix or lg.termination.kind != "fix":
             continue
         allowed = FIX_TOL_M
         k = own.get(lg.index)
@@ -77,7 +77,8 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
     gplan = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
     gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for lg in path.legs:
-        if lg.path_term not in ("RF", "AF"):
+        kind = LEG_TYPES[lg.path_term]
+        if kind.arc_centre is None:
             continue
         arcs = [s for s in path.segments if s.leg_index == lg.index and isinstance(s.geom, Arc)
                 and s.role == "leg"]
@@ -88,7 +89,7 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
         if r.turn_dir in ("L", "R") and arc.turn != r.turn_dir:
             out.append(Finding(lg.index, "impossible", f"{lg.path_term} arc turns {arc.turn}, "
                                f"coded {r.turn_dir}"))
-        if lg.path_term == "RF" and lg.index > 0 and path.legs[lg.index - 1].record.fix \
+        if kind.arc_centre == "fix" and lg.index > 0 and path.legs[lg.index - 1].record.fix \
                 and path.legs[lg.index - 1].termination.kind == "fix" and r.fix is not None:
             # Ω: the angle the database's fixes subtend about the coded centre
             t0 = path.legs[lg.index - 1].termination
@@ -100,11 +101,10 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
             if abs(built - omega_k) > 1.0 and abs(built - omega_k) < 359.0:
                 out.append(Finding(lg.index, "discontinuity", f"RF arc angle built "
                                    f"{built:.1f}° vs {omega_k:.1f}° between its fixes"))
-        coded_r = r.arc_radius_m if lg.path_term == "RF" else r.rho_m
+        coded_r = kind.coded_radius_m(r)
         if coded_r:
             dr = arc.radius_m - coded_r
-            tol = RF_RADIUS_TOL_M if lg.path_term == "RF" else 0.6 * NM_M
-            if abs(dr) > tol:
+            if abs(dr) > kind.radius_tol_m:
                 out.append(Finding(lg.index, "correction",
                                    f"{lg.path_term} radius coded {coded_r / NM_M:.3f} NM, fixes "
                                    f"give {arc.radius_m / NM_M:.3f} NM: path follows the fixes",
@@ -116,18 +116,18 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                 break
             if g_req <= gmax:
                 out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
-                                   f"{arc.radius_m / NM_M:.2f} NM at {v / KT:.0f} kt: bank "
+                                   f"{arc.radius_m / NM_M:.2f} NM at {v / KT_MPS:.0f} kt: bank "
                                    f"{gplan:.0f} -> {g_req:.1f}°", "γ"))
                 break
             v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax)))
             if v_reg >= perf.tas_min_mps:
                 out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
-                                   f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT:.0f} -> "
-                                   f"{v_reg / KT:.0f} kt at bank {gmax:.0f}°", "V,γ"))
+                                   f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT_MPS:.0f} -> "
+                                   f"{v_reg / KT_MPS:.0f} kt at bank {gmax:.0f}°", "V,γ"))
                 break
             out.append(Finding(lg.index, "impossible", f"{lg.path_term} radius "
                                f"{arc.radius_m / NM_M:.2f} NM needs bank {g_req:.0f}° > "
-                               f"{gmax:.0f}° even at the minimum speed {v_reg / KT:.0f} kt"))
+                               f"{gmax:.0f}° even at the minimum speed {v_reg / KT_MPS:.0f} kt"))
             break
     return out
 
@@ -143,7 +143,7 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
         v_need = perf.climb_gradient_max * perf.tas_plan_mps / params.climb_min_gradient
         if v_need >= perf.tas_min_mps:
             out.append(Finding(-1, "correction", f"climb gradient {100 * theta_perf:.1f}% < 3.3%:"
-                               f" speed {v / KT:.0f} -> {v_need / KT:.0f} kt", "V,Θ"))
+                               f" speed {v / KT_MPS:.0f} -> {v_need / KT_MPS:.0f} kt", "V,Θ"))
             v = v_need
             theta_perf = perf.climb_gradient_at(v)
         else:
@@ -162,10 +162,11 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
         k = w.leg_index + 1
         if not prof.climb[k] or w.lo_m is None or prof.alt_m[k] >= w.lo_m - 1.0:
             continue
-        if path.legs[w.leg_index].path_term in ("HA", "HF", "HM", "CA", "FA", "VA"):
+        kind = LEG_TYPES[path.legs[w.leg_index].path_term]
+        if kind.altitude_terminated or kind.hold:
             continue  # altitude-terminated or reached in the hold: met by construction
         nxt = path.legs[w.leg_index + 1] if w.leg_index + 1 < len(path.legs) else None
-        if nxt is not None and nxt.path_term in ("HA", "HF", "HM") and nxt.record.fix \
+        if nxt is not None and LEG_TYPES[nxt.path_term].hold and nxt.record.fix \
                 and nxt.record.fix.ident == w.fix_ident:
             continue  # climb in the hold that follows at the same fix
         # find the last node where the climb was free to start from
@@ -187,11 +188,11 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                 break
         if ok:
             out.append(Finding(w.leg_index, "correction", f"{name} at or above "
-                               f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.1f}% climb: speed "
-                               f"{v / KT:.0f} -> {vv / KT:.0f} kt", "V,Θ"))
+                               f"{w.lo_m / FT_M:.0f} ft needs {100 * need:.1f}% climb: speed "
+                               f"{v / KT_MPS:.0f} -> {vv / KT_MPS:.0f} kt", "V,Θ"))
         else:
             out.append(Finding(w.leg_index, "impossible", f"{name} at or above "
-                               f"{w.lo_m / 0.3048:.0f} ft needs {100 * need:.2f}% climb, aircraft "
+                               f"{w.lo_m / FT_M:.0f} ft needs {100 * need:.2f}% climb, aircraft "
                                f"max {100 * perf.climb_gradient_at(perf.tas_min_mps):.2f}% at "
                                "minimum speed"))
     grads = prof.gradients()
@@ -207,7 +208,7 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
         ident = lg.record.fix.ident if lg.record.fix else lg.path_term
         if v_reg >= perf.tas_min_mps:
             out.append(Finding(k - 1, "correction", f"descent to {ident} needs "
-                               f"{100 * need:.1f}%: speed {v / KT:.0f} -> {v_reg / KT:.0f} kt",
+                               f"{100 * need:.1f}%: speed {v / KT_MPS:.0f} -> {v_reg / KT_MPS:.0f} kt",
                                "V,Θ"))
         else:
             out.append(Finding(k - 1, "impossible", f"descent to {ident} needs "
@@ -237,7 +238,7 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
     for lg in path.legs:
         r = lg.record
         f = r.fix.ident if r.fix else ""
-        if lg.path_term in ("TF", "CF", "DF") and prev_fix and f:
+        if LEG_TYPES[lg.path_term].track_to_fix and prev_fix and f:
             key = (prev_fix, f)
             if key in seen:
                 out.append(Finding(lg.index, "loop", f"path {prev_fix}->{f} flown twice "
@@ -249,8 +250,8 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
     for a, b in zip(lines, lines[1:]):
         if b.leg_index == a.leg_index + 1 and \
                 abs(wrap180(b.geom.start_course_deg - a.geom.end_course_deg)) > 175.0 and \
-                a.path_term not in ("PI", "HM", "HF", "HA") and \
-                b.path_term not in ("PI", "HM", "HF", "HA"):
+                not LEG_TYPES[a.path_term].course_reversal and \
+                not LEG_TYPES[b.path_term].course_reversal:
             mid = b.geom.point_at(0.5 * b.geom.length_m())
             along, xtk, _, _ = project(a.geom, *mid)
             if abs(xtk) < 100.0 and -100.0 < along < a.geom.length_m() + 100.0:
@@ -270,7 +271,7 @@ def outcome(findings) -> str:
 
 
 def check_path(path: ProcedurePath, perf: Performance, params: BuildParams | None = None,
-               g_mps2: float = 9.80665) -> ProcedurePath:
+               g_mps2: float = G0_MPS2) -> ProcedurePath:
     """Run the monitor on a built path; return it with findings, profile and status.
 
     Parameters

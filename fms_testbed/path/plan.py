@@ -21,9 +21,9 @@ from pathlib import Path
 
 from fms_testbed.config.procedure import ProcedureSpec, parse_procedure  # noqa: F401 (re-export)
 from fms_testbed.core.errors import ConfigError, UserError
+from fms_testbed.core.units import FT_M, NM_M
+from fms_testbed.legs.types import LEG_TYPES
 
-NM_M = 1852.0
-FT_M = 0.3048
 
 
 def load_db(spec_db: str, base: Path | None = None):
@@ -105,7 +105,7 @@ def merge_parts(parts: list):
     legs = list(parts[0].legs)
     for p in parts[1:]:
         nxt = list(p.legs)
-        if nxt and nxt[0].path_term == "IF" and legs and legs[-1].fix is not None \
+        if nxt and LEG_TYPES[nxt[0].path_term].initial and legs and legs[-1].fix is not None \
                 and nxt[0].fix is not None and nxt[0].fix.ident == legs[-1].fix.ident:
             nxt = nxt[1:]
         legs += nxt
@@ -113,7 +113,9 @@ def merge_parts(parts: list):
         cut = next((i for i, lg in enumerate(legs) if lg.missed_approach_start), len(legs))
         legs = legs[:cut]
     trans = "+".join(p.transition for p in parts if p.transition)
-    return replace(parts[-1], transition=trans, legs=tuple(legs))
+    return replace(parts[-1], transition=trans, legs=tuple(legs),
+                   defects=tuple(d for p in parts for d in p.defects),
+                   lines=tuple(ln for p in parts for ln in p.lines))
 
 
 PLAN_CLIMB_FRACTION = 0.75
@@ -132,13 +134,16 @@ class FlyablePath:
 
     path: the built and checked :class:`ProcedurePath` (profile attached); seq: the merged
     sequence it came from; leg_offset: index of its first leg in the whole procedure (non-zero
-    after an in-flight rebuild); rnp_m: RNP per leg, m.
+    after an in-flight rebuild); rnp_m: RNP per leg, m; degraded: what is in doubt in a
+    degraded procedure built with ``allow_degraded`` (one 'file:line: field: reason' per
+    defect of its records; empty for a sound procedure).
     """
 
     path: object
     seq: object
     leg_offset: int
     rnp_m: tuple[float, ...]
+    degraded: tuple[str, ...] = ()
 
 
 def _perf_params(cfg, spec: ProcedureSpec):
@@ -179,13 +184,20 @@ def build_procedure(db, spec: ProcedureSpec, cfg) -> FlyablePath:
 
     Raises
     ------
-    UserError when the procedure cannot be found or is impossible to build (with the monitor's
-    reason).
+    UserError when the procedure cannot be found, is impossible to build (with the monitor's
+    reason), or is degraded (a rejected, duplicated or misplaced record of its own; one line
+    naming the record: file, line, field, reason) and ``spec.allow_degraded`` is not set. With
+    it, the built path lists the defects in ``FlyablePath.degraded``.
     """
     from fms_testbed.path.segmentation import build_sequence
+    from fms_testbed.procedures.integrity import refusal
 
     seq = merge_parts(select_parts(db, spec.airport, spec.procedure, spec.transition,
                                    spec.runway))
+    if seq.degraded and not spec.allow_degraded:
+        raise UserError(refusal(seq.name, seq.defects))
+    if not seq.legs:
+        raise UserError(f"{seq.name}: no leg left to fly (every record rejected)")
     perf, params = _perf_params(cfg, spec)
     path = build_sequence(db, seq, perf, params)
     start_alt = spec.start_alt_ft * FT_M if spec.start_alt_ft is not None else None
@@ -209,7 +221,7 @@ def build_procedure(db, spec: ProcedureSpec, cfg) -> FlyablePath:
         why = "; ".join(f.message for f in fp.path.findings if f.category == "impossible")
         raise UserError(f"{seq.name}: the monitor finds the procedure impossible to fly: "
                         f"{why or 'no path segments'}")
-    return fp
+    return replace(fp, degraded=tuple(str(d) for d in seq.defects))
 
 
 def rebuild_from(db, whole: FlyablePath, spec: ProcedureSpec, cfg, next_leg: int,
@@ -233,4 +245,4 @@ def rebuild_from(db, whole: FlyablePath, spec: ProcedureSpec, cfg, next_leg: int
     if not path.segments or path.status == "impossible":
         return None
     fp = _finish(path, seq, spec, cfg, perf, params, next_leg)
-    return replace(fp, rnp_m=whole.rnp_m[next_leg:])
+    return replace(fp, rnp_m=whole.rnp_m[next_leg:], degraded=whole.degraded)

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from fms_testbed.core.units import FT_M
 from fms_testbed.legs.model import ProcedurePath
 
 
@@ -176,7 +177,7 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
         if climb_top_m is not None:
             level = max(top, climb_top_m)
         else:
-            level = top if np.isfinite(top) else (trans if trans else 18000 * 0.3048)
+            level = top if np.isfinite(top) else (trans if trans else 18000 * FT_M)
         cap[k] = min(run, level)
     for k in range(1, n + 1):
         if climb[k]:

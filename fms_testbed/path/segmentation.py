@@ -20,6 +20,7 @@ from dataclasses import replace
 
 from fms_testbed.core.geodesy import LocalFrame, direct, gravity_mps2, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line
+from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
 from fms_testbed.procedures.database import Database, Sequence
@@ -28,9 +29,6 @@ from fms_testbed.legs.types import LEG_TYPES, LegError
 from fms_testbed.legs.model import (BuildParams, BuiltLeg, Finding, FlightState, Performance, PathSegment,
                     ProcedurePath, isa_tas_mps, turn_radius_m)
 
-FT_M = 0.3048
-#: Leg types that end at their fix (the next TF starts from that fix).
-FIX_ENDING = frozenset({"IF", "TF", "CF", "DF", "RF", "AF", "HF", "HA", "HM"})
 
 
 def resolve_legs(db: Database, seq: Sequence) -> tuple[list[ResolvedLeg], list[Finding]]:
@@ -78,7 +76,7 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightS
     first = legs[0]
     if seq.proc_type == "D":
         rwy = _runway(db, seq.airport, seq.transition) if seq.transition.startswith("RW") else None
-        if rwy is not None and first.pt != "IF":
+        if rwy is not None and not LEG_TYPES[first.pt].initial:
             brg = wrap360((rwy.bearing_deg or 0.0) + (apt.magvar_deg if apt else 0.0))
             lat, lon, az = direct(rwy.lat_deg, rwy.lon_deg, brg, rwy.length_m or 0.0)
             alt = (rwy.elev_m if rwy.elev_m is not None else elev) + 35 * FT_M
@@ -145,7 +143,8 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         return replace(path, findings=path.findings + (Finding(-1, "impossible", str(exc)),))
     ref = legs[0].fix or db.airports.get(seq.airport)
     g = gravity_mps2(ref.lat_deg if ref else state.lat_deg)
-    prev_fixes = [None] + [lg.fix if lg.pt in FIX_ENDING else None for lg in legs[:-1]]
+    # a TF starts from the previous leg's fix when that leg ends at its fix
+    prev_fixes = [None] + [lg.fix if LEG_TYPES[lg.pt].ends_at_fix else None for lg in legs[:-1]]
     b = LegBuilder(legs, perf, params, g, prev_fixes)
     b.climbing = seq.proc_type == "D"
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
@@ -161,15 +160,17 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         # for the faster of the two
         b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0), bank, g)
         start_st = state
+        leg_cls = LEG_TYPES[leg.pt]
         try:
-            state, term = LEG_TYPES[leg.pt].build(b, state)
+            state, term = leg_cls.build(b, state)
         except LegError as exc:
             b.finding("impossible", f"leg {i + 1} {leg.pt}: {exc} (line {leg.rec.line})")
             break
         state = b.settle(state)
         if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
             state = replace(state, alt_m=_descent_target(leg))
-        built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps))
+        built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps,
+                              coded=leg_cls.coded_path(b, term)))
     segs = round_corners(b, perf, params, bank)
     built = _attach_segments(built, segs)
     status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
@@ -178,7 +179,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
 
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
-    if st.track_deg is not None and seq.proc_type == "D" and legs[0].pt != "IF" \
+    if st.track_deg is not None and seq.proc_type == "D" and not LEG_TYPES[legs[0].pt].initial \
             and seq.transition.startswith("RW") and _runway(db, seq.airport, seq.transition):
         return "runway"
     return "fix" if legs[0].fix is not None else "airport"
@@ -245,8 +246,8 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
             else:
                 v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax)))
                 if v_reg >= perf.tas_min_mps:
-                    b.finding("correction", f"fly-by at {fix}: speed {v / 0.514444:.0f} -> "
-                              f"{v_reg / 0.514444:.0f} kt, bank {gmax:.0f}°, radius "
+                    b.finding("correction", f"fly-by at {fix}: speed {v / KT_MPS:.0f} -> "
+                              f"{v_reg / KT_MPS:.0f} kt, bank {gmax:.0f}°, radius "
                               f"{r_geom:.0f} m (turn {omega:+.0f}°)", "V,γ")
                     r, bank, v = r_geom, gmax, v_reg
                 else:

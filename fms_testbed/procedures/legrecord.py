@@ -9,7 +9,9 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from fms_testbed.procedures.records import FT_M, KT_MPS, NM_M, RecordError, _int, parse_alt_ft
+from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.procedures.fields import (FieldError, check_record, in_range, parse_alt_ft,
+                                           read_code, read_ident, read_int)
 
 #: The 23 ARINC-424 path terminators.
 PATH_TERMINATORS = ("IF", "TF", "CF", "DF", "FA", "FC", "FD", "FM", "CA", "CD", "CI", "CR",
@@ -87,83 +89,157 @@ class LegRecord:
         return self.airport, self.proc_type, self.proc_id, self.route_type, self.transition
 
 
-def _ref(rec: str, a: int, ident_len: int, reg: int, sec: int) -> FixRef | None:
-    ident = rec[a - 1:a - 1 + ident_len].strip()
+#: Section codes a leg's fix (cols 37-38) or RF centre (cols 115-116) may refer to.
+FIX_SECTIONS = frozenset({"PC", "EA", "D ", "DB", "PN", "PG", "PA", "PI", "HC", "HA", "HG"})
+#: Section codes of a recommended navaid (cols 79-80).
+NAVAID_SECTIONS = frozenset({"D ", "DB", "PN", "PI"})
+#: Altitude descriptors (col 83) :func:`fms_testbed.path.profile.window` knows.
+ALT_DESCRIPTORS = frozenset(" +-@BCGHIJVXY")
+#: Waypoint description code (cols 40-43), allowed characters per position (ARINC-424 5.17).
+DESC_CODES = (frozenset(" ACEFGHNPRTUV"), frozenset(" BEUY"), frozenset(" ABCGMPRS"),
+              frozenset(" ABCDEFHIMNPS"))
+_ROUTE_TYPES = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789")
+
+
+def _ref(rec: str, a: int, ident_len: int, reg: int, sec: int, what: str,
+         sections: frozenset, section_optional: bool = False,
+         lone_region: bool = False) -> FixRef | None:
+    """A fix reference (ident at ``a``, region at ``reg``, section at ``sec``), checked: the
+    ident and region are letters and digits, the section one of ``sections`` (or blank when
+    ``section_optional``); a blank ident has a blank section, and a blank region unless
+    ``lone_region`` (the FAA CIFP 2301 leaves a region without its RF centre twice, a section
+    off a recommended navaid three times)."""
+    ident = read_ident(rec, a, a + ident_len - 1, f"{what} ident")
+    region = read_ident(rec, reg, reg + 1, f"{what} region")
+    section = rec[sec - 1:sec + 1]
     if not ident:
+        if section.strip() or (region and not lone_region):
+            raise FieldError(a, f"{what} ident", f"blank, but its region/section "
+                                                 f"{region!r}/{section!r} are coded", sec + 1)
         return None
-    return FixRef(ident, rec[reg - 1:reg + 1].strip(), rec[sec - 1:sec + 1].upper())
+    if section.strip() or not section_optional:
+        read_code(rec, sec, sec + 1, f"{what} section", sections)
+    return FixRef(ident, region, section)
+
+
+def _course(rec: str) -> tuple[float | None, bool]:
+    """Course (cols 71-74), deg, and whether it is true ('DDDT') rather than magnetic."""
+    raw = rec[70:74]
+    if not raw.strip():
+        return None, False
+    if raw[3] == "T":
+        if not raw[:3].isascii() or not raw[:3].isdigit():
+            raise FieldError(71, "course", f"{raw!r} is not DDDT (true) in ASCII digits", 74)
+        return float(in_range(int(raw[:3]), "true course", 71, 74, raw, "course")), True
+    if not raw.isascii() or not raw.isdigit():
+        raise FieldError(71, "course", f"{raw!r} is not tenths of a degree in 4 ASCII digits",
+                         74)
+    return in_range(int(raw), "course", 71, 74, raw) / 10.0, False
+
+
+def _distance_time(rec: str) -> tuple[float | None, float | None]:
+    """Distance (cols 75-78, tenths of a NM) in m, or time ('T' + tenths of a minute) in s."""
+    raw = rec[74:78]
+    if not raw.strip():
+        return None, None
+    if raw[0] == "T":
+        if not raw[1:].isascii() or not raw[1:].isdigit():
+            raise FieldError(75, "time", f"{raw!r} is not T + tenths of a minute in 3 ASCII "
+                                         "digits", 78)
+        return None, in_range(int(raw[1:]), "time", 75, 78, raw) * 6.0
+    if not raw.isascii() or not raw.isdigit():
+        raise FieldError(75, "distance", f"{raw!r} is not tenths of a NM in 4 ASCII digits", 78)
+    return in_range(int(raw), "distance", 75, 78, raw) / 10.0 * NM_M, None
+
+
+def _rnp(rec: str) -> float | None:
+    """RNP (cols 45-47): two digits of mantissa and one of negative exponent, NM (> 0)."""
+    raw = rec[44:47]
+    if not raw.strip():
+        return None
+    if not raw.isascii() or not raw.isdigit():
+        raise FieldError(45, "RNP", f"{raw!r} is not 3 ASCII digits", 47)
+    if int(raw[:2]) == 0:
+        raise FieldError(45, "RNP", f"{raw!r} codes an RNP of 0 NM", 47)
+    return int(raw[:2]) * 10.0 ** (-int(raw[2]))
+
+
+def is_procedure_record(rec: str) -> bool:
+    """Section/subsection (cols 5-6, 13) say SID, STAR or approach (airport or heliport)."""
+    return rec[4:6] in ("P ", "H ") and rec[12:13] in ("D", "E", "F")
+
+
+def read_key(rec: str) -> tuple[str, str, str, str, str]:
+    """The transition a procedure record belongs to, checked: (airport, type 'D'/'E'/'F',
+    procedure ident, route type, transition ident), as :attr:`LegRecord.key`.
+
+    Raises
+    ------
+    FieldError
+        when one of the key's fields (cols 5-25) is malformed.
+    """
+    if len(rec) < 29:
+        raise FieldError(len(rec) + 1, "record length",
+                         f"record has {len(rec)} columns, too few for its key (cols 5-29)")
+    read_code(rec, 5, 6, "section", {"P ", "H "})
+    sub = read_code(rec, 13, 13, "subsection", {"D", "E", "F"})
+    return (read_ident(rec, 7, 10, "airport ident", required=True), sub,
+            read_ident(rec, 14, 19, "procedure ident", procedure=True, required=True),
+            read_code(rec, 20, 20, "route type", _ROUTE_TYPES),
+            read_ident(rec, 21, 25, "transition ident"))
 
 
 def parse_leg(rec: str, line: int) -> LegRecord:
     """Parse one primary procedure record (132 columns) into a :class:`LegRecord`.
 
+    Every field the testbed reads is checked for its format and range (:mod:`.fields`):
+    the key (cols 5-29), fix, description code, turn direction, RNP, path terminator, navaid,
+    arc radius, theta, rho, course, distance/time, altitude descriptor and altitudes,
+    transition altitude, speed limit and its descriptor, vertical angle, RF centre.
+
     Raises
     ------
-    RecordError
-        naming the 1-based column and the reason when a field is malformed.
+    FieldError
+        naming the 1-based columns, the field and the reason when a field is malformed.
     """
-    if len(rec) < 120:
-        raise RecordError(len(rec) + 1, f"record has {len(rec)} columns, expected 132")
-    pt = rec[47:49]
-    if pt not in _PT_SET:
-        raise RecordError(48, f"unknown path terminator {pt!r}")
-    seq = _int(rec, 27, 29, "sequence number")
+    check_record(rec)
+    airport, sub, proc_id, route_type, transition = read_key(rec)
+    read_code(rec, 39, 39, "continuation number", {"0", "1"})
+    read_ident(rec, 11, 12, "ICAO region")
+    seq = read_int(rec, 27, 29, "sequence number")
     if seq is None:
-        raise RecordError(27, "missing sequence number")
-    crs_s = rec[70:74]
-    course, course_true = None, False
-    if crs_s.strip():
-        if crs_s[3] == "T":
-            course_true = True
-            crs_s = crs_s[:3] + "0"
-            digits = crs_s[:3]
-            if not digits.strip().isdigit():
-                raise RecordError(71, f"course {rec[70:74]!r} is not tenths of a degree")
-            course = float(int(digits))
-        else:
-            if not crs_s.strip().isdigit():
-                raise RecordError(71, f"course {crs_s!r} is not tenths of a degree")
-            course = int(crs_s) / 10.0
-        if course > 360.0:
-            raise RecordError(71, f"course {course} deg above 360")
-    dist_s = rec[74:78]
-    distance_m = time_s = None
-    if dist_s.strip():
-        if dist_s[0] == "T":
-            if not dist_s[1:].strip().isdigit():
-                raise RecordError(75, f"time {dist_s!r} is not T + tenths of a minute")
-            time_s = int(dist_s[1:]) * 6.0
-        else:
-            if not dist_s.strip().isdigit():
-                raise RecordError(75, f"distance {dist_s!r} is not tenths of a NM")
-            distance_m = int(dist_s) / 10.0 * NM_M
-    arc_r = _int(rec, 57, 62, "arc radius")
-    theta = _int(rec, 63, 66, "theta")
-    rho = _int(rec, 67, 70, "rho")
-    spd = _int(rec, 100, 102, "speed limit")
-    vpa = _int(rec, 103, 106, "vertical angle", signed=True)
-    rnp_s = rec[44:47].strip()
-    rnp = None
-    if rnp_s:
-        if not rnp_s.isdigit() or len(rnp_s) != 3:
-            raise RecordError(45, f"RNP {rnp_s!r} is not 3 digits")
-        rnp = int(rnp_s[:2]) * 10.0 ** (-int(rnp_s[2]))
-    turn = rec[43]
-    if turn not in "LRE ":
-        raise RecordError(44, f"turn direction {turn!r} is not L, R or E")
-    sub = rec[12]
+        raise FieldError(27, "sequence number", "is blank", 29)
+    pt = read_code(rec, 48, 49, "path terminator", _PT_SET)
+    desc = rec[39:43]
+    for k, allowed in enumerate(DESC_CODES):
+        read_code(rec, 40 + k, 40 + k, f"waypoint description {k + 1}", allowed)
+    turn = read_code(rec, 44, 44, "turn direction", {"L", "R", "E", " "})
+    tdv = read_code(rec, 50, 50, "turn direction valid", {"Y", " "})
+    course, course_true = _course(rec)
+    distance_m, time_s = _distance_time(rec)
+    arc_r = read_int(rec, 57, 62, "arc radius")
+    theta = read_int(rec, 63, 66, "theta")
+    rho = read_int(rec, 67, 70, "rho")
+    alt_desc = read_code(rec, 83, 83, "altitude descriptor", ALT_DESCRIPTORS)
+    alt1, alt2 = parse_alt_ft(rec, 85, "altitude 1"), parse_alt_ft(rec, 90, "altitude 2")
+    trans_alt = read_int(rec, 95, 99, "transition altitude")
+    spd = read_int(rec, 100, 102, "speed limit")
+    vpa = read_int(rec, 103, 106, "vertical angle", signed=True)
+    speed_desc = read_code(rec, 118, 118, "speed limit descriptor", {" ", "+", "-"})
     return LegRecord(
-        airport=rec[6:10].strip(), proc_type=sub, proc_id=rec[13:19].strip(),
-        route_type=rec[19], transition=rec[20:25].strip(), seq=seq,
-        fix=_ref(rec, 30, 5, 35, 37), desc=rec[39:43], turn_dir=turn.strip(),
-        rnp_nm=rnp, path_term=pt, turn_dir_valid=rec[49] == "Y",
-        navaid=_ref(rec, 51, 4, 55, 79),
+        airport=airport, proc_type=sub, proc_id=proc_id, route_type=route_type,
+        transition=transition, seq=seq,
+        fix=_ref(rec, 30, 5, 35, 37, "fix", FIX_SECTIONS), desc=desc, turn_dir=turn.strip(),
+        rnp_nm=_rnp(rec), path_term=pt, turn_dir_valid=tdv == "Y",
+        navaid=_ref(rec, 51, 4, 55, 79, "navaid", NAVAID_SECTIONS, section_optional=True),
         arc_radius_m=None if arc_r is None else arc_r / 1000.0 * NM_M,
         theta_deg=None if theta is None else theta / 10.0,
         rho_m=None if rho is None else rho / 10.0 * NM_M,
         course_deg=course, course_true=course_true, distance_m=distance_m, time_s=time_s,
-        alt_desc=rec[82].strip(), alt1_m=parse_alt_ft(rec, 85), alt2_m=parse_alt_ft(rec, 90),
-        trans_alt_m=None if (t := _int(rec, 95, 99, "transition altitude")) is None else t * FT_M,
-        speed_limit_mps=None if spd is None else spd * KT_MPS, speed_desc=rec[117].strip(),
+        alt_desc=alt_desc.strip(), alt1_m=alt1, alt2_m=alt2,
+        trans_alt_m=None if trans_alt is None else trans_alt * FT_M,
+        speed_limit_mps=None if spd is None else spd * KT_MPS, speed_desc=speed_desc.strip(),
         vpa_deg=None if vpa is None else vpa / 100.0,
-        centre=_ref(rec, 107, 5, 113, 115), heliport=rec[4] == "H", line=line)
+        centre=_ref(rec, 107, 5, 113, 115, "centre fix", FIX_SECTIONS, lone_region=True),
+        heliport=rec[4] == "H",
+        line=line)

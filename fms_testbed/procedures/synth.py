@@ -11,6 +11,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fms_testbed.core.geodesy import direct
+from fms_testbed.core.units import NM_M
 
 
 def _put(buf: list[str], col: int, text: str) -> None:
@@ -182,7 +183,7 @@ def leg_record(airport: str, proc: str, pt: str, seq: int, *, proc_type: str = "
 
 def offset(lat: float, lon: float, az_deg: float, dist_nm: float) -> tuple[float, float]:
     """Point ``dist_nm`` NM from (lat, lon) on azimuth ``az_deg``, deg."""
-    la, lo, _ = direct(lat, lon, az_deg, dist_nm * 1852.0)
+    la, lo, _ = direct(lat, lon, az_deg, dist_nm * NM_M)
     return la, lo
 
 

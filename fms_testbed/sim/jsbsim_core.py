@@ -26,16 +26,11 @@ from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.core.errors import TrimError, UserError
 from fms_testbed.sim.inner_loops import gain_properties, system_xml
 from fms_testbed.core.state import AircraftState
+from fms_testbed.core.units import DEG_RAD, FT_M, KT_MPS, LBF_N, SLUG_KG, mps_to_kmh
 
 log = logging.getLogger("fms_testbed.jsbsim")
 
-FT = 0.3048
-KT = 1852.0 / 3600.0
-LBF = 4.4482216152605
-SLUG = 14.593902937
-G0 = 9.80665
 DT_S = 1.0 / 120.0
-_RAD = math.pi / 180.0
 
 # ----------------------------------------------------------------------------------- logging
 
@@ -180,15 +175,15 @@ _READ = {  # state field -> (property, scale)
     "t_s": ("simulation/sim-time-sec", 1.0),
     "lat_deg": ("position/lat-geod-deg", 1.0),
     "lon_deg": ("position/long-gc-deg", 1.0),
-    "alt_m": ("position/h-sl-ft", FT),
-    "agl_m": ("position/h-agl-ft", FT),
-    "tas_mps": ("velocities/vt-fps", FT),
-    "cas_mps": ("velocities/vc-kts", KT),
-    "gs_mps": ("velocities/vg-fps", FT),
-    "vs_mps": ("velocities/h-dot-fps", FT),
-    "vn": ("velocities/v-north-fps", FT),
-    "ve": ("velocities/v-east-fps", FT),
-    "vd": ("velocities/v-down-fps", FT),
+    "alt_m": ("position/h-sl-ft", FT_M),
+    "agl_m": ("position/h-agl-ft", FT_M),
+    "tas_mps": ("velocities/vt-fps", FT_M),
+    "cas_mps": ("velocities/vc-kts", KT_MPS),
+    "gs_mps": ("velocities/vg-fps", FT_M),
+    "vs_mps": ("velocities/h-dot-fps", FT_M),
+    "vn": ("velocities/v-north-fps", FT_M),
+    "ve": ("velocities/v-east-fps", FT_M),
+    "vd": ("velocities/v-down-fps", FT_M),
     "roll_rad": ("attitude/phi-rad", 1.0),
     "pitch_rad": ("attitude/theta-rad", 1.0),
     "heading_rad": ("attitude/psi-rad", 1.0),
@@ -200,12 +195,12 @@ _READ = {  # state field -> (property, scale)
     "q_rps": ("velocities/q-rad_sec", 1.0),
     "r_rps": ("velocities/r-rad_sec", 1.0),
     "weight_lbs": ("inertia/weight-lbs", 1.0),
-    "fx": ("forces/fbx-total-lbs", LBF),
-    "fy": ("forces/fby-total-lbs", LBF),
-    "fz": ("forces/fbz-total-lbs", LBF),
+    "fx": ("forces/fbx-total-lbs", LBF_N),
+    "fy": ("forces/fby-total-lbs", LBF_N),
+    "fz": ("forces/fbz-total-lbs", LBF_N),
     "mach": ("velocities/mach", 1.0),
     "throttle": ("fms/throttle-out", 1.0),
-    "mass_kg": ("inertia/mass-slugs", SLUG),
+    "mass_kg": ("inertia/mass-slugs", SLUG_KG),
     "elevator": ("fcs/elevator-cmd-norm", 1.0),
     "aileron": ("fcs/aileron-cmd-norm", 1.0),
     "rudder": ("fcs/rudder-cmd-norm", 1.0),
@@ -330,12 +325,12 @@ class JSBSimAircraft:
 
     def _trim_once(self, alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg):
         fdm, c = self.fdm, self.cfg
-        cond = (f"{c.name} ({c.jsbsim_model}) at {alt_m:.0f} m / {tas_mps * 3.6:.0f} km/h TAS, "
+        cond = (f"{c.name} ({c.jsbsim_model}) at {alt_m:.0f} m / {mps_to_kmh(tas_mps):.0f} km/h TAS, "
                 f"gamma {gamma_deg:.1f} deg")
         fdm["ic/lat-geod-deg"] = lat_deg
         fdm["ic/long-gc-deg"] = lon_deg
-        fdm["ic/h-sl-ft"] = alt_m / FT
-        fdm["ic/vt-kts"] = tas_mps / KT
+        fdm["ic/h-sl-ft"] = alt_m / FT_M
+        fdm["ic/vt-kts"] = tas_mps / KT_MPS
         fdm["ic/psi-true-deg"] = heading_deg
         fdm["ic/gamma-deg"] = gamma_deg
         fdm["ic/phi-deg"] = 0.0
@@ -371,7 +366,7 @@ class JSBSimAircraft:
         if not math.isfinite(alpha) or alpha > c.trim.alpha_max_deg + 0.5:
             raise TrimError(f"trim failed for {cond}: alpha {alpha:.1f} deg beyond bound")
         thr = fdm["fcs/throttle-cmd-norm[0]"]
-        res = TrimResult(alt_m=alt_m, tas_mps=fdm["velocities/vt-fps"] * FT, alpha_deg=alpha,
+        res = TrimResult(alt_m=alt_m, tas_mps=fdm["velocities/vt-fps"] * FT_M, alpha_deg=alpha,
                          pitch_deg=math.degrees(fdm["attitude/theta-rad"]), throttle=thr,
                          elevator=fdm["fcs/elevator-cmd-norm"], aileron=fdm["fcs/aileron-cmd-norm"],
                          rudder=fdm["fcs/rudder-cmd-norm"])
@@ -443,13 +438,13 @@ class JSBSimAircraft:
         (t, lat, lon, h, agl, vt, vc, vg, hdot, vn, ve, vd, phi, theta, psi, trk, alpha, beta,
          gamma, p, q, r, w_lbs, fx, fy, fz, mach, thr, m_slug, *_rest) = (
             raw if raw is not None else self.read_raw())
-        rad = _RAD
-        k = LBF / (m_slug * SLUG)
+        rad = DEG_RAD
+        k = LBF_N / (m_slug * SLUG_KG)
         # from this frame's forces (the inner loops' own measurement runs at the loop rate)
         nx, ny = wind_axis_load_factors(fx, fz, alpha, w_lbs)
         # positional, in AircraftState's field order (cheaper than keywords on the hot path)
         return AircraftState(
-            t, lat * rad, lon * rad, h * FT, vt * FT, vc * KT, vg * FT, hdot * FT,
-            np.array((ve * FT, vn * FT, -vd * FT)), phi, theta, psi, trk, alpha, beta, gamma,
-            p, q, r, nx, ny, np.array((fx * k, fy * k, fz * k)), mach, agl * FT, thr,
-            m_slug * SLUG)
+            t, lat * rad, lon * rad, h * FT_M, vt * FT_M, vc * KT_MPS, vg * FT_M, hdot * FT_M,
+            np.array((ve * FT_M, vn * FT_M, -vd * FT_M)), phi, theta, psi, trk, alpha, beta, gamma,
+            p, q, r, nx, ny, np.array((fx * k, fy * k, fz * k)), mach, agl * FT_M, thr,
+            m_slug * SLUG_KG)

@@ -1,17 +1,25 @@
 """Plots of the coupled-law work: comparison runs, the paper's Fig. 2 layout, linear analysis.
 
-Plotting only: every function takes computed data (DataFrames, arrays) and writes one PNG.
+Plotting only: every function takes computed data (DataFrames, arrays) and returns a matplotlib
+Figure; the caller saves it (:func:`fms_testbed.viz.figure.save`).
+
+Units: these are engineering plots of the control law, drawn as the paper (Danilin) draws them —
+SI with speeds in km/h: speed and speed errors km/h, altitude and altitude errors m, flight-path
+angle deg, load factors g, time s. (Plots of a flight — ground tracks, profiles, time histories —
+use the aviation units NM, ft, kt instead: :mod:`fms_testbed.viz.run`.)
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from fms_testbed.viz.figure import subplots
 import numpy as np
 import pandas as pd
+from matplotlib.figure import Figure
 
-KMH = 3.6
+from fms_testbed.core.units import KMH_MPS
+from fms_testbed.viz.figure import subplots
+
+KMH = 1.0 / KMH_MPS
+"""m/s → km/h."""
 _LAW_STYLE = {"coupled": dict(color="C0", lw=1.8), "pi": dict(color="C3", lw=1.2),
               "tecs": dict(color="C2", lw=1.2), "ideal": dict(color="k", lw=1.0, ls="--")}
 _LAW_LABEL = {"coupled": "coupled law (JSBSim)", "pi": "baseline (a): PI autothrottle (JSBSim)",
@@ -35,14 +43,14 @@ def _events(ax, df: pd.DataFrame) -> None:
             ax.axvline(df["t_s"].iloc[i + 1], color="0.6", lw=0.7, ls=":")
 
 
-def plot_comparison(runs: dict[str, pd.DataFrame], title: str, path: Path) -> Path:
-    """Speed error, altitude error, throttle and n_y of several laws on one scenario.
+def plot_comparison(runs: dict[str, pd.DataFrame], title: str) -> Figure:
+    """Speed error (km/h), altitude error (m), throttle and n_y (g) of several laws on one
+    scenario.
 
     Parameters
     ----------
     runs : law name → timeseries (runner columns); ``"ideal"`` is drawn dashed
-    title : figure title (the scenario)
-    path : output PNG
+    title : figure title (the scenario and its headline figures)
     """
     fig, axes = subplots(4, 1, figsize=(10, 10), sharex=True)
     for name, df in runs.items():
@@ -67,18 +75,17 @@ def plot_comparison(runs: dict[str, pd.DataFrame], title: str, path: Path) -> Pa
     axes[0].legend(loc="best", fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    return path
+    return fig
 
 
-def plot_paper_fig2(runs: dict[str, pd.DataFrame], title: str, path: Path) -> Path:
-    """The paper's Fig. 2 layout: V, H, θ, n_xa, n_ya stacked against time.
+def plot_paper_fig2(runs: dict[str, pd.DataFrame], title: str) -> Figure:
+    """The paper's Fig. 2 layout: V (km/h), H (m), θ (deg), n_xa, n_ya (g) stacked against time.
 
     Parameters
     ----------
     runs : law name → timeseries; the coupled law on JSBSim and its ideal point-mass response
         are expected, baselines optional
-    title : figure title;  path : output PNG
+    title : figure title
     """
     fig, axes = subplots(5, 1, figsize=(9, 12), sharex=True)
     for name, df in runs.items():
@@ -101,12 +108,11 @@ def plot_paper_fig2(runs: dict[str, pd.DataFrame], title: str, path: Path) -> Pa
     axes[0].legend(loc="lower right", fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    return path
+    return fig
 
 
-def plot_bode_coupling(omega_rps: np.ndarray, cases: dict[str, np.ndarray], path: Path,
-                       title: str) -> Path:
+def plot_bode_coupling(omega_rps: np.ndarray, cases: dict[str, np.ndarray],
+                       title: str) -> Figure:
     """Magnitudes of W(jω): diagonal and V/H cross terms for several lag cases.
 
     Parameters
@@ -114,11 +120,11 @@ def plot_bode_coupling(omega_rps: np.ndarray, cases: dict[str, np.ndarray], path
     omega_rps : frequencies, rad/s
     cases : label → complex W(jω) of shape (4, 2, len(ω)) (outputs V, H, θ, n_xa; inputs
         V_cmd, H_cmd)
-    path : output PNG;  title : figure title
+    title : figure title
     """
     fig, axes = subplots(2, 2, figsize=(11, 7), sharex=True)
-    panels = [((0, 0), "V / V_cmd, dB", 0, 0, 1.0), ((0, 1), "V / H_cmd, dB re (km/h)/m", 0, 1, 3.6),
-              ((1, 0), "H / V_cmd, dB re m/(km/h)", 1, 0, 1 / 3.6), ((1, 1), "H / H_cmd, dB", 1, 1, 1.0)]
+    panels = [((0, 0), "V / V_cmd, dB", 0, 0, 1.0), ((0, 1), "V / H_cmd, dB re (km/h)/m", 0, 1, KMH),
+              ((1, 0), "H / V_cmd, dB re m/(km/h)", 1, 0, 1 / KMH), ((1, 1), "H / H_cmd, dB", 1, 1, 1.0)]
     floor = 1e-16
     notes: dict[tuple, list[str]] = {}
     for label, W in cases.items():
@@ -140,12 +146,11 @@ def plot_bode_coupling(omega_rps: np.ndarray, cases: dict[str, np.ndarray], path
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    return path
+    return fig
 
 
 def plot_linear_steps(t_s: np.ndarray, cases: dict[str, tuple[np.ndarray, np.ndarray]],
-                      dV_mps: float, dH_m: float, path: Path, title: str) -> Path:
+                      dV_mps: float, dH_m: float, title: str) -> Figure:
     """Linear step responses: V and H for a speed step and for an altitude step, per lag case.
 
     Parameters
@@ -153,7 +158,7 @@ def plot_linear_steps(t_s: np.ndarray, cases: dict[str, tuple[np.ndarray, np.nda
     t_s : times, s
     cases : label → (speed-step outputs, altitude-step outputs), each (4, len(t)) as returned by
         :func:`fms_testbed.control.linear.step_responses`
-    dV_mps, dH_m : the step sizes, m/s and m;  path : output PNG;  title : figure title
+    dV_mps, dH_m : the step sizes, m/s and m;  title : figure title
     """
     fig, axes = subplots(2, 2, figsize=(11, 7), sharex=True)
     for label, (sv, sh) in cases.items():
@@ -178,19 +183,18 @@ def plot_linear_steps(t_s: np.ndarray, cases: dict[str, tuple[np.ndarray, np.nda
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    return path
+    return fig
 
 
-def plot_tuning_overlay(jsb: dict[str, pd.DataFrame], lin: dict[str, pd.DataFrame], path: Path,
-                        title: str) -> Path:
+def plot_tuning_overlay(jsb: dict[str, pd.DataFrame], lin: dict[str, pd.DataFrame],
+                        title: str) -> Figure:
     """JSBSim responses of the tuned law with the linear prediction overlaid.
 
     Parameters
     ----------
     jsb, lin : ``"alt"`` / ``"speed"`` → DataFrame with t_s, alt_m, tas_mps, cmd_alt_m,
         cmd_tas_mps (the linear one as deviations added to the same trim)
-    path : output PNG;  title : figure title
+    title : figure title
     """
     fig, axes = subplots(2, 2, figsize=(11, 7), sharex=True)
     for c, key in enumerate(("alt", "speed")):
@@ -208,5 +212,4 @@ def plot_tuning_overlay(jsb: dict[str, pd.DataFrame], lin: dict[str, pd.DataFram
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=90)
-    return path
+    return fig

@@ -1,19 +1,23 @@
 """Plot a built procedure transition like Danilin (2017), Fig. 2: legs labelled with their path
-terminator codes, arcs visible with their centres, fixes marked. Plotting never computes the
-path; it only draws the segments it is given, in an azimuthal-equidistant plane (NM) about the
-first fix."""
+terminator codes, arcs visible with their centres, fixes marked, and the planned altitude with
+the coded constraints below. Plotting never computes the path; it only draws the segments it is
+given, in an azimuthal-equidistant plane about the first fix.
+
+Units (the aviation edge, as every flight plot of :mod:`fms_testbed.viz`): horizontal distances
+in NM, altitudes in ft.
+"""
 
 from __future__ import annotations
 
-from pathlib import Path
-
-from fms_testbed.viz.figure import subplots
+from matplotlib.figure import Figure
 
 from fms_testbed.core.geodesy import LocalFrame
 from fms_testbed.core.segments import Arc
+from fms_testbed.core.units import FT_M, NM_M
 from fms_testbed.legs.model import ProcedurePath
+from fms_testbed.legs.types import LEG_TYPES
+from fms_testbed.viz.figure import subplots
 
-NM_M = 1852.0
 _STYLE = {"leg": ("tab:blue", "-"), "turn": ("tab:orange", "-"), "flyby": ("tab:red", "-"),
           "hold": ("tab:purple", "-"), "connector": ("grey", ":")}
 
@@ -23,8 +27,18 @@ def _xy(fr: LocalFrame, lat: float, lon: float) -> tuple[float, float]:
     return x / NM_M, y / NM_M
 
 
-def plot_path(path: ProcedurePath, out_file: str | Path) -> Path:
-    """Draw the path to a PNG; return its path."""
+def plot_path(path: ProcedurePath) -> Figure:
+    """Draw a built path: ground track (NM) with the legs labelled, and, when the path has a
+    planned profile, the planned altitude (ft) with the coded constraints.
+
+    Parameters
+    ----------
+    path : the built (and monitored) procedure path
+
+    Returns
+    -------
+    matplotlib Figure (save it with :func:`fms_testbed.viz.figure.save`)
+    """
     if not path.segments:
         raise ValueError(f"{path.name}: nothing to plot (no segments)")
     lat0, lon0 = path.segments[0].geom.start
@@ -83,25 +97,24 @@ def plot_path(path: ProcedurePath, out_file: str | Path) -> Path:
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(True, alpha=0.3)
     first = path.legs[0].record.fix if path.legs else None
-    origin = first.ident if first is not None and path.legs[0].path_term == "IF" else "start"
-    ax.set_xlabel(f"east of {origin} [NM]")
-    ax.set_ylabel("north [NM]")
-    ax.set_title(f"{path.name} — {path.status}\n"
+    origin = first.ident if first is not None and LEG_TYPES[path.legs[0].path_term].initial \
+        else "start"
+    ax.set_xlabel(f"east of {origin}, NM")
+    ax.set_ylabel(f"north of {origin}, NM")
+    ax.set_title(f"{path.name} — monitor {path.status}, {path.length_m() / NM_M:.1f} NM, "
+                 f"{len(path.legs)} legs\n"
                  + " ".join(f"{lg.path_term}" for lg in path.legs), fontsize=10)
     ax.legend(loc="best", fontsize=8)
     if axv is not None:
         _profile_panel(axv, path)
-    out = Path(out_file)
-    out.parent.mkdir(parents=True, exist_ok=True)
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
-    return out
+    return fig
 
 
 def _profile_panel(ax, path: ProcedurePath) -> None:
     """Planned altitude along the path with the coded altitude windows."""
     prof = path.profile
-    ax.plot(prof.along_m / NM_M, prof.alt_m / 0.3048, "-", color="tab:blue",
+    ax.plot(prof.along_m / NM_M, prof.alt_m / FT_M, "-", color="tab:blue",
             label="planned altitude")
     for name, sel, marker in (("at or above", lambda w: w.lo_m is not None and w.hi_m is None,
                                "^"),
@@ -113,13 +126,13 @@ def _profile_panel(ax, path: ProcedurePath) -> None:
         if not ws:
             continue
         xs = [w.along_m / NM_M for w in ws]
-        ys = [(w.lo_m if w.lo_m is not None else w.hi_m) / 0.3048 for w in ws]
+        ys = [(w.lo_m if w.lo_m is not None else w.hi_m) / FT_M for w in ws]
         ax.plot(xs, ys, marker, color="k", mfc="none", ls="none", label=name)
         for w, x, y in zip(ws, xs, ys):
             if w.fix_ident:
                 ax.annotate(w.fix_ident, (x, y), fontsize=7, xytext=(3, 3),
                             textcoords="offset points")
-    ax.set_xlabel("distance along the path [NM]")
-    ax.set_ylabel("altitude [ft]")
+    ax.set_xlabel("distance along the path, NM")
+    ax.set_ylabel("altitude, ft")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)

@@ -1,23 +1,23 @@
 """Plots of a procedure flight: ground track over the designed path with the legs labelled, the
 vertical profile with the altitude constraints drawn, and the flight errors along the path.
 
-Plotting only: every number comes from the timeseries, the summary or the built path.
-Horizontal positions are shown in km east/north of the procedure start (local equirectangular
-plane, exact enough for a drawing), distances along the path in NM, altitudes in ft.
+Plotting only: every number comes from the timeseries, the summary or the built path; each
+function returns a matplotlib Figure.
+
+Units (the aviation edge, as every flight plot: see :mod:`fms_testbed.viz.run`): horizontal
+positions in NM east/north of the procedure start (azimuthal-equidistant plane), distances
+along the path in NM, altitudes in ft, CAS in kt; path errors (FTE/TSE/NSE/PDE) in m.
 """
 
 from __future__ import annotations
 
-
 import matplotlib
-
-from fms_testbed.viz.figure import subplots
 import numpy as np
+from matplotlib.figure import Figure
 
-from fms_testbed.viz.run import local_en_km
-
-FT_M = 0.3048
-NM_M = 1852.0
+from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.viz.figure import subplots
+from fms_testbed.viz.run import local_en_nm
 
 
 def _sample(geom, step_m: float = 200.0):
@@ -26,30 +26,32 @@ def _sample(geom, step_m: float = 200.0):
     return [p[0] for p in pts], [p[1] for p in pts]
 
 
-def plot_ground_track(df, summary, fp, flown_paths=()):
-    """Ground track (true, and navigation when it differs) over the designed path; each leg is
-    labelled '<n> <code> <fix>' at its middle; constrained fixes marked."""
+def plot_ground_track(df, summary, fp, flown_paths=()) -> Figure:
+    """Ground track (true, and navigation when it differs) over the designed path, NM from the
+    start; each leg is labelled '<n> <code> <fix>' at its middle; fixes marked; FTE95 in the
+    title."""
     path = fp.path
     s0 = path.segments[0].geom.start
-    def xy_km(lat, lon):
-        return local_en_km(lat, lon, *s0)
+
+    def xy_nm(lat, lon):
+        return local_en_nm(np.asarray(lat, dtype=float), np.asarray(lon, dtype=float), *s0)
 
     fig, ax = subplots(figsize=(9, 8))
     colors = matplotlib.colormaps["tab10"].colors
     for k, seg in enumerate(path.segments):
         la, lo = _sample(seg.geom)
-        x, y = xy_km(la, lo)
+        x, y = xy_nm(la, lo)
         ax.plot(x, y, color=colors[seg.leg_index % 10], lw=3.0, alpha=0.45,
                 label="designed path (colour = leg)" if k == 0 else None)
     for j, extra in enumerate(flown_paths):
         for k, seg in enumerate(extra.path.segments):
             la, lo = _sample(seg.geom)
-            x, y = xy_km(la, lo)
+            x, y = xy_nm(la, lo)
             ax.plot(x, y, "k--", lw=0.8, label="path rebuilt in flight" if j == k == 0 else None)
-    x, y = xy_km(df["lat_deg"], df["lon_deg"])
+    x, y = xy_nm(df["lat_deg"], df["lon_deg"])
     ax.plot(x, y, color="crimson", lw=1.2, label="flown (truth)")
     if summary.get("procedure", {}).get("navigation", "truth") != "truth":
-        xn, yn = xy_km(df["nav_lat_deg"], df["nav_lon_deg"])
+        xn, yn = xy_nm(df["nav_lat_deg"], df["nav_lon_deg"])
         ax.plot(xn, yn, color="navy", lw=0.8, ls=":", label="navigation solution")
     for lg in path.legs:
         if not lg.seg_count:
@@ -57,29 +59,32 @@ def plot_ground_track(df, summary, fp, flown_paths=()):
         segs = path.segments[lg.seg_first:lg.seg_first + lg.seg_count]
         longest = max(segs, key=lambda s: s.geom.length_m())
         la, lo = longest.geom.point_at(0.5 * longest.geom.length_m())
-        xm, ym = xy_km(la, lo)
+        xm, ym = xy_nm(la, lo)
         fix = lg.termination.fix_ident or (lg.record.fix.ident if lg.record.fix else "")
         ax.annotate(f"{lg.index + 1} {lg.path_term} {fix}".strip(), (float(xm), float(ym)),
                     fontsize=8, xytext=(4, 4), textcoords="offset points",
                     bbox={"boxstyle": "round,pad=0.2", "fc": "white", "alpha": 0.7})
         t = lg.termination
         if t.kind == "fix" and t.lat_deg is not None:
-            xf, yf = xy_km(t.lat_deg, t.lon_deg)
+            xf, yf = xy_nm(t.lat_deg, t.lon_deg)
             ax.plot(float(xf), float(yf), "k^", ms=5)
     ax.plot(0, 0, "go", ms=8, label="start")
-    ax.set_xlabel("east of start, km")
-    ax.set_ylabel("north of start, km")
+    ax.plot([], [], "k^", ms=5, label="fix a leg ends at")
+    ax.set_xlabel("east of start, NM")
+    ax.set_ylabel("north of start, NM")
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(alpha=0.3)
-    e = summary.get("errors", {}).get("fte", {}).get("all", {})
+    err = summary.get("errors", {})
+    e = err.get("fte", {}).get("all", {})
+    tse = err.get("tse", {}).get("all", {}).get("p95_m")
     ax.set_title(f"{path.name}: ground track ({summary.get('aircraft', '')}, "
-                 f"FTE95 {e.get('p95_m')} m, max {e.get('max_m')} m)")
+                 f"FTE95 {e.get('p95_m')} m, max {e.get('max_m')} m; TSE95 {tse} m)")
     ax.legend(loc="best", fontsize=8)
     fig.tight_layout()
     return fig
 
 
-def plot_vertical(df, summary, fp):
+def plot_vertical(df, summary, fp) -> Figure:
     """Altitude and CAS along the path with the planned profile, the altitude command and the
     coded altitude constraints (▲ at or above, ▼ at or below, ◆ at, I between)."""
     prof = fp.path.profile
@@ -109,10 +114,12 @@ def plot_vertical(df, summary, fp):
     ax.plot([], [], "k^", label="constraint: ▲ at/above  ▼ at/below  ◆ at  | between")
     ax.set_ylabel("altitude, ft")
     ax.grid(alpha=0.3)
-    ok = summary.get("constraints_met")
-    ax.set_title(f"{fp.path.name}: vertical profile (constraints met: {ok})")
+    cons = summary.get("constraints", [])
+    missed = sum(c.get("ok") is False for c in cons)
+    ax.set_title(f"{fp.path.name}: vertical profile — {len(cons)} constraints checked, "
+                 f"{missed} missed")
     ax.legend(fontsize=8, loc="best")
-    ax2.plot(s_nm, df["cas_mps"] * 3600 / NM_M, color="crimson", lw=1.2, label="flown CAS")
+    ax2.plot(s_nm, df["cas_mps"] / KT_MPS, color="crimson", lw=1.2, label="flown CAS")
     for c in summary.get("constraints", []):
         if "cas_kt" in c:
             lim = float(str(c["speed_limit_kt"]).lstrip("+-@"))
@@ -130,7 +137,7 @@ def plot_vertical(df, summary, fp):
     return fig
 
 
-def plot_errors(df, summary, fp):
+def plot_errors(df, summary, fp) -> Figure:
     """FTE, TSE, NSE and PDE (m) along the path, leg boundaries labelled, RNP stated."""
     fig, ax = subplots(figsize=(10, 5))
     s_nm = df["along_m"].to_numpy() / NM_M

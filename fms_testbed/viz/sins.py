@@ -1,15 +1,18 @@
 """Plots of the SINS error analysis (σ envelopes, realisations, 95 % position error).
 
 Plotting never computes: it draws :class:`~.analysis.CovarianceResult` /
-:class:`~.analysis.MonteCarloResult` objects.
+:class:`~.analysis.MonteCarloResult` objects and returns matplotlib Figures (the caller saves
+them with :func:`fms_testbed.viz.figure.save`).
+
+Units: engineering plots of the navigation error, in SI — position errors m, attitude errors
+mrad, time min since the start.
 """
 
 from __future__ import annotations
 
-from pathlib import Path
+from matplotlib.figure import Figure
 
 from fms_testbed.viz.figure import subplots
-import numpy as np
 
 _ROWS = {
     "position": ((0, "east position error, m", 1.0), (1, "north position error, m", 1.0),
@@ -20,10 +23,14 @@ _ROWS = {
 }
 
 
-def plot_envelopes(cov, mc, out: Path, kind: str = "position", title: str = "") -> Path:
+def plot_envelopes(cov, mc, kind: str = "position", title: str = "") -> Figure:
     """Error components vs time: ±1σ/±3σ from covariance, Monte-Carlo realisations and ±3σ.
 
-    ``cov`` or ``mc`` may be None. Writes ``ins_<kind>.png`` in ``out`` and returns its path.
+    Parameters
+    ----------
+    cov, mc : covariance and Monte-Carlo results (either may be None)
+    kind : ``"position"`` (east/north/up errors, m) or ``"attitude"`` (tilts and heading, mrad)
+    title : figure title
     """
     rows = _ROWS[kind]
     fig, axes = subplots(len(rows), 1, figsize=(9, 8), sharex=True)
@@ -49,13 +56,12 @@ def plot_envelopes(cov, mc, out: Path, kind: str = "position", title: str = "") 
     axes[-1].set_xlabel("time since start, min")
     fig.suptitle(title)
     fig.tight_layout()
-    path = Path(out) / f"ins_{kind}.png"
-    fig.savefig(path, dpi=110)
-    return path
+    return fig
 
 
-def plot_p95(results: dict, out: Path, title: str = "") -> Path:
-    """95 % horizontal (radial) and vertical position error vs time for each named result."""
+def plot_p95(results: dict, title: str = "") -> Figure:
+    """95 % horizontal (radial) and vertical position error (m) vs time (min) for each named
+    result (label → covariance or Monte-Carlo result)."""
     fig, (ax1, ax2) = subplots(2, 1, figsize=(9, 6), sharex=True)
     styles = {"covariance": "k-", "Monte-Carlo": "r--"}
     for name, res in results.items():
@@ -71,9 +77,7 @@ def plot_p95(results: dict, out: Path, title: str = "") -> Path:
         ax.legend(loc="upper left", fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    path = Path(out) / "ins_p95.png"
-    fig.savefig(path, dpi=110)
-    return path
+    return fig
 
 
-__all__ = ["plot_envelopes", "plot_p95", "np"]
+__all__ = ["plot_envelopes", "plot_p95"]

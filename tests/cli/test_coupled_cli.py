@@ -135,7 +135,7 @@ def test_tune_quick_on_jsbsim_does_not_worsen_the_cost_and_writes_the_file(tmp_p
 
 def test_compare_rejects_a_malformed_wind(capsys):
     assert main(["compare", "--wind", "270"]) == 2
-    assert "FROM_DEG/SPEED_MPS" in capsys.readouterr().err
+    assert "FROM_DEG/SPEED_KT" in capsys.readouterr().err
 
 
 def test_compare_set_overrides_a_law_parameter_and_rejects_unknown_keys(tmp_path, capsys):

@@ -24,6 +24,8 @@ def test_fly_command_writes_summary_timeseries_and_plots(tmp_path, capsys):
     assert s["status"] == "ok" and s["procedure"]["type"] == "APPROACH"
     for name in ("procedure_track.png", "procedure_vertical.png", "procedure_errors.png"):
         assert (out / name).stat().st_size > 10_000
+    assert s["tracks"] == ["track.geojson", "track.kml"]              # for Google Earth / QGIS
+    assert "track.kml" in text
     import pandas as pd
     df = pd.read_parquet(out / "timeseries.parquet")
     assert {"xtk_m", "nav_xtk_m", "leg_index", "leg_code"} <= set(df.columns)
@@ -107,3 +109,31 @@ def test_every_shipped_procedure_scenario_validates_and_builds():
     for p in files:
         scn, spec, fp, db = load_procedure_scenario(p)
         assert fp.path.segments and scn.initial.tas_mps > 0, p
+
+
+@pytest.mark.parametrize("text, want", [
+    ("270/20", {"from_deg": 270.0, "speed_kt": 20.0}),
+    ("270/20kt", {"from_deg": 270.0, "speed_kt": 20.0}),
+    ("90/10mps", {"from_deg": 90.0, "speed_mps": 10.0}),
+    ("90/36kmh", {"from_deg": 90.0, "speed_mps": 10.0}),
+])
+def test_wind_unit_suffixes(text, want):
+    got = parse_wind(text)
+    assert got.keys() == want.keys()
+    assert all(got[k] == pytest.approx(v) for k, v in want.items())
+
+
+def test_every_command_taking_a_wind_parses_it_the_same_way():
+    """compare, run and fly: the same --wind help (FROM_DEG/SPEED_KT) and the same parser."""
+    import argparse
+
+    from fms_testbed.cli import build_parser
+    from fms_testbed.cli.common import WIND_HELP
+
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    with_wind = {name: p for name, p in sub.choices.items()
+                 if any("--wind" in a.option_strings for a in p._actions)}
+    assert {"run", "fly", "compare"} <= set(with_wind)
+    for name, p in with_wind.items():
+        act = next(a for a in p._actions if "--wind" in a.option_strings)
+        assert act.help == WIND_HELP, name

@@ -11,7 +11,8 @@ import pytest
 
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.data import scenarios_dir
-from fms_testbed.config.scenario import KMH, load_scenario
+from fms_testbed.config.scenario import load_scenario
+from fms_testbed.core.units import KMH_MPS, KT_MPS
 
 GOOD = """\
 aircraft: "737"
@@ -33,9 +34,9 @@ def _file(tmp_path, text):
 def test_good_scenario_converts_units_to_si(tmp_path):
     s = load_scenario(_file(tmp_path, GOOD))
     assert s.initial.altitude_m == pytest.approx(3048.0)
-    assert s.initial.speed == ("tas", pytest.approx(400 * KMH))
-    assert s.wind.speed_ms == pytest.approx(20 * 0.514444, rel=1e-5)
-    assert s.events[1].speed == ("cas", pytest.approx(250 * 0.514444, rel=1e-5))
+    assert s.initial.speed == ("tas", pytest.approx(400 * KMH_MPS))
+    assert s.wind.speed_ms == pytest.approx(20 * KT_MPS, rel=1e-12)
+    assert s.events[1].speed == ("cas", pytest.approx(250 * KT_MPS, rel=1e-12))
 
 
 @pytest.mark.parametrize("text, field, why", [

@@ -13,6 +13,8 @@ from hypothesis import strategies as st
 from fms_testbed.config.aircraft import load_aircraft
 from fms_testbed.control import VERTICAL_LAWS, CoupledLaw, CoupledLawParams
 from fms_testbed.control.coupled_law import gravity_ratio, params_from_config
+from fms_testbed.core.earth import OMEGA_IE_RPS
+from fms_testbed.core.units import G0_MPS2
 from fms_testbed.control.pointmass import (CommandEvent, PointMassParams, make_state,
                                            second_order_step, simulate)
 
@@ -147,11 +149,11 @@ def test_invalid_tuning_is_rejected_with_the_field_name():
 
 
 def test_gravity_ratio_includes_height_latitude_and_eotvos():
-    assert gravity_ratio(math.radians(45), 0.0) == pytest.approx(9.80620 / 9.80665, abs=2e-5)
+    assert gravity_ratio(math.radians(45), 0.0) == pytest.approx(9.80620 / G0_MPS2, abs=2e-5)
     assert gravity_ratio(0.0, 10000.0) < gravity_ratio(0.0, 0.0)
     east = gravity_ratio(math.radians(47), 3000.0, 111.0, 0.0)
     west = gravity_ratio(math.radians(47), 3000.0, -111.0, 0.0)
-    assert (west - east) * 9.80665 == pytest.approx(4 * 7.292115e-5 * 111 * math.cos(
+    assert (west - east) * G0_MPS2 == pytest.approx(4 * OMEGA_IE_RPS * 111 * math.cos(
         math.radians(47)), rel=1e-6)
 
 

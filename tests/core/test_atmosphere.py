@@ -3,6 +3,7 @@
 import pytest
 
 from fms_testbed.core.atmosphere import cas_to_tas, isa, tas_to_cas
+from fms_testbed.core.units import mps_to_kt
 
 
 def test_isa_table_values():
@@ -15,5 +16,5 @@ def test_isa_table_values():
 def test_cas_equals_tas_at_sea_level_and_roundtrips():
     assert cas_to_tas(100.0, 0.0) == pytest.approx(100.0, rel=1e-9)
     tas = cas_to_tas(128.6, 3048.0)  # 250 kt CAS at 10,000 ft ≈ 289 kt TAS
-    assert tas / 0.514444 == pytest.approx(289, abs=2)
+    assert mps_to_kt(tas) == pytest.approx(289, abs=2)
     assert tas_to_cas(tas, 3048.0) == pytest.approx(128.6, rel=1e-9)

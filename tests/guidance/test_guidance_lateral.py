@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from fms_testbed.guidance.lateral import (G_MPS2, LateralGains, anticipation_m, bank_command_rad,
-                                          feedforward_bank_rad)
+from fms_testbed.core.units import G0_MPS2
+from fms_testbed.guidance.lateral import LateralGains, anticipation_m, bank_command_rad, feedforward_bank_rad
 
 GAINS = LateralGains(bank_max_deg=25.0, roll_rate_dps=5.0)
 
@@ -15,7 +15,7 @@ GAINS = LateralGains(bank_max_deg=25.0, roll_rate_dps=5.0)
 def test_on_an_arc_without_error_the_bank_is_the_coordinated_turn_bank():
     v, r = 118.0, 3900.0
     bank = bank_command_rad(0.0, 0.0, v, 1.0 / r, GAINS)
-    assert bank == pytest.approx(math.atan(v * v / (G_MPS2 * r)), rel=1e-12)
+    assert bank == pytest.approx(math.atan(v * v / (G0_MPS2 * r)), rel=1e-12)
     assert bank_command_rad(0.0, 0.0, v, -1.0 / r, GAINS) == pytest.approx(-bank)
 
 

@@ -13,6 +13,7 @@ from fms_testbed.procedures.synth import (airport_record, leg_record, offset, wa
                                         write_file)
 from fms_testbed.core.segments import Arc
 from fms_testbed.core.geodesy import inverse, wrap180
+from fms_testbed.core.units import NM_M
 from tests.path.test_world import PARAMS, PERF
 
 SETTINGS = settings(max_examples=40, deadline=None,
@@ -80,7 +81,7 @@ def test_rf_arcs_keep_the_coded_radius_direction_and_end_fix(tmp_path_factory, l
     path = _build(tmp, recs)
     inv = invariants(path)
     assert inv.max_gap_m <= 1.0 and inv.fix_excess_m <= 0.0
-    assert inv.rf_radius_err_m <= 0.05 * 1852.0 and inv.turn_mismatch == 0
+    assert inv.rf_radius_err_m <= 0.05 * NM_M and inv.turn_mismatch == 0
     rf = [s.geom for s in path.segments if s.path_term == "RF" and isinstance(s.geom, Arc)]
     assert len(rf) == 1
     assert abs(abs(rf[0].sweep_deg) - sweep) < 0.05

@@ -12,10 +12,11 @@ from fms_testbed.procedures.synth import leg_record as L
 from fms_testbed.procedures.synth import offset, waypoint_record
 from fms_testbed.core.segments import Arc
 from fms_testbed.core.geodesy import gravity_mps2, inverse
+from fms_testbed.core.units import FT_M as FT
+from fms_testbed.core.units import KT_MPS
+from fms_testbed.core.units import NM_M as NM
 from tests.path.test_world import APT, PARAMS, PERF, build, world
 
-FT = 0.3048
-NM = 1852.0
 G = gravity_mps2(APT[0])
 R_PLAN = turn_radius_m(PERF.tas_plan_mps, PARAMS.bank_plan_deg, G)
 
@@ -281,7 +282,7 @@ def test_coded_speed_limit_caps_the_planned_speed_but_not_the_entry_turn(tmp_pat
             sid("DF", 20, fix="WS", speed_kt=180, speed_desc="-")]
     p = build(tmp_path, legs)
     turn = [s for s in arcs(p, "turn") if s.leg_index == 1][0]
-    assert turn.speed_mps < 180 * 1852 / 3600 * 1.05          # IAS 180 kt -> TAS at ~1000 ft
+    assert turn.speed_mps < 180 * KT_MPS * 1.05          # IAS 180 kt -> TAS at ~1000 ft
     assert turn.geom.radius_m == pytest.approx(
         turn_radius_m(p.legs[0].speed_mps, PARAMS.bank_plan_deg, G), rel=1e-3)
     assert turn.geom.radius_m > R_PLAN

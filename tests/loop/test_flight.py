@@ -11,6 +11,7 @@ import pytest
 
 from fms_testbed.run import run_scenario
 from fms_testbed.core.timeseries import COLUMNS
+from fms_testbed.core.units import KT_MPS
 
 BASE = {"aircraft": "737", "initial": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 3000,
                                         "tas_kmh": 400, "heading_deg": 90}}
@@ -93,7 +94,7 @@ def test_cas_target_converted_with_altitude():
     df = run_scenario(scn).df
     from fms_testbed.core.atmosphere import cas_to_tas
     last = df.iloc[-1]
-    assert last["cmd_tas_mps"] == pytest.approx(float(cas_to_tas(200 * 0.514444, last["alt_m"])), rel=1e-4)
+    assert last["cmd_tas_mps"] == pytest.approx(float(cas_to_tas(200 * KT_MPS, last["alt_m"])), rel=1e-4)
 
 
 def test_steady_wind_is_ramped_in_and_then_held():
@@ -105,9 +106,9 @@ def test_steady_wind_is_ramped_in_and_then_held():
     df = run_scenario(scn).df
     late = df[df.t_s > WIND_RAMP_S + 40]
     # wind from the north at 30 kt: ground velocity has a southward component, heading crabs left
-    assert late["vn_mps"].mean() == pytest.approx(-30 * 0.514444, abs=0.5)
+    assert late["vn_mps"].mean() == pytest.approx(-30 * KT_MPS, abs=0.5)
     crab_deg = ((late["heading_deg"] - late["track_deg"] + 180) % 360 - 180).mean()
-    assert crab_deg == pytest.approx(-math.degrees(math.asin(30 * 0.514444 / 111.1)), abs=0.5)
+    assert crab_deg == pytest.approx(-math.degrees(math.asin(30 * KT_MPS / 111.1)), abs=0.5)
     assert late["tas_mps"].mean() == pytest.approx(111.1, abs=0.3)
 
 

@@ -6,10 +6,10 @@ import dataclasses
 import pytest
 
 from fms_testbed.procedures.synth import leg_record as L
+from fms_testbed.core.units import NM_M as NM
 from fms_testbed.procedures.synth import offset, waypoint_record
 from tests.path.test_world import PERF, build, world
 
-NM = 1852.0
 
 
 def app(pt, seq, **kw):

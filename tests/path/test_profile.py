@@ -7,10 +7,10 @@ import pytest
 
 from fms_testbed.path.profile import window
 from fms_testbed.procedures.synth import leg_record as L
+from fms_testbed.core.units import FT_M as FT
 from fms_testbed.procedures.synth import offset, waypoint_record
 from tests.path.test_world import APT, PERF, build, world
 
-FT = 0.3048
 
 
 @pytest.mark.parametrize("desc, lo, hi", [("+", 1000, None), ("-", None, 1000),
@@ -93,8 +93,8 @@ def test_a_flight_climb_top_replaces_the_transition_altitude_level_off():
     grad = 0.07
     check = plan_profile(path, grad, path.legs[0].start.alt_m)
     flight = plan_profile(path, grad, path.legs[0].start.alt_m, climb_top_m=4572.0)
-    assert max(check.alt_m) == pytest.approx(18000 * 0.3048)
+    assert max(check.alt_m) == pytest.approx(18000 * FT)
     assert max(flight.alt_m) == pytest.approx(4572.0)
     assert all(b >= a - 1e-9 for a, b in zip(flight.alt_m, flight.alt_m[1:]))   # climbs only
     assert fp.path.profile is not None and max(fp.path.profile.alt_m) == pytest.approx(
-        spec.climb_top_ft * 0.3048)
+        spec.climb_top_ft * FT)

@@ -10,7 +10,6 @@ from fms_testbed.procedures.synth import (airport_record, offset, runway_record,
                                         waypoint_record, write_file)
 
 APT = (50.0, 10.0)
-KT = 1852.0 / 3600.0
 PERF = Performance(tas_plan_mps=118.0, tas_min_mps=77.0, climb_gradient_max=0.10,
                    climb_rate_max_mps=12.0, descent_rate_max_mps=12.0, bank_max_deg=25.0)
 PARAMS = BuildParams()

@@ -11,11 +11,12 @@ import math
 import numpy as np
 import pytest
 
+from fms_testbed.core.units import FT_M
+from fms_testbed.core.units import NM_M as NM
 from fms_testbed.procedures.database import load_database
 from fms_testbed.loop.procedure import prepare
 from fms_testbed.run import fly_procedure
 
-NM = 1852.0
 
 
 @pytest.fixture(scope="module")
@@ -103,7 +104,7 @@ def test_ca_leg_ends_when_the_altitude_is_reached_then_df_turns_from_there(db):
     ca_alt = fp.seq.legs[k].alt1_m
     df = res.df
     end_of_ca = df[df["leg_index"] == k].iloc[-1]
-    assert end_of_ca["alt_m"] == pytest.approx(ca_alt, abs=50 * 0.3048)
+    assert end_of_ca["alt_m"] == pytest.approx(ca_alt, abs=50 * FT_M)
     assert any(e["kind"] == "rebuild" and e["leg"] == k + 1 for e in ev)
     after = df[df["leg_index"] == k + 1]
     assert after["leg_code"].iloc[0] == "DF" and "turn" in set(after["seg_role"])
@@ -141,7 +142,7 @@ def test_approach_ends_at_the_runway_threshold_at_the_coded_height(db):
     last = fp.seq.legs[-1]
     assert last.fix.ident.startswith("RW")
     end = res.df.iloc[-1]
-    assert end["alt_m"] == pytest.approx(last.alt1_m, abs=50 * 0.3048)
+    assert end["alt_m"] == pytest.approx(last.alt1_m, abs=50 * FT_M)
     assert res.summary["reason"] == "guidance complete"
 
 
@@ -250,7 +251,7 @@ def test_ha_hold_is_left_over_the_fix_once_the_altitude_is_reached(db):
     ev = [e for e in res.summary["guidance_events"] if "HA altitude reached" in e.get("detail", "")]
     assert len(ev) == 1
     end = res.df.iloc[-1]
-    assert end["alt_m"] >= ha.termination.alt_m - 50 * 0.3048
+    assert end["alt_m"] >= ha.termination.alt_m - 50 * FT_M
     assert _dist_m(end["lat_deg"], end["lon_deg"], ha.termination.lat_deg,
                    ha.termination.lon_deg) < 300.0
     planned_ha_m = sum(s.geom.length_m() for s in fp.path.segments if s.leg_index == ha.index)
@@ -267,3 +268,31 @@ def test_heading_legs_are_left_out_of_the_path_error_statistics(db):
     assert e["heading_leg_samples"] >= vm["samples"] > 0
     assert vm["fte95_m"] is None and vm["rnp_contained"] is None
     assert (res.df.loc[res.df["leg_code"] == "VM", "heading_leg"] == 1).all()
+
+
+def test_demo_sid_flies_with_a_finite_pde_on_its_cf_leg():
+    """Issue 10: PDE on CF legs raised UnboundLocalError, hidden as NaN by a broad except.
+    DEEZZ5 RW31L (demo-sid.yaml): the VI intercepts the CF course into SKORR, so the CF's own
+    path lies on the coded course line — its PDE is finite and under a metre; the fly-by arc
+    that ends the leg is a transition (NaN)."""
+    import fms_testbed
+    from pathlib import Path
+
+    scn = Path(__file__).resolve().parents[2] / "scenarios" / "demo-sid.yaml"
+    df = fms_testbed.run_scenario(scn, out_dir=None).df
+    cf = df[df["leg_code"] == "CF"]
+    own = cf.loc[cf["seg_role"] == "leg", "pde_m"].to_numpy()
+    assert own.size > 100 and np.isfinite(own).all()
+    assert 0.0 <= own.max() < 1.0
+    assert cf.loc[cf["seg_role"] == "flyby", "pde_m"].isna().all()
+
+
+def test_pde_is_logged_on_a_flown_hold_circuit(db):
+    """2R6 R18 JEBTA starts with an HF at JEBTA, entered over the fix on its inbound course:
+    the circuit flown is the coded racetrack (PDE finite, millimetres)."""
+    res, _ = flown(db, "2R6", "R18", transition="JEBTA")
+    _completed(res)
+    hf = res.df[res.df["leg_code"] == "HF"]
+    circuit = hf.loc[hf["seg_role"].isin(["leg", "hold"]), "pde_m"].to_numpy()
+    assert circuit.size > 1000 and np.isfinite(circuit).all()
+    assert circuit.max() < 0.01

@@ -6,9 +6,10 @@ import numpy as np
 import pytest
 import scipy.linalg
 
+from fms_testbed.core.earth import A_M, radii_m
+from fms_testbed.core.units import G0_MPS2
 from fms_testbed.sensors.sins.discretize import discretize
-from fms_testbed.sensors.sins.model import (A_M, baro_gains, build_F, dcm_body_to_enu, earth_radii, gravity_up,
-                                    mechanisation_rates)
+from fms_testbed.sensors.sins.model import baro_gains, build_F, dcm_body_to_enu, gravity_up, mechanisation_rates
 
 LAT, ALT = 0.82, 3000.0
 V = np.array([150.0, 100.0, 5.0])
@@ -23,7 +24,7 @@ def _skew(v):
 
 
 def _T(lat, h):
-    rm, rn, _, _ = earth_radii(lat)
+    rm, rn = radii_m(lat)
     return np.array([[0.0, (rn + h) * math.cos(lat), 0.0], [rm + h, 0.0, 0.0], [0.0, 0.0, 1.0]])
 
 
@@ -105,7 +106,7 @@ def test_schuler_foucault_and_vertical_instability_from_eigenvalues():
     lat = math.radians(45.0)
     F, _, g = _stationary_F(lat, baro_tau_s=None)   # Schuler splits by ± Ω sin φ
     ev = np.linalg.eigvals(F[:9, :9])
-    rm, rn, _, _ = earth_radii(lat)
+    rm, rn = radii_m(lat)
     w_s = math.sqrt(g / math.sqrt(rm * rn))
     period_min = 2 * math.pi / w_s / 60
     assert period_min == pytest.approx(84.4, rel=0.01)
@@ -136,7 +137,7 @@ def _close(actual, formula, rel):
 def test_single_axis_accelerometer_bias_gives_schuler_bowl_within_10pct():
     F, c, g = _stationary_F()
     w_s = math.sqrt(g / A_M)
-    b = 9.80665e-3                                           # 1 mg on body x (east)
+    b = 1e-3 * G0_MPS2                                           # 1 mg on body x (east)
     x0 = np.zeros(33)
     x0[9] = b
     t, x = _propagate(F, x0, 3600.0)
@@ -193,7 +194,8 @@ def test_white_noise_growth_matches_short_time_formulas():
 
 
 def test_stationary_alignment_nulls_level_and_gyrocompass_rates():
-    from fms_testbed.sensors.sins.model import alignment_map, earth_rate_enu
+    from fms_testbed.core.earth import earth_rate_enu
+    from fms_testbed.sensors.sins.model import alignment_map
     from fms_testbed.sensors.sins.presets import load_imu
 
     imu = load_imu("STIM300")
@@ -213,7 +215,7 @@ def test_aligned_stationary_ins_has_no_bias_schuler_bowl():
     from fms_testbed.sensors.sins.model import alignment_map
     F, c, g = _stationary_F()
     x0 = np.zeros(33)
-    x0[9] = 9.80665e-3                                        # 1 mg east accelerometer bias
+    x0[9] = 1e-3 * G0_MPS2                                        # 1 mg east accelerometer bias
     x0 = alignment_map(math.radians(45.0), c, DECAY) @ x0
     _, x = _propagate(F, x0, 3600.0)
     assert np.abs(x[:, 0]).max() < 1.0                        # vs 12.7 km unaligned

@@ -5,6 +5,7 @@ import math
 import pytest
 
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.units import G0_MPS2
 from fms_testbed.sensors.sins.presets import list_presets, load_imu, load_imu_spec
 
 DEG_H = math.pi / 180 / 3600
@@ -31,8 +32,8 @@ def test_stim300_units_convert_to_si():
     assert imu.q_psd[12] == pytest.approx(2 * (0.5 * DEG_H) ** 2 / 3600)
     # accel bias: turn-on 750 µg kept constant (no decay) + in-run 50 µg as a random walk
     assert imu.decay_rps[0] == 0.0
-    assert imu.p0_var[9] == pytest.approx((750e-6 * 9.80665) ** 2)
-    assert imu.q_psd[9] == pytest.approx(2 * (50e-6 * 9.80665) ** 2 / 3600)
+    assert imu.p0_var[9] == pytest.approx((750e-6 * G0_MPS2) ** 2)
+    assert imu.q_psd[9] == pytest.approx(2 * (50e-6 * G0_MPS2) ** 2 / 3600)
     assert imu.p0_var[18] == pytest.approx(500e-6 ** 2)                          # gyro SF
     assert imu.p0_var[27] == pytest.approx(1e-3 ** 2) and imu.q_psd[27] == 0     # constant
 
@@ -47,7 +48,7 @@ def test_user_yaml_file(tmp_path):
     p = tmp_path / "my_imu.yaml"
     p.write_text("gyro: {arw_deg_per_sqrt_h: 0.1}\naccelerometer: {bias_turn_on_ug: 100}\n")
     imu = load_imu(p)
-    assert imu.name == "my_imu" and imu.p0_var[9] == pytest.approx((100e-6 * 9.80665) ** 2)
+    assert imu.name == "my_imu" and imu.p0_var[9] == pytest.approx((100e-6 * G0_MPS2) ** 2)
 
 
 @pytest.mark.parametrize("text, match", [

@@ -12,9 +12,11 @@ imports).
 
 from pathlib import Path as _Path
 
-from fms_testbed.sensors.sins._numba_cache import invalidate_if_sources_changed as _invalidate
+import fms_testbed.core.earth as _earth
+from fms_testbed.core._numba_cache import invalidate_if_sources_changed as _invalidate
 
-_invalidate(_Path(__file__).parent)  # before any kernel is loaded from the cache
+# before any kernel is loaded from the cache; model.build_F inlines core/earth.py's kernels
+_invalidate(_Path(__file__).parent, also_hash=(_Path(_earth.__file__),))
 
 from fms_testbed.sensors.sins.discretize import DiscretisationError, discretize, discretize_sins  # noqa: E402
 from fms_testbed.sensors.sins.euler import eps_to_euler_errors, euler_errors_to_eps  # noqa: E402

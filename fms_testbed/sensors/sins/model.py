@@ -20,7 +20,8 @@ are first formed in geodetic coordinates (δφ, δλ, δh) and then carried to m
     δa^B = b_a + D_a k_a + Γ_a β_a + η_a,   δω^B = b_g + D_g k_g + Γ_g β_g + η_g
     ξ' = -ξ/τ + η  (first-order Gauss-Markov, q = 2σ²/τ), τ = inf: random walk / random constant
 
-Earth: WGS-84 radii, Somigliana normal gravity scaled by (a/(a+h))², no deflection of the
+Earth: :mod:`fms_testbed.core.earth` — WGS-84 radii, normal gravity γ(φ, h) (Somigliana with the
+second-order height term, NIMA TR8350.2 eq. 4-1, 4-3) and its gradient, no deflection of the
 vertical. The noise input matrix is G = blockdiag(0, C_B^N, -C_B^N, I_24); because each triad's
 channels are alike, Q = G Q1 Gᵀ is diagonal and constant (eq. 6.9).
 """
@@ -32,6 +33,9 @@ import math
 import numpy as np
 from numba import njit
 
+from fms_testbed.core.earth import (OMEGA_IE_RPS, earth_rate_enu, normal_gravity_and_gradient,
+                                   radii_and_derivatives, radii_m, transport_rate_enu)
+
 N_STATES = 33
 POS, VEL, ATT = slice(0, 3), slice(3, 6), slice(6, 9)
 BA, BG, KA, KG, MA, MG = (slice(9, 12), slice(12, 15), slice(15, 18), slice(18, 21),
@@ -42,43 +46,16 @@ STATE_NAMES = (
     + [f"bg_{c}_rps" for c in "xyz"] + [f"ka_{c}" for c in "xyz"] + [f"kg_{c}" for c in "xyz"]
     + [f"ma_{i}_rad" for i in range(1, 7)] + [f"mg_{i}_rad" for i in range(1, 7)])
 
-A_M = 6378137.0                      # WGS-84 semi-major axis, m
-FLAT = 1.0 / 298.257223563           # WGS-84 flattening
-E2 = FLAT * (2.0 - FLAT)             # first eccentricity squared
-OMEGA_IE_RPS = 7.292115e-5           # Earth rotation rate, rad/s
-GAMMA_E_MPS2 = 9.7803253359          # normal gravity at the equator, m/s^2
-K_SOMIGLIANA = 0.00193185265241      # Somigliana constant
-
-
-@njit(cache=True)
-def earth_radii(lat_rad):
-    """Meridian and transverse radii of curvature and their latitude derivatives.
-
-    Returns (R_M, R_N, dR_M/dφ, dR_N/dφ), m and m/rad (WGS-84).
-    """
-    s, c = math.sin(lat_rad), math.cos(lat_rad)
-    w = 1.0 - E2 * s * s
-    rn = A_M / math.sqrt(w)
-    rm = A_M * (1.0 - E2) / w ** 1.5
-    drn = A_M * E2 * s * c / w ** 1.5
-    drm = 3.0 * A_M * (1.0 - E2) * E2 * s * c / w ** 2.5
-    return rm, rn, drm, drn
-
 
 @njit(cache=True)
 def gravity_up(lat_rad, alt_m):
     """Up component of gravity and its derivatives: (g_U, ∂g_U/∂φ, ∂g_U/∂h), m/s², per rad, 1/s².
 
-    g_U = -γ(φ) (a/(a+h))², γ Somigliana normal gravity.
+    g_U = -γ(φ, h), γ the normal gravity of :func:`fms_testbed.core.earth.normal_gravity_mps2`
+    (latitude φ in rad, height h in m).
     """
-    s, c = math.sin(lat_rad), math.cos(lat_rad)
-    w = 1.0 - E2 * s * s
-    num = 1.0 + K_SOMIGLIANA * s * s
-    gam = GAMMA_E_MPS2 * num / math.sqrt(w)
-    dgam = GAMMA_E_MPS2 * (2.0 * K_SOMIGLIANA * s * c / math.sqrt(w)
-                           + num * E2 * s * c / w ** 1.5)
-    r = A_M / (A_M + alt_m)
-    return -gam * r * r, -dgam * r * r, 2.0 * gam * r * r / (A_M + alt_m)
+    g, dg_dlat, dg_dh = normal_gravity_and_gradient(lat_rad, alt_m)
+    return -g, -dg_dlat, -dg_dh
 
 
 def dcm_body_to_enu(roll_rad: float, pitch_rad: float, heading_rad: float) -> np.ndarray:
@@ -126,7 +103,7 @@ def build_F(lat_rad, alt_m, v_enu_mps, f_b_mps2, w_ib_b_rps, c_bn, decay_rps, k1
     vE, vN, vU = v_enu_mps[0], v_enu_mps[1], v_enu_mps[2]
     s, c = math.sin(lat_rad), math.cos(lat_rad)
     t = s / c
-    rm, rn, drm, drn = earth_radii(lat_rad)
+    rm, rn, drm, drn = radii_and_derivatives(lat_rad)
     mh, nh = rm + alt_m, rn + alt_m
     _, dg_dlat, dg_dh = gravity_up(lat_rad, alt_m)
     W = OMEGA_IE_RPS
@@ -223,18 +200,6 @@ def noise_input_matrix(c_bn: np.ndarray) -> np.ndarray:
     return G
 
 
-def earth_rate_enu(lat_rad: float) -> np.ndarray:
-    """ω_IE^N in ENU, rad/s."""
-    return OMEGA_IE_RPS * np.array([0.0, math.cos(lat_rad), math.sin(lat_rad)])
-
-
-def transport_rate_enu(lat_rad: float, alt_m: float, v_enu_mps: np.ndarray) -> np.ndarray:
-    """ω_EN^N in ENU, rad/s (eq. 6.2)."""
-    rm, rn, _, _ = earth_radii(lat_rad)
-    vE, vN = float(v_enu_mps[0]), float(v_enu_mps[1])
-    return np.array([-vN / (rm + alt_m), vE / (rn + alt_m), vE * math.tan(lat_rad) / (rn + alt_m)])
-
-
 def _skew(v: np.ndarray) -> np.ndarray:
     return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
 
@@ -246,7 +211,7 @@ def mechanisation_rates(lat_rad: float, alt_m: float, v_enu_mps: np.ndarray, c_b
     Returns (φ' rad/s, λ' rad/s, h' m/s, V' (3,) m/s², C' (3, 3) 1/s). Gravity has only an up
     component (:func:`gravity_up`). Used as the reference the linear model is checked against.
     """
-    rm, rn, _, _ = earth_radii(lat_rad)
+    rm, rn = radii_m(lat_rad)
     v = np.asarray(v_enu_mps, float)
     lat_dot = v[1] / (rm + alt_m)
     lon_dot = v[0] / ((rn + alt_m) * math.cos(lat_rad))
@@ -261,13 +226,14 @@ def mechanisation_rates(lat_rad: float, alt_m: float, v_enu_mps: np.ndarray, c_b
 def baro_gains(tau_s: float | None, lat_rad: float = 0.0) -> tuple[float, float]:
     """Gains (k1 1/s, k2 1/s²) of a critically damped baro loop with time constant ``tau_s``.
 
-    Closed loop s² + k1 s + (k2 - 2g/R) = (s + 1/τ)²; ``None`` means no damping (0, 0).
+    Closed loop s² + k1 s + (k2 - ∂g_U/∂h) = (s + 1/τ)², ∂g_U/∂h ≈ 2g/a the free vertical
+    channel's instability (:func:`gravity_up` at height 0, latitude ``lat_rad`` in rad); ``None``
+    means no damping (0, 0).
     """
     if tau_s is None:
         return 0.0, 0.0
     w = 1.0 / tau_s
-    g = -gravity_up(lat_rad, 0.0)[0]
-    return 2.0 * w, w * w + 2.0 * g / A_M
+    return 2.0 * w, w * w + gravity_up(lat_rad, 0.0)[2]
 
 
 def alignment_map(lat_rad: float, c_bn: np.ndarray, decay_rps: np.ndarray) -> np.ndarray:

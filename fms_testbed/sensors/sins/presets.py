@@ -28,15 +28,13 @@ import yaml
 from pydantic import BaseModel, ConfigDict, Field, ValidationError
 
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.units import DEG_RAD, DPH_RPS, G0_MPS2
 from fms_testbed.data import imu_dir as _data_imu_dir
 from fms_testbed.sensors.sins.model import N_STATES
 
 NonNeg = Annotated[float, Field(ge=0)]
 PosOrNone = Annotated[float, Field(gt=0)] | None
 
-DEG = math.pi / 180.0
-HOUR_S = 3600.0
-G0_MPS2 = 9.80665                       # standard gravity for µg conversions, m/s²
 
 
 class _Frozen(BaseModel):
@@ -58,7 +56,7 @@ class GyroSpec(_Frozen):
 
 
 class AccelSpec(_Frozen):
-    """Accelerometer triad, 1σ per axis, units in the keys (µg = 1e-6 × 9.80665 m/s²)."""
+    """Accelerometer triad, 1σ per axis, units in the keys (µg = 1e-6 g0, standard gravity)."""
 
     vrw_mps_per_sqrt_h: NonNeg = 0.0
     bias_turn_on_ug: NonNeg = 0.0
@@ -110,9 +108,9 @@ class ImuModel:
     def summary(self) -> str:
         """One line: the main figures in datasheet units."""
         s = np.sqrt(self.p0_var)
-        return (f"{self.name}: ARW {math.sqrt(self.q_psd[6]) / DEG * 60:.3g} deg/sqrt(h), "
+        return (f"{self.name}: ARW {math.sqrt(self.q_psd[6]) / DEG_RAD * 60:.3g} deg/sqrt(h), "
                 f"VRW {math.sqrt(self.q_psd[3]) * 60:.3g} m/s/sqrt(h), "
-                f"gyro bias {s[12] / DEG * HOUR_S:.3g} deg/h, accel bias "
+                f"gyro bias {s[12] / DPH_RPS:.3g} deg/h, accel bias "
                 f"{s[9] / G0_MPS2 * 1e6:.3g} ug (1 sigma)")
 
 
@@ -146,9 +144,9 @@ def imu_model(spec: ImuSpec) -> ImuModel:
                         a.bias_correlation_time_s, a.bias_rate_random_walk_ug_per_sqrt_s * ug,
                         a.scale_factor_ppm * 1e-6, a.scale_factor_correlation_time_s,
                         a.misalignment_mrad * 1e-3, a.misalignment_correlation_time_s)
-    gyr = _triad_states(g.bias_turn_on_deg_per_h * DEG / HOUR_S,
-                        g.bias_instability_deg_per_h * DEG / HOUR_S, g.bias_correlation_time_s,
-                        g.bias_rate_random_walk_deg_per_h_per_sqrt_h * DEG / HOUR_S / 60.0,
+    gyr = _triad_states(g.bias_turn_on_deg_per_h * DPH_RPS,
+                        g.bias_instability_deg_per_h * DPH_RPS, g.bias_correlation_time_s,
+                        g.bias_rate_random_walk_deg_per_h_per_sqrt_h * DPH_RPS / 60.0,
                         g.scale_factor_ppm * 1e-6, g.scale_factor_correlation_time_s,
                         g.misalignment_mrad * 1e-3, g.misalignment_correlation_time_s)
     # state order 9..32: b_a, b_g, k_a, k_g, β_a, β_g
@@ -156,7 +154,7 @@ def imu_model(spec: ImuSpec) -> ImuModel:
     decay = np.concatenate([np.full(n, d) for d, _, _, n in blocks])
     q = np.zeros(N_STATES)
     q[3:6] = (a.vrw_mps_per_sqrt_h / 60.0) ** 2          # m/s/√h → m/s/√s
-    q[6:9] = (g.arw_deg_per_sqrt_h * DEG / 60.0) ** 2     # °/√h → rad/√s
+    q[6:9] = (g.arw_deg_per_sqrt_h * DEG_RAD / 60.0) ** 2     # °/√h → rad/√s
     q[9:] = np.concatenate([np.full(n, qq) for _, qq, _, n in blocks])
     p0 = np.zeros(N_STATES)
     p0[0:3] = ini.position_m ** 2
@@ -218,5 +216,16 @@ def load_imu_spec(imu: str | Path | dict) -> ImuSpec:
 
 
 def load_imu(imu: str | Path | dict) -> ImuModel:
-    """Preset name, YAML path or mapping → :class:`ImuModel` (SI arrays)."""
+    """Preset name, YAML path or mapping → :class:`ImuModel` (SI arrays).
+
+    A MEMS gyro preset (``fms_testbed/data/mems/``) with compensation stages is accepted too:
+    ``"STIM210"``, ``"STIM210+compensated"``, ``"STIM210+temperature+run-to-run"`` or
+    ``{mems: STIM210, stages: [...]}`` (:mod:`fms_testbed.sensors.mems.equivalent`).
+    """
+    # imported here: the MEMS package builds on this module
+    from fms_testbed.sensors.mems.equivalent import equivalent_imu, parse_mems_request
+
+    mems = parse_mems_request(imu) if isinstance(imu, (str, dict)) else None
+    if mems is not None:
+        return equivalent_imu(*mems)
     return imu_model(load_imu_spec(imu))

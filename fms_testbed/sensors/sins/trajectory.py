@@ -15,8 +15,10 @@ from pathlib import Path
 
 import numpy as np
 
+from fms_testbed.core.earth import earth_rate_enu, radii_m, transport_rate_enu
 from fms_testbed.core.errors import UserError
-from fms_testbed.sensors.sins.model import earth_radii, earth_rate_enu, gravity_up, transport_rate_enu
+from fms_testbed.core.units import DEG_RAD
+from fms_testbed.sensors.sins.model import gravity_up
 
 REQUIRED_COLUMNS = ("t_s", "lat_deg", "lon_deg", "alt_m", "ve_mps", "vn_mps", "vu_mps",
                     "roll_deg", "pitch_deg", "heading_deg", "p_dps", "q_dps", "r_dps",
@@ -85,7 +87,7 @@ def from_dataframe(df, where: str = "timeseries") -> Trajectory:
     if bad.size:
         raise UserError(f"{where}: row {bad[0] + 1}: t_s not increasing ({t[bad[0]]} -> "
                         f"{t[bad[0] + 1]})")
-    d = math.pi / 180.0
+    d = DEG_RAD
     col = lambda *names: np.column_stack([df[n].to_numpy(float) for n in names])  # noqa: E731
     return Trajectory(
         t, df["lat_deg"].to_numpy(float) * d, df["lon_deg"].to_numpy(float) * d,
@@ -136,7 +138,7 @@ def straight_level(duration_s: float, dt_s: float = 0.1, lat_deg: float = 45.0,
     lon = np.empty(n)
     lat[0], lon[0] = math.radians(lat_deg), math.radians(lon_deg)
     for k in range(1, n):
-        rm, rn, _, _ = earth_radii(lat[k - 1])
+        rm, rn = radii_m(lat[k - 1])
         lat[k] = lat[k - 1] + v[1] / (rm + alt_m) * dt_s
         lon[k] = lon[k - 1] + v[0] / ((rn + alt_m) * math.cos(lat[k - 1])) * dt_s
     f_b = np.empty((n, 3))

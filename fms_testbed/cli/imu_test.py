@@ -1,0 +1,88 @@
+"""``fms-testbed imu-test``: the static drift test of a MEMS gyro with the three-stage compensation
+of Vorobyov et al. (seed 000).
+
+    fms-testbed imu-test --imu STIM210 [--duration-h 2] [--temperature-profile FILE|warmup|ramp]
+        [--stages none,temperature,run-to-run,slow-drift] [--seed N] [--allan] --out DIR
+
+Writes into ``--out``: ``accumulated_angle.csv`` (``t_s`` and ``angle_<stage>_<axis>_deg``, one
+row per second), ``summary.json`` (per stage and axis the residual zero signal and mean drift in
+°/s and the angle in °; the seed's figures next to the measured ones; the seed; with ``--allan``
+the fitted ARW °/√h and bias instability °/h vs the preset's) and the plots
+``zero_signal_vs_temperature.png``, ``residual_after_run_to_run.png``, ``accumulated_angle.png``
+(and ``allan.png``). Exit code 0; 2 on a user error (unknown preset, bad profile file, unknown
+stage).
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+from fms_testbed.core.errors import UserError
+from fms_testbed.data import results_dir
+
+DEFAULT_STAGES = "none,temperature,run-to-run,slow-drift"
+
+
+def cmd_imu_test(args) -> int:
+    """Run the static test, write the CSV, the summary and the plots; print one line per stage."""
+    from fms_testbed.sensors.mems.compensation import parse_stages
+    from fms_testbed.sensors.mems.static_test import run_static_test
+    from fms_testbed.viz.figure import save
+    from fms_testbed.viz.mems import (plot_accumulated_angle, plot_allan,
+                                      plot_residual_after_run_to_run,
+                                      plot_zero_signal_vs_temperature)
+
+    stages = parse_stages(args.stages)
+    if not args.duration_h > 0:
+        raise UserError(f"--duration-h must be > 0 h, got {args.duration_h}")
+    res = run_static_test(args.imu, args.duration_h * 3600.0, args.temperature_profile, stages,
+                          args.seed, allan=args.allan)
+    out = Path(args.out) if args.out else results_dir() / f"imu-test-{res.imu}"
+    out.mkdir(parents=True, exist_ok=True)
+    res.angle_frame().to_csv(out / "accumulated_angle.csv", index=False, float_format="%.7g")
+    plots = {"accumulated_angle.png": plot_accumulated_angle}
+    if res.calibration is not None:
+        plots["zero_signal_vs_temperature.png"] = plot_zero_signal_vs_temperature
+    if {"temperature", "run-to-run"} & set(stages):
+        plots["residual_after_run_to_run.png"] = plot_residual_after_run_to_run
+    if res.allan is not None:
+        plots["allan.png"] = plot_allan
+    for name, plot in plots.items():
+        save(plot(res), out / name)
+    summary = res.summary()
+    summary["outputs"] = ["accumulated_angle.csv", "summary.json", *sorted(plots)]
+    (out / "summary.json").write_text(json.dumps(summary, indent=1, allow_nan=False) + "\n")
+    print(f"{res.imu}: {res.duration_s / 3600:g} h static at {res.rate_hz:g} Hz, profile "
+          f"{res.profile.name}, seed {res.seed} ({res.wall_time_s:.1f} s)")
+    for st, r in res.stage.items():
+        print(f"  {st:11s} residual zero signal max {r.residual_max_deg_per_s.max():.5f} deg/s, "
+              f"angle {', '.join(f'{v:.2f}' for v in r.angle_deg)} deg (x, y, z)")
+    if res.allan is not None:
+        a = res.allan
+        print(f"  Allan ({res.allan_signal}): ARW {', '.join(f'{v:.4f}' for v in a.arw_deg_per_sqrt_h)}"
+              f" deg/sqrt(h), bias instability "
+              f"{', '.join(f'{v:.3f}' for v in a.bias_instability_deg_per_h)} deg/h")
+    print(f"  outputs in {out}: {', '.join(summary['outputs'])}")
+    return 0
+
+
+def register(sub) -> None:
+    """Add ``imu-test`` to the CLI."""
+    p = sub.add_parser("imu-test", help="static MEMS gyro drift test with the three-stage "
+                                        "compensation (temperature, run-to-run, slow drift)")
+    p.add_argument("--imu", default="STIM210", help="MEMS gyro preset or YAML file "
+                                                    "(default STIM210)")
+    p.add_argument("--duration-h", type=float, default=2.0, help="test length, h (default 2)")
+    p.add_argument("--temperature-profile", default="warmup",
+                   help="warmup (switch-on self-heating, default), ramp (thermal cycle over the "
+                        "operating range), constant, or a CSV file with t_s,temperature_degC")
+    p.add_argument("--stages", default=DEFAULT_STAGES,
+                   help=f"compensation stages to apply and report, comma-separated "
+                        f"(default {DEFAULT_STAGES})")
+    p.add_argument("--seed", type=int, default=0, help="seed of the calibration and test runs "
+                                                       "(default 0)")
+    p.add_argument("--allan", action="store_true",
+                   help="fit ARW and bias instability from the overlapping Allan deviation")
+    p.add_argument("--out", help="output folder (default results/imu-test-<imu>)")
+    p.set_defaults(func=cmd_imu_test)

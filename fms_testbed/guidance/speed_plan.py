@@ -1,0 +1,101 @@
+"""Speed planning: the TAS target of each guidance step from the coded limits and the arcs ahead.
+
+The aircraft's planned speed, flown as a CAS (its TAS at the present altitude), is capped so
+every arc within the deceleration distance ahead can be flown :data:`ARC_BANK_MARGIN_DEG` below
+the bank limit (:func:`arc_speed_cap_mps`, the monitor's V,γ correction applied in flight), then
+moved into the CAS band the leg's coded limit allows (:func:`~.vertical.cas_band`); in descent
+(STAR/approach) an 'at' or 'at or below' limit, once entered, holds for the rest of the
+procedure. The target is refreshed every :data:`SPEED_UPDATE_S` and on entering a leg.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from fms_testbed.core.atmosphere import cas_to_tas_scalar
+from fms_testbed.core.units import G0_MPS2
+from fms_testbed.guidance.geometry import LocalPiece
+from fms_testbed.guidance.vertical import SpeedLimit, cas_band, tas_target_mps
+
+ARC_BANK_MARGIN_DEG = 3.0
+"""Arcs are flown at a speed that needs at most the bank limit minus this, deg."""
+DECEL_MPS2 = 0.3
+"""Deceleration assumed when slowing for an arc ahead, m/s²."""
+DECEL_EXTRA_S = 10.0
+"""Flight time added to the deceleration distance before an arc, s."""
+LOOKAHEAD_M = 30000.0
+"""Arcs further ahead than this are not looked at, m."""
+SPEED_UPDATE_S = 1.0
+"""The TAS target is recomputed this often, s."""
+
+
+def arc_speed_cap_mps(pieces: list[LocalPiece], i: int, along_m: float, v_mps: float,
+                      bank_max_deg: float) -> float:
+    """Highest TAS at which every arc within the deceleration distance ahead can be flown with
+    ARC_BANK_MARGIN_DEG to spare below the bank limit, m/s (inf when none): v = sqrt(R g tan γ).
+
+    Parameters
+    ----------
+    pieces : the active path's pieces; i : the piece flown; along_m : distance along it, m
+    v_mps : present speed, m/s (deceleration distance (V² − v²) / (2 a) + DECEL_EXTRA_S V,
+        a = DECEL_MPS2)
+    bank_max_deg : the aircraft's bank limit, deg
+    """
+    g_tan = G0_MPS2 * math.tan(math.radians(bank_max_deg - ARC_BANK_MARGIN_DEG))
+    cap = math.inf
+    dist = -along_m
+    for p in pieces[i:]:
+        if p.is_arc:
+            v = math.sqrt(p.radius_m * g_tan)
+            if dist <= max(v_mps * v_mps - v * v, 0.0) / (2 * DECEL_MPS2) + DECEL_EXTRA_S * v_mps:
+                cap = min(cap, v)
+        dist += p.length_m
+        if dist > LOOKAHEAD_M:
+            break
+    return cap
+
+
+@dataclass
+class SpeedPlan:
+    """The TAS target and the state it carries from leg to leg (module docstring).
+
+    limits: coded speed limit per leg of the whole procedure; descent: STAR/approach (limits
+    carry on); plan_tas_mps: the aircraft's planned speed (flown as a CAS), m/s; cas_min_mps:
+    its minimum CAS, m/s; tas_cmd_mps: the present target, m/s; carry_max_cas_mps: the lowest
+    'at'/'at or below' CAS entered in descent, m/s; next_t_s: when the target is due again, s.
+    """
+
+    limits: list[SpeedLimit | None]
+    descent: bool
+    plan_tas_mps: float
+    cas_min_mps: float
+    tas_cmd_mps: float
+    carry_max_cas_mps: float | None = None
+    next_t_s: float = -1.0
+
+    def enter_leg(self, k: int) -> None:
+        """Leg ``k`` (whole-procedure index) is entered: in descent its 'at'/'at or below' limit
+        carries on."""
+        lim = self.limits[k] if k < len(self.limits) else None
+        if self.descent and lim is not None and lim.desc in ("", "@", "-"):
+            c = lim.cas_mps
+            self.carry_max_cas_mps = c if self.carry_max_cas_mps is None else \
+                min(self.carry_max_cas_mps, c)
+
+    def due_now(self) -> None:
+        """Recompute the target at the next step (a new leg is flown)."""
+        self.next_t_s = -1.0
+
+    def update(self, t_s: float, alt_m: float, leg: int, pieces: list[LocalPiece], i: int,
+               along_m: float, gs_mps: float, bank_max_deg: float) -> float:
+        """The TAS target at time ``t_s`` (s), altitude (m), on leg ``leg`` (whole-procedure
+        index), piece ``i`` at ``along_m`` (m), ground speed (m/s), m/s."""
+        if t_s >= self.next_t_s:
+            lim = self.limits[leg] if leg < len(self.limits) else None
+            lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
+            plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m),
+                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg))
+            self.tas_cmd_mps = tas_target_mps(plan, alt_m, lo, hi, self.cas_min_mps)
+            self.next_t_s = t_s + SPEED_UPDATE_S
+        return self.tas_cmd_mps
