@@ -288,7 +288,8 @@ def cmd_tune(args) -> int:
                              f"(lags nx {res.lags_s[0]:.2f} s, ny {res.lags_s[1]:.2f} s)\n"
                              f"cost {b.cost:.3f} (start {res.start.cost:.3f}): T_V "
                              f"{b.params.T_V_s:.2f} s, ξ_V {b.params.xi_V:.2f}, T_H "
-                             f"{b.params.T_H_s:.2f} s, ξ_H {b.params.xi_H:.2f}"),
+                             f"{b.params.T_H_s:.2f} s, ξ_H {b.params.xi_H:.2f}",
+                             plant={"jsbsim": "JSBSim"}.get(args.plant, "point mass")),
          out / "tuned-vs-linear.png")
     start, best = res.start.row(), b.row()
     keys = [k for k in best if k not in ("note",)]

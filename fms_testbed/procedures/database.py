@@ -18,7 +18,8 @@ from pathlib import Path
 from fms_testbed.core.errors import UserError
 from fms_testbed.data import procedures_dir
 from fms_testbed.procedures.fields import FieldError, RecordError
-from fms_testbed.procedures.integrity import Defect, Key, rejected_defect, sequence_defects
+from fms_testbed.procedures.integrity import (DEFECT_KINDS, Defect, Key, rejected_defect,
+                                              sequence_defects)
 from fms_testbed.procedures.legrecord import LegRecord, parse_leg, read_key
 from fms_testbed.procedures.loader import scan_text
 from fms_testbed.procedures.records import Fix
@@ -148,6 +149,7 @@ class Database:
             found = defects[k] + sequence_defects([(lg.line, lg.seq) for lg in legs[k]],
                                                   self.path)
             found += self._reference_defects(airport, legs[k])
+            found.sort(key=lambda d: DEFECT_KINDS.index(d.kind))  # the most telling first
             seqs.append(Sequence(*k, legs=tuple(sorted(legs[k], key=lambda lg: lg.seq)),
                                  defects=tuple(found), lines=tuple(self._key_lines.get(k, ()))))
         self._parsed[airport] = seqs

@@ -27,8 +27,9 @@ from dataclasses import dataclass
 Key = tuple[str, str, str, str, str]
 """(airport, type 'D'/'E'/'F', procedure ident, route type, transition ident)."""
 
-DEFECT_KINDS = ("rejected", "duplicate", "order", "interleaved", "fix-rejected",
+DEFECT_KINDS = ("rejected", "duplicate", "order", "fix-rejected", "interleaved",
                 "internal-error")
+"""The defect kinds, most telling first (a transition's defects are listed in this order)."""
 
 
 @dataclass(frozen=True, slots=True)

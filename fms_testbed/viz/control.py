@@ -187,18 +187,20 @@ def plot_linear_steps(t_s: np.ndarray, cases: dict[str, tuple[np.ndarray, np.nda
 
 
 def plot_tuning_overlay(jsb: dict[str, pd.DataFrame], lin: dict[str, pd.DataFrame],
-                        title: str) -> Figure:
-    """JSBSim responses of the tuned law with the linear prediction overlaid.
+                        title: str, plant: str = "JSBSim") -> Figure:
+    """Responses of the tuned law on a plant (JSBSim or the point mass) with the linear
+    prediction overlaid.
 
     Parameters
     ----------
     jsb, lin : ``"alt"`` / ``"speed"`` → DataFrame with t_s, alt_m, tas_mps, cmd_alt_m,
         cmd_tas_mps (the linear one as deviations added to the same trim)
     title : figure title
+    plant : legend label of ``jsb`` (the plant the law was tuned on)
     """
     fig, axes = subplots(2, 2, figsize=(11, 7), sharex=True)
     for c, key in enumerate(("alt", "speed")):
-        for src, st in ((jsb, dict(color="C0", lw=1.8, label="JSBSim")),
+        for src, st in ((jsb, dict(color="C0", lw=1.8, label=plant)),
                         (lin, dict(color="k", lw=1.0, ls="--", label="linear prediction"))):
             d = src[key]
             axes[0, c].plot(d["t_s"], d["alt_m"] - d["cmd_alt_m"], **st)

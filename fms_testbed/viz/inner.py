@@ -90,8 +90,8 @@ def plot_loop_steps(loop: str, runs: list[tuple[str, StepResult]], aircraft: str
     ok = all(r.ok for _, r in runs)
     spec = runs[0][1].spec
     settle = f"{worst_settle:.2f} s" if math.isfinite(worst_settle) else "not settled"
-    fig.suptitle(f"{aircraft}: {name} loop — {'PASS' if ok else 'FAIL'}: worst settling "
-                 f"{settle} (spec ≤ {spec.settle_max_s:g} s), worst overshoot "
+    fig.suptitle(f"{aircraft}: {name} loop — {'PASS' if ok else 'FAIL'}: worst settling: "
+                 f"{settle} (spec ≤ {spec.settle_max_s:g} s); worst overshoot: "
                  f"{worst_over:.1f} % (spec ≤ {spec.overshoot_max_pct:g} %)", fontsize=11)
     fig.tight_layout()
     return fig

@@ -123,10 +123,12 @@ def track_kml(df: pd.DataFrame, summary: dict, path: ProcedurePath | None = None
             _add_path(f, fp.path, st, fp.leg_offset, f"rebuild {j + 1}: ")
     f = kml.newfolder(name="flight")
     pts = track_points(df)
-    fte = summary.get("errors", {}).get("fte", {}).get("all", {}).get("p95_m")
+    err = summary.get("errors", {})
+    fte = err.get("fte", {}).get("all", {}).get("p95_m")
+    tse = err.get("tse", {}).get("all", {}).get("p95_m")
     desc = (f"{summary.get('aircraft', '')}, {summary.get('status')}: "
             f"{float(df['t_s'].iloc[-1] - df['t_s'].iloc[0]):.0f} s flown; altitude m MSL"
-            + (f"; FTE95 {fte} m" if fte is not None else ""))
+            + (f"; FTE95 {fte} m, TSE95 {tse} m" if fte is not None else ""))
     _add_track(f, pts, "flown (truth)", desc, _style(_FLOWN, 3))
     if nav_differs(df):
         _add_track(f, track_points(df, nav=True), "navigation solution",

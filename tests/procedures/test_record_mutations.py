@@ -258,3 +258,36 @@ def test_many_mutations_lose_no_record_silently(ms):
             # end of T's lines
             lines0 = [ln - 1 for ln in CLEAN[t].lines]
             assert i + 1 in held or i in (lines0[0], lines0[-1]), (ms, t)
+
+
+_CLEAN_ROWS: dict = {}
+
+
+def _clean_status(airport):
+    from fms_testbed.evaluation.check import check_airport, perf_for
+    if airport not in _CLEAN_ROWS:
+        seqs = CLEAN_DB.sequences(airport)
+        rows = check_airport(CLEAN_DB, airport, perf_for("737"))
+        _CLEAN_ROWS[airport] = {s.key: r["status"] for s, r in zip(seqs, rows)}
+    return _CLEAN_ROWS[airport]
+
+
+@pytest.mark.slow
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(m=mutation())
+def test_check_rows_after_a_mutation_are_honest(m):
+    """The check table of the mutated airport: 'degraded' exactly for the degraded
+    transitions, no internal error, and the clean status for every transition that means what
+    it meant."""
+    from fms_testbed.evaluation.check import check_airport, perf_for
+    db = check_one_mutation(m)
+    apt = OWNER[m[1]][0]
+    clean = _clean_status(apt)
+    seqs = db.sequences(apt)
+    rows = check_airport(db, apt, perf_for("737"))
+    assert len(rows) == len(seqs)
+    for s, r in zip(seqs, rows):
+        assert r["monitor_status"] != "internal-error", (m, r["findings"])
+        assert (r["status"] == "degraded") == s.degraded, (m, s.key)
+        if not s.degraded and tuple(_meaning(lg) for lg in s.legs) == CLEAN_LEGS.get(s.key):
+            assert r["status"] == clean[s.key], (m, s.key)
