@@ -162,21 +162,21 @@ def read_code(rec: str, a: int, b: int, what: str, allowed) -> str:
     return s
 
 
-_IDENT = re.compile(r"[A-Z0-9]+ *| *")
-_PROC_IDENT = re.compile(r"[A-Z0-9][A-Z0-9\-]* *")
-
-
 def read_ident(rec: str, a: int, b: int, what: str, procedure: bool = False,
                required: bool = False) -> str:
     """Ident field in columns ``a..b``, left-justified letters and digits ('-' too in a
     procedure ident), stripped; '' when blank (an error when ``required``)."""
     raw = rec[a - 1:b]
-    if required and not raw.strip():
-        raise FieldError(a, what, "is blank", b)
-    if not (_PROC_IDENT if procedure and raw.strip() else _IDENT).fullmatch(raw):
-        raise FieldError(a, what, f"{raw!r} is not a left-justified ident of letters and digits",
-                         b)
-    return raw.strip()
+    s = raw.rstrip(" ")
+    if not s:
+        if required:
+            raise FieldError(a, what, "is blank", b)
+        return ""
+    core = s.replace("-", "") if procedure and s[0] != "-" else s
+    if not (core.isascii() and core.isalnum() and (core.isupper() or core.isdigit())):
+        raise FieldError(a, what, f"{raw!r} is not a left-justified ident of upper-case "
+                                  f"letters and digits{' (and -)' if procedure else ''}", b)
+    return s
 
 
 def _angle(s: str, col: int, hemis: str, ndeg: int, what: str) -> float:

@@ -99,6 +99,8 @@ ALT_DESCRIPTORS = frozenset(" +-@BCGHIJVXY")
 DESC_CODES = (frozenset(" ACEFGHNPRTUV"), frozenset(" BEUY"), frozenset(" ABCGMPRS"),
               frozenset(" ABCDEFHIMNPS"))
 _ROUTE_TYPES = frozenset("ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789")
+_TURNS, _TDV, _SPEED_DESC = frozenset("LRE "), frozenset("Y "), frozenset(" +-")
+_PRIMARY, _SECTIONS, _SUBSECTIONS = frozenset("01"), frozenset({"P ", "H "}), frozenset("DEF")
 
 
 def _ref(rec: str, a: int, ident_len: int, reg: int, sec: int, what: str,
@@ -164,6 +166,39 @@ def _rnp(rec: str) -> float | None:
     return int(raw[:2]) * 10.0 ** (-int(raw[2]))
 
 
+#: Fields of a procedure record, (first column, last column, name) 1-based, for naming the
+#: field a bad character is in.
+LEG_FIELDS = ((1, 1, "record type"), (2, 4, "area"), (5, 6, "section"), (7, 10, "airport ident"),
+              (11, 12, "ICAO region"), (13, 13, "subsection"), (14, 19, "procedure ident"),
+              (20, 20, "route type"), (21, 25, "transition ident"), (27, 29, "sequence number"),
+              (30, 34, "fix ident"), (35, 36, "fix region"), (37, 38, "fix section"),
+              (39, 39, "continuation number"), (40, 43, "waypoint description"),
+              (44, 44, "turn direction"), (45, 47, "RNP"), (48, 49, "path terminator"),
+              (50, 50, "turn direction valid"), (51, 54, "navaid ident"),
+              (55, 56, "navaid region"), (57, 62, "arc radius"), (63, 66, "theta"),
+              (67, 70, "rho"), (71, 74, "course"), (75, 78, "distance"),
+              (79, 80, "navaid section"), (83, 83, "altitude descriptor"),
+              (85, 89, "altitude 1"), (90, 94, "altitude 2"), (95, 99, "transition altitude"),
+              (100, 102, "speed limit"), (103, 106, "vertical angle"),
+              (107, 111, "centre fix ident"), (113, 114, "centre fix region"),
+              (115, 116, "centre fix section"), (118, 118, "speed limit descriptor"),
+              (124, 128, "file record number"), (129, 132, "cycle date"))
+
+
+def check_leg_record(rec: str) -> None:
+    """:func:`~.fields.check_record` for a procedure record: a bad character is reported
+    under the field it is in (e.g. 'course', columns 71-74)."""
+    try:
+        check_record(rec)
+    except FieldError as exc:
+        if exc.field != "character set":
+            raise
+        for a, b, name in LEG_FIELDS:
+            if a <= exc.column <= b:
+                raise FieldError(exc.column, name, exc.reason) from None
+        raise
+
+
 def is_procedure_record(rec: str) -> bool:
     """Section/subsection (cols 5-6, 13) say SID, STAR or approach (airport or heliport)."""
     return rec[4:6] in ("P ", "H ") and rec[12:13] in ("D", "E", "F")
@@ -181,8 +216,8 @@ def read_key(rec: str) -> tuple[str, str, str, str, str]:
     if len(rec) < 29:
         raise FieldError(len(rec) + 1, "record length",
                          f"record has {len(rec)} columns, too few for its key (cols 5-29)")
-    read_code(rec, 5, 6, "section", {"P ", "H "})
-    sub = read_code(rec, 13, 13, "subsection", {"D", "E", "F"})
+    read_code(rec, 5, 6, "section", _SECTIONS)
+    sub = read_code(rec, 13, 13, "subsection", _SUBSECTIONS)
     return (read_ident(rec, 7, 10, "airport ident", required=True), sub,
             read_ident(rec, 14, 19, "procedure ident", procedure=True, required=True),
             read_code(rec, 20, 20, "route type", _ROUTE_TYPES),
@@ -202,9 +237,9 @@ def parse_leg(rec: str, line: int) -> LegRecord:
     FieldError
         naming the 1-based columns, the field and the reason when a field is malformed.
     """
-    check_record(rec)
+    check_leg_record(rec)
     airport, sub, proc_id, route_type, transition = read_key(rec)
-    read_code(rec, 39, 39, "continuation number", {"0", "1"})
+    read_code(rec, 39, 39, "continuation number", _PRIMARY)
     read_ident(rec, 11, 12, "ICAO region")
     seq = read_int(rec, 27, 29, "sequence number")
     if seq is None:
@@ -212,9 +247,10 @@ def parse_leg(rec: str, line: int) -> LegRecord:
     pt = read_code(rec, 48, 49, "path terminator", _PT_SET)
     desc = rec[39:43]
     for k, allowed in enumerate(DESC_CODES):
-        read_code(rec, 40 + k, 40 + k, f"waypoint description {k + 1}", allowed)
-    turn = read_code(rec, 44, 44, "turn direction", {"L", "R", "E", " "})
-    tdv = read_code(rec, 50, 50, "turn direction valid", {"Y", " "})
+        if desc[k] not in allowed:
+            read_code(rec, 40 + k, 40 + k, f"waypoint description {k + 1}", allowed)
+    turn = read_code(rec, 44, 44, "turn direction", _TURNS)
+    tdv = read_code(rec, 50, 50, "turn direction valid", _TDV)
     course, course_true = _course(rec)
     distance_m, time_s = _distance_time(rec)
     arc_r = read_int(rec, 57, 62, "arc radius")
@@ -225,7 +261,7 @@ def parse_leg(rec: str, line: int) -> LegRecord:
     trans_alt = read_int(rec, 95, 99, "transition altitude")
     spd = read_int(rec, 100, 102, "speed limit")
     vpa = read_int(rec, 103, 106, "vertical angle", signed=True)
-    speed_desc = read_code(rec, 118, 118, "speed limit descriptor", {" ", "+", "-"})
+    speed_desc = read_code(rec, 118, 118, "speed limit descriptor", _SPEED_DESC)
     return LegRecord(
         airport=airport, proc_type=sub, proc_id=proc_id, route_type=route_type,
         transition=transition, seq=seq,

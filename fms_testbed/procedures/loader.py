@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 
 from fms_testbed.procedures.fields import FieldError, RecordError, check_record
 from fms_testbed.procedures.integrity import Defect, Key, rejected_defect, structure_defects
-from fms_testbed.procedures.legrecord import is_procedure_record, read_key
+from fms_testbed.procedures.legrecord import check_leg_record, is_procedure_record, read_key
 from fms_testbed.procedures.records import (Fix, parse_airport, parse_localizer, parse_ndb,
                                             parse_runway, parse_vhf, parse_waypoint)
 
@@ -183,7 +183,7 @@ def scan_text(text: str, file: str) -> Scan:
             continue
         bad = None
         try:
-            check_record(rec)
+            (check_leg_record if is_procedure_record(rec) else check_record)(rec)
             if rec[0] != "S":
                 raise FieldError(1, "record type", f"{rec[0]!r} is not 'S' (standard)")
         except FieldError as exc:

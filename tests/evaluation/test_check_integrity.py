@@ -86,7 +86,8 @@ def test_cli_check_lists_rejected_records_and_keeps_all_rejected_transitions(tmp
     assert f"{n_legs} rejected records" in text
     rej = pd.read_csv(out / "rejected_records.csv")
     assert list(rej.columns) == ["file", "line", "columns", "field", "reason", "record"]
-    assert len(rej) == n_legs and set(rej.field) == {"character set"}
+    assert len(rej) == n_legs and set(rej.field) == {"course"}
+    assert rej.reason.str.contains("U+00B2", regex=False).all()
     assert sorted(rej.line) == [i + 1 for i, r in enumerate(LINES) if is_leg(r)]
     assert (rej.record.str.len() == 132).all()
     df = pd.read_parquet(out / "procedures_check.parquet")
@@ -157,7 +158,7 @@ def test_check_of_a_corrupted_copy_of_a_real_cifp_slice(tmp_path, capsys):
     rej = pd.read_csv(cor / "rejected_records.csv")
     shift = {i: i + 1 + (i > dup) for i in edits}     # 1-based lines in the corrupted copy
     assert sorted(rej.line) == sorted(shift.values())
-    assert set(rej.field) == {"character set", "speed limit", "vertical angle"}
+    assert set(rej.field) == {"course", "speed limit", "vertical angle"}
     a = pd.read_parquet(ref / "procedures_check.parquet")
     b = pd.read_parquet(cor / "procedures_check.parquet")
     assert len(a) == len(b) and (a.procedure.values == b.procedure.values).all()

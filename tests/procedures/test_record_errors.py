@@ -147,11 +147,11 @@ def test_altitude_reader_rejects_non_ascii_digits():
 @pytest.mark.parametrize("rec, field", [
     (VA[:131], "record length"),
     (VA + " ", "record length"),
-    (put(VA, 71, "043²"), "character set"),       # a Latin-1 superscript two
-    (put(VA, 60, "\x85"), "character set"),       # NEL: str.splitlines() would split here
-    (put(VA, 60, "\x0c"), "character set"),
-    (put(VA, 60, "a"), "character set"),          # ARINC-424 is upper case
-    (put(VA, 60, "_"), "character set"),
+    (put(VA, 71, "043²"), "course"),              # a Latin-1 superscript two
+    (put(VA, 60, "\x85"), "arc radius"),          # NEL: str.splitlines() would split here
+    (put(VA, 60, "\x0c"), "arc radius"),
+    (put(VA, 31, "a"), "fix ident"),              # ARINC-424 is upper case
+    (put(VA, 121, "_"), "character set"),         # a reserved column
 ])
 def test_record_length_and_character_set(rec, field):
     with pytest.raises(FieldError) as e:

@@ -1,0 +1,193 @@
+"""A campaign's folder: ``run.json``, the ``flights/`` Parquet dataset, kept artefacts.
+
+::
+
+    DIR/run.json              command, version, database (path, SHA-256), case count, options,
+                              status ('running' / 'complete'), counts by status, timings
+    DIR/flights/part-*.parquet  one row per finished case (:data:`~.rows.SCHEMA`)
+    DIR/cases/<case_id>/      --keep timeseries,plots: the flight's outputs (``Results.save``)
+
+Atomic and resumable: rows are written a batch at a time (:class:`BatchWriter`: every
+``batch_rows`` rows or ``batch_s`` seconds, and at the end), each batch to a hidden temporary
+file in ``flights/`` that is renamed into place once written and synced. A run killed at any
+moment (SIGKILL of everything) leaves only whole part files; the hidden temporary files are
+ignored by every Parquet reader (names starting with '.') and removed by the next run. Resuming
+lists the case ids already in ``flights/`` (:func:`finished_ids`) and flies only the others, so
+nothing is lost or written twice. One run at a time: ``DIR/.lock`` is held (``flock``) while a
+run writes (the kernel releases it when the process dies).
+"""
+
+from __future__ import annotations
+
+import fcntl
+import json
+import os
+import tempfile
+import time
+from datetime import datetime, timezone
+from pathlib import Path
+
+import pyarrow.parquet as pq
+
+from fms_testbed.campaign.rows import table
+from fms_testbed.core.errors import UserError
+from fms_testbed.core.jsonio import dumps
+
+FLIGHTS = "flights"
+CASES = "cases"
+RUN_JSON = "run.json"
+
+
+def _fsync_dir(folder: Path) -> None:
+    fd = os.open(folder, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def write_json_atomic(path: Path, data: dict) -> None:
+    """Strict JSON written to a temporary file beside ``path`` and renamed over it."""
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    with os.fdopen(fd, "w") as fh:
+        fh.write(dumps(data))
+        fh.flush()
+        os.fsync(fh.fileno())
+    os.replace(tmp, path)
+    _fsync_dir(path.parent)
+
+
+def read_run_json(out: Path) -> dict | None:
+    """``DIR/run.json`` of a previous run, or None."""
+    try:
+        data = json.loads((out / RUN_JSON).read_text())
+    except (OSError, ValueError):
+        return None
+    return data if isinstance(data, dict) and data.get("tool") == "fms-testbed" else None
+
+
+def part_files(out: Path) -> list[Path]:
+    """The complete part files of ``DIR/flights`` (sorted by name)."""
+    folder = out / FLIGHTS
+    if not folder.is_dir():
+        return []
+    return sorted(p for p in folder.iterdir() if p.suffix == ".parquet"
+                  and not p.name.startswith((".", "_")))
+
+
+def finished_ids(out: Path) -> set[str]:
+    """Case ids already written (read from the ``case_id`` column of every part file)."""
+    ids: set[str] = set()
+    for p in part_files(out):
+        ids.update(pq.read_table(p, columns=["case_id"]).column("case_id").to_pylist())
+    return ids
+
+
+def clean_partial(out: Path) -> int:
+    """Remove hidden temporary part files a killed run left; return how many."""
+    folder = out / FLIGHTS
+    n = 0
+    if folder.is_dir():
+        for p in folder.glob(".part-*"):
+            p.unlink(missing_ok=True)
+            n += 1
+    return n
+
+
+class RunLock:
+    """``DIR/.lock`` held exclusively for the life of a run (one writer per folder)."""
+
+    def __init__(self, out: Path):
+        self.path = out / ".lock"
+        self.fd: int | None = None
+
+    def __enter__(self) -> "RunLock":
+        self.fd = os.open(self.path, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(self.fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            os.close(self.fd)
+            self.fd = None
+            raise UserError(f"--out {self.path.parent}: another regress run is writing into "
+                            "this folder") from None
+        return self
+
+    def __exit__(self, *exc) -> None:
+        if self.fd is not None:
+            fcntl.flock(self.fd, fcntl.LOCK_UN)
+            os.close(self.fd)
+            self.fd = None
+
+
+class BatchWriter:
+    """Collect rows; write them as one part file every ``batch_rows`` rows or ``batch_s``
+    seconds (module docstring).
+
+    Parameters
+    ----------
+    out : the campaign folder
+    batch_rows : rows per part file at most
+    batch_s : the longest time a finished row waits in memory, s
+    """
+
+    def __init__(self, out: Path, batch_rows: int = 64, batch_s: float = 15.0):
+        self.folder = out / FLIGHTS
+        self.folder.mkdir(parents=True, exist_ok=True)
+        self.batch_rows, self.batch_s = batch_rows, batch_s
+        self.rows: list[dict] = []
+        self.t_last = time.monotonic()
+        self.n_files = 0
+        self.n_rows = 0
+
+    def add(self, row: dict) -> None:
+        """Add one row; write the batch when it is due."""
+        self.rows.append(row)
+        if len(self.rows) >= self.batch_rows or time.monotonic() - self.t_last >= self.batch_s:
+            self.flush()
+
+    def flush(self) -> None:
+        """Write the rows held (if any) as one part file, atomically."""
+        self.t_last = time.monotonic()
+        if not self.rows:
+            return
+        tab = table(self.rows)
+        name = f"part-{time.time_ns():020d}-{os.getpid()}-{self.rows[0]['case_id']}.parquet"
+        fd, tmp = tempfile.mkstemp(prefix=".part-", suffix=".tmp", dir=self.folder)
+        try:
+            with os.fdopen(fd, "wb") as fh:
+                pq.write_table(tab, fh, compression="zstd")
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, self.folder / name)
+        except BaseException:
+            Path(tmp).unlink(missing_ok=True)
+            raise
+        _fsync_dir(self.folder)
+        self.n_files += 1
+        self.n_rows += len(self.rows)
+        self.rows = []
+
+
+def utc_now() -> str:
+    """The current UTC time, ISO 8601 to the second."""
+    return datetime.now(timezone.utc).isoformat(timespec="seconds")
+
+
+__all__ = ["CASES", "FLIGHTS", "RUN_JSON", "BatchWriter", "RunLock", "clean_partial",
+           "finished_ids", "part_files", "read_flights", "read_run_json", "utc_now", "write_json_atomic"]
+
+
+def read_flights(out: str | Path):
+    """The ``flights/`` dataset of a campaign folder as a DataFrame (every column of
+    :data:`~.rows.SCHEMA`, even when no part file is written yet)."""
+    import pandas as pd
+
+    from fms_testbed.campaign.rows import SCHEMA
+
+    out = Path(out)
+    parts = part_files(out)
+    if not parts:
+        if read_run_json(out) is None:
+            raise UserError(f"{out}: not a regress run folder (no run.json)")
+        return SCHEMA.empty_table().to_pandas()
+    return pd.read_parquet(out / FLIGHTS)
