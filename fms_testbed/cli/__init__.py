@@ -40,6 +40,7 @@ COMMAND_MODULES = (
     "fms_testbed.cli.coupled",      # tune, compare, analyse
     "fms_testbed.cli.ins",         # ins
     "fms_testbed.cli.imu_test",     # imu-test
+    "fms_testbed.cli.regress",      # regress run / diff / report
 )
 
 
@@ -68,10 +69,22 @@ def _exit_on_sigterm(signum, frame) -> None:  # pragma: no cover - exercised in 
     raise SystemExit(128 + signum)
 
 
+_interrupted = threading.Event()
+
+
+def _on_sigint(signum, frame) -> None:  # pragma: no cover - exercised in a subprocess
+    """SIGINT: remember it, then raise KeyboardInterrupt. Raised while a numba kernel is being
+    compiled or called, the interrupt surfaces as another exception (a SystemError from the
+    dispatcher); the flag lets :func:`main` report it as the interrupt it is."""
+    _interrupted.set()
+    raise KeyboardInterrupt
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; return the process exit code."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _exit_on_sigterm)
+        signal.signal(signal.SIGINT, _on_sigint)
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(
@@ -91,6 +104,11 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into `head`: stop quietly (Python docs, signal)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except Exception:
+        if _interrupted.is_set():      # the interrupt, surfacing through compiled code
+            print("fms-testbed: interrupted", file=sys.stderr)
+            return 130
+        raise
 
 
 if __name__ == "__main__":  # pragma: no cover
