@@ -76,7 +76,12 @@ def check_out_dir(out_dir: str | Path, overwrite: bool = False) -> Path:
 
 
 def file_sha256(path: str | Path) -> str | None:
-    """SHA-256 of a file's bytes (None when it cannot be read)."""
+    """SHA-256 of a file's bytes (None when it cannot be read).
+
+    Parameters
+    ----------
+    path : the file
+    """
     h = hashlib.sha256()
     try:
         with open(path, "rb") as f:

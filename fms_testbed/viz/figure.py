@@ -21,7 +21,14 @@ def subplots(*args, figsize: tuple[float, float] = (8.0, 6.0), **kwargs):
 
 
 def save(fig: Figure, path: str | Path, dpi: int = 110) -> Path:
-    """Write a figure to ``path`` (PNG unless the suffix says otherwise); return the path."""
+    """Write a figure to ``path`` (PNG unless the suffix says otherwise); return the path.
+
+    Parameters
+    ----------
+    fig : the figure
+    path : the file to write
+    dpi : resolution, dots per inch
+    """
     path = Path(path)
     fig.savefig(path, dpi=dpi)
     return path
