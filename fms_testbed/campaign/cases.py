@@ -275,6 +275,20 @@ def enumerate_cases(index: DatabaseIndex, airports: list[str], types: list[str],
     return out
 
 
-__all__ = ["CASE_ID_HEX", "TYPES", "TYPE_NAMES", "Case", "aircraft_files", "case_seed",
+
+def case_from_row(row) -> Case:
+    """The case a ``flights`` row records (to fly it again: same id, so the same seed). The
+    aircraft file's SHA-256 is not in the row: it is left empty."""
+    from fms_testbed.campaign.conditions import make_conditions
+
+    cond = json.loads(row["conditions_json"])
+    return Case(str(row["case_id"]), str(row["airport"]), str(row["type"]),
+                str(row["procedure"]), str(row["runway"] or ""), str(row["transition"] or ""),
+                str(row["aircraft"]), "", make_conditions(cond, f"case {row['case_id']}"),
+                int(row["campaign_seed"]), str(row["records_sha256"]))
+
+
+__all__ = ["CASE_ID_HEX", "TYPES", "TYPE_NAMES", "Case", "aircraft_files", "case_from_row",
+           "case_seed",
            "enumerate_cases", "flyable_sequences", "make_case", "parse_types", "records_sha256",
            "sample_airports", "used_lines"]

@@ -38,6 +38,16 @@ CASES = "cases"
 RUN_JSON = "run.json"
 
 
+def _umask() -> int:
+    old = os.umask(0)
+    os.umask(old)
+    return old
+
+
+_FILE_MODE = 0o666 & ~_umask()
+"""Mode of the files written (temporary files are created 0600; the results are not secret)."""
+
+
 def _fsync_dir(folder: Path) -> None:
     fd = os.open(folder, os.O_RDONLY)
     try:
@@ -49,6 +59,7 @@ def _fsync_dir(folder: Path) -> None:
 def write_json_atomic(path: Path, data: dict) -> None:
     """Strict JSON written to a temporary file beside ``path`` and renamed over it."""
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
+    os.fchmod(fd, _FILE_MODE)
     with os.fdopen(fd, "w") as fh:
         fh.write(dumps(data))
         fh.flush()
@@ -153,6 +164,7 @@ class BatchWriter:
         tab = table(self.rows)
         name = f"part-{time.time_ns():020d}-{os.getpid()}-{self.rows[0]['case_id']}.parquet"
         fd, tmp = tempfile.mkstemp(prefix=".part-", suffix=".tmp", dir=self.folder)
+        os.fchmod(fd, _FILE_MODE)
         try:
             with os.fdopen(fd, "wb") as fh:
                 pq.write_table(tab, fh, compression="zstd")

@@ -144,35 +144,57 @@ def fly_case(case, opts: FlyOptions) -> dict:
 
 
 def _fly(case, opts: FlyOptions, t0: float, stage: list[str]) -> dict:
+    db = worker_index(opts).db
+    row, res = fly_on(case, db, opts.db_path, opts.timeout_s, t0, stage)
+    if res is not None and opts.keep and opts.keep_dir:
+        stage[0] = "writing the kept artefacts"
+        res.save(Path(opts.keep_dir) / case.case_id, plots="plots" in opts.keep,
+                 command=["fms-testbed", "regress", "run", "case", case.case_id])
+    return row
+
+
+def fly_on(case, db, db_path: str, timeout_s: float | None = None,
+           t0: float | None = None, stage: list[str] | None = None):
+    """Build and fly one case from a loaded database; return (row, Results or None when the
+    procedure was not built). Raises what the flight raises (:func:`fly_case` records it).
+
+    Parameters
+    ----------
+    case : the :class:`~fms_testbed.campaign.cases.Case`
+    db : the loaded database; db_path : its file (named in the scenario)
+    timeout_s : wall-time limit from ``t0`` (``time.perf_counter()``), s; None: none
+    stage : a one-item list updated with what is being done (for a timeout's reason)
+    """
     from fms_testbed.loop.flight import Flight
     from fms_testbed.loop.procedure import prepare_procedure
     from fms_testbed.path.plan import merge_parts, select_parts
     from fms_testbed.procedures.integrity import refusal
     from fms_testbed.run.api import results_of
 
-    db = worker_index(opts).db
+    stage = stage if stage is not None else [""]
+    t0 = time.perf_counter() if t0 is None else t0
     stage[0] = "selecting the procedure"
     try:
         seq = merge_parts(select_parts(db, case.airport, case.procedure,
                                        case.transition or None, case.runway or None))
     except UserError as exc:
-        return failed_row(case, "impossible", str(exc))
+        return failed_row(case, "impossible", str(exc)), None
     if seq.degraded:
         row = failed_row(case, "degraded", refusal(seq.name, seq.defects))
         add_sequence(row, seq)
-        return row
+        return row, None
     stage[0] = "building the procedure"
     try:
-        scn, prepared = prepare_procedure(case.scenario(opts.db_path), f"case {case.case_id}",
+        scn, prepared = prepare_procedure(case.scenario(db_path), f"case {case.case_id}",
                                           db=db)
     except UserError as exc:
         row = failed_row(case, "impossible", str(exc))
         add_sequence(row, seq)
-        return row
+        return row, None
     stage[0] = "trimming"
     flight = Flight(scn, procedure=prepared, seed=case.seed, progress=False)
     stage[0] = "flying"
-    deadline = None if opts.timeout_s is None else t0 + opts.timeout_s
+    deadline = None if timeout_s is None else t0 + timeout_s
     timed_out = False
     while flight.step(STEP_CHUNK):
         if deadline is not None and time.perf_counter() > deadline:
@@ -184,15 +206,11 @@ def _fly(case, opts: FlyOptions, t0: float, stage: list[str]) -> dict:
     if timed_out:
         g = flight.guidance
         row.update(status="timeout", error_class=None,
-                   reason=f"--case-timeout {opts.timeout_s:g} s reached after "
+                   reason=f"--case-timeout {timeout_s:g} s reached after "
                           f"{row['sim_time_s']:.0f} s simulated, on leg {g.leg + 1} of "
                           f"{len(prepared.path.seq.legs)}")
-    if opts.keep and opts.keep_dir:
-        stage[0] = "writing the kept artefacts"
-        res.save(Path(opts.keep_dir) / case.case_id, plots="plots" in opts.keep,
-                 command=["fms-testbed", "regress", "run", "case", case.case_id])
-    return row
+    return row, res
 
 
-__all__ = ["STEP_CHUNK", "WATCHDOG_FACTOR", "CaseTimeout", "FlyOptions", "fly_case",
+__all__ = ["STEP_CHUNK", "WATCHDOG_FACTOR", "CaseTimeout", "FlyOptions", "fly_case", "fly_on",
            "init_pool_worker", "worker_index"]

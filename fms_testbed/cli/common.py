@@ -133,6 +133,8 @@ def print_results(res) -> None:
         print(f"{p['name']} ({p['type']}, {len(p['legs'])} legs, {p['length_nm']} NM, monitor "
               f"{p['monitor_status']}): {s['status']} ({s['reason']}), {s['duration_s']:.0f} s "
               f"flown in {s['wall_time_s']:.1f} s wall")
+        for d in p.get("degraded", []):
+            print(f"  DEGRADED (--allow-degraded): {d}")
         e = s.get("errors", {})
         if e:
             f, t, n = e["fte"], e["tse"], e["nse"]

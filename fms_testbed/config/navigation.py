@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import BaseModel, ConfigDict, Field
+from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 _FINITE = ConfigDict(extra="forbid", allow_inf_nan=False, strict=True)
 
@@ -52,7 +52,116 @@ class SinsBlock(BaseModel):
         0.0, description="reuse Φ_k, S_k this long before rebuilding F, s (0: every step)")
 
 
-NavigationBlock = Annotated[Union[TruthBlock, SinsBlock], Field(discriminator="source")]
+class IntervalBlock(BaseModel):
+    """A time interval of simulated time, s (``end_s`` omitted: to the end of the flight)."""
+
+    model_config = _FINITE
+    start_s: Annotated[float, Field(ge=0)] = Field(description="start, s")
+    end_s: Annotated[float, Field(gt=0)] | None = Field(None, description="end, s")
+
+    @model_validator(mode="after")
+    def _order(self):
+        if self.end_s is not None and self.end_s <= self.start_s:
+            raise ValueError(f"end_s {self.end_s:g} s must be after start_s {self.start_s:g} s")
+        return self
+
+
+class OutlierBlock(IntervalBlock):
+    """GNSS outlier burst: extra white position noise on the fixes inside the interval."""
+
+    sigma_m: Annotated[float, Field(gt=0, le=1e5)] = Field(
+        description="σ of the extra position noise per axis, m")
+
+
+class RampBlock(IntervalBlock):
+    """Slow GNSS ramp fault: a position error growing at ``rate_mps`` (E, N, U) from ``start_s``."""
+
+    rate_mps: Annotated[list[Annotated[float, Field(ge=-100, le=100)]],
+                        Field(min_length=3, max_length=3)] = Field(
+        description="ramp rate E, N, U, m/s")
+
+
+_Sig3 = Annotated[list[Annotated[float, Field(ge=0, le=1e4)]], Field(min_length=3, max_length=3)]
+"""Three values E, N, U (a YAML list)."""
+
+
+class GnssBlock(BaseModel):
+    """GNSS receiver: error model per ENU axis (1σ), timing, and truth-side faults."""
+
+    model_config = _FINITE
+    rate_hz: Annotated[float, Field(gt=0, le=50)] = Field(1.0, description="fix rate, Hz")
+    latency_s: Annotated[float, Field(ge=0, le=5)] = Field(
+        0.1, description="delivery delay after the time of validity, s (< the fix period)")
+    pos_markov_sigma_m: _Sig3 = Field([1.0, 1.0, 2.0], description="position Markov σ E, N, U, m")
+    pos_markov_tau_s: Annotated[float, Field(ge=1, le=1e5)] = Field(
+        300.0, description="position Markov correlation time, s")
+    pos_white_sigma_m: _Sig3 = Field([0.5, 0.5, 1.0], description="position white σ E, N, U, m")
+    vel_markov_sigma_mps: _Sig3 = Field([0.02, 0.02, 0.04],
+                                        description="velocity Markov σ E, N, U, m/s")
+    vel_markov_tau_s: Annotated[float, Field(ge=1, le=1e5)] = Field(
+        60.0, description="velocity Markov correlation time, s")
+    vel_white_sigma_mps: _Sig3 = Field([0.05, 0.05, 0.1],
+                                       description="velocity white σ E, N, U, m/s")
+    outages: list[IntervalBlock] = Field(default_factory=list, description="no fix inside these")
+    outliers: list[OutlierBlock] = Field(default_factory=list, description="outlier bursts")
+    ramps: list[RampBlock] = Field(default_factory=list, description="slow ramp faults")
+
+    @model_validator(mode="after")
+    def _latency(self):
+        if self.latency_s >= 1.0 / self.rate_hz:
+            raise ValueError(f"latency_s {self.latency_s:g} s must be below the fix period "
+                             f"{1.0 / self.rate_hz:g} s")
+        return self
+
+
+class BaroBlock(BaseModel):
+    """Baro altimeter: Gauss-Markov bias plus white noise (1σ)."""
+
+    model_config = _FINITE
+    markov_sigma_m: Annotated[float, Field(ge=0, le=1000)] = Field(5.0, description="bias σ, m")
+    markov_tau_s: Annotated[float, Field(ge=1, le=1e6)] = Field(
+        1800.0, description="bias correlation time, s")
+    white_sigma_m: Annotated[float, Field(gt=0, le=100)] = Field(0.5, description="white σ, m")
+    rate_hz: Annotated[float, Field(gt=0, le=50)] = Field(10.0, description="reading rate, Hz")
+    failed_from_s: Annotated[float, Field(ge=0)] | None = Field(
+        None, description="the output freezes from this time (stuck static port), s")
+
+
+class FilterBlock(BaseModel):
+    """INS/GNSS filter settings."""
+
+    model_config = _FINITE
+    gate_sigma: Annotated[float, Field(gt=0, le=100)] = Field(
+        5.0, description="innovation gate per component, σ")
+    unmodelled_tau_s: Annotated[float, Field(ge=0, le=1e5)] = Field(
+        100.0, description="correlation time of the noise standing in for the scale factors "
+                           "and misalignments the filter does not carry, s")
+    method: Literal["picard", "vanloan"] = Field("picard", description="discretisation")
+
+
+class InsGnssBlock(BaseModel):
+    """``navigation: {source: ins_gnss, imu: PRESET, ...}`` — INS(s) from the 33-state error
+    model, a GNSS receiver and a baro on the truth side, and a loosely coupled error-state
+    Kalman filter per INS (15 INS + 6 GNSS Markov + 1 baro states)."""
+
+    model_config = _FINITE
+    source: Literal["ins_gnss"]
+    imu: str | dict[str, Any] = Field(
+        description="IMU preset name (fms_testbed/data/imu/), a .yaml path, or an inline mapping")
+    n_ins: Annotated[int, Field(ge=1, le=3)] = Field(1, description="number of INS units")
+    seed: Annotated[int, Field(ge=0)] | None = Field(
+        None, description="seed of every error realisation (default: the run's seed)")
+    gnss: GnssBlock = Field(default_factory=GnssBlock, description="GNSS receiver")
+    baro: BaroBlock | None = Field(default_factory=BaroBlock,
+                                   description="baro altimeter (null: none)")
+    filter: FilterBlock = Field(default_factory=FilterBlock, description="filter settings")
+    alert_delay_s: Annotated[float, Field(ge=0, le=30)] | None = Field(
+        None, description="ANP > RNP must persist this long before the RNP alert, s (default: "
+                          "2 s, within the 10 s time to alert of terminal/approach)")
+
+
+NavigationBlock = Annotated[Union[TruthBlock, SinsBlock, InsGnssBlock],
+                            Field(discriminator="source")]
 """The navigation block of a scenario, discriminated by ``source``."""
 
 
@@ -63,4 +172,5 @@ def with_default_source(raw: Any) -> Any:
     return raw
 
 
-__all__ = ["NavigationBlock", "SinsBlock", "TruthBlock", "with_default_source"]
+__all__ = ["BaroBlock", "FilterBlock", "GnssBlock", "InsGnssBlock", "NavigationBlock", "SinsBlock",
+           "TruthBlock", "with_default_source"]

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from fms_testbed.core.contracts import NavigationSource
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.navigation.ins_gnss import InsGnssNavigation
 from fms_testbed.navigation.sins import SinsNavigation
 from fms_testbed.navigation.truth import TruthNavigation
 
@@ -18,6 +19,7 @@ from fms_testbed.navigation.truth import TruthNavigation
 SOURCES: dict[str, type] = {
     "truth": TruthNavigation,
     "sins": SinsNavigation,
+    "ins_gnss": InsGnssNavigation,
 }
 
 
@@ -37,4 +39,5 @@ def make_source(spec: dict | None, seed: int | None = None) -> NavigationSource:
     return SOURCES[name].from_spec(spec, seed=seed)
 
 
-__all__ = ["SOURCES", "make_source", "NavigationSource", "TruthNavigation", "SinsNavigation"]
+__all__ = ["SOURCES", "make_source", "NavigationSource", "TruthNavigation", "SinsNavigation",
+           "InsGnssNavigation"]

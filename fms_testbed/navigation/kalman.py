@@ -1,93 +1,118 @@
 """Discrete Kalman filter steps: prediction and the Joseph-form correction (with its innovation
 statistics), as plain functions on numpy arrays — the estimator knows nothing of INS or GNSS.
+Compiled with numba (a navigation step runs them several times at 10 Hz).
 
     prediction:  x⁻ = Φ x,  P⁻ = Φ P Φᵀ + Q_k
     correction:  ν = z - H x⁻,  S = H P⁻ Hᵀ + R,  K = P⁻ Hᵀ S⁻¹,
                  x = x⁻ + K ν,  P = (I - K H) P⁻ (I - K H)ᵀ + K R Kᵀ   (Joseph form)
 
 The Joseph form keeps P symmetric positive semidefinite for any gain (Bucy & Joseph 1968), which
-matters here because a gain row may be zeroed (:func:`correct` with ``frozen``: a channel
-excluded by the fault-tolerant estimator of seed 001 keeps its prediction) — the short form
-(I - K H) P⁻ is only right for the optimal K.
+matters here because gain rows may be zeroed (``frozen``: a channel excluded by the
+fault-tolerant estimator of seed 001 keeps its prediction) — the short form (I - K H) P⁻ is only
+right for the optimal K.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
-import scipy.linalg
+from numba import njit
 
 
-@dataclass(frozen=True)
-class Correction:
-    """Result of one correction.
-
-    x, P : corrected state and covariance
-    innovation : ν = z - H x⁻ (measurement units);  S : its covariance
-    nis : normalised innovation squared νᵀ S⁻¹ ν (χ² with len(z) degrees of freedom when the
-        filter is consistent)
-    """
-
-    x: np.ndarray
-    P: np.ndarray
-    innovation: np.ndarray
-    S: np.ndarray
-    nis: float
-
-
-def predict(x: np.ndarray, P: np.ndarray, phi: np.ndarray, qk: np.ndarray
-            ) -> tuple[np.ndarray, np.ndarray]:
-    """Prediction x⁻ = Φ x, P⁻ = Φ P Φᵀ + Q_k (symmetrised).
+@njit(cache=True)
+def predict(x, P, phi, qk):
+    """Prediction (x⁻, P⁻) = (Φ x, Φ P Φᵀ + Q_k), P⁻ symmetrised.
 
     Parameters
     ----------
     x : (n,) state;  P : (n, n) covariance, state units²
     phi : (n, n) transition over the step;  qk : (n, n) discrete process-noise covariance
     """
-    P = phi @ P @ phi.T + qk
-    return phi @ x, 0.5 * (P + P.T)
+    Pn = phi @ P @ phi.T + qk
+    return phi @ x, 0.5 * (Pn + Pn.T)
 
 
-def innovation(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray
-               ) -> tuple[np.ndarray, np.ndarray, float]:
-    """(ν, S, NIS) of a measurement before it is used (gating, fault detection).
+@njit(cache=True)
+def innovation(x, P, z, H, R):
+    """(ν, S, NIS) of a measurement z = H x + v, v ~ N(0, R), before it is used.
 
     Parameters
     ----------
     z : (m,) measurement;  H : (m, n);  R : (m, m) measurement-noise covariance
+
+    Returns
+    -------
+    ν = z - H x (m,), S = H P Hᵀ + R (m, m), NIS = νᵀ S⁻¹ ν (χ²_m for a consistent filter)
     """
     nu = z - H @ x
     S = H @ P @ H.T + R
     S = 0.5 * (S + S.T)
-    c = scipy.linalg.cho_factor(S, lower=True, check_finite=False)
-    return nu, S, float(nu @ scipy.linalg.cho_solve(c, nu, check_finite=False))
+    return nu, S, float(nu @ np.linalg.solve(S, nu))
 
 
-def correct(x: np.ndarray, P: np.ndarray, z: np.ndarray, H: np.ndarray, R: np.ndarray,
-            frozen: np.ndarray | None = None) -> Correction:
+@njit(cache=True)
+def correct(x, P, z, H, R, frozen):
     """Joseph-form correction with measurement z = H x + v, v ~ N(0, R).
 
     Parameters
     ----------
     x : (n,) predicted state;  P : (n, n) predicted covariance
     z : (m,) measurement;  H : (m, n);  R : (m, m)
-    frozen : optional (n,) bool mask of states whose gain rows are zeroed: they keep their
-        prediction (a channel excluded by the fault-tolerant estimator, seed 001); P stays the
-        exact covariance of that sub-optimal estimate (Joseph form)
+    frozen : (n,) bool, states whose gain rows are zeroed: they keep their prediction (a channel
+        excluded by the fault-tolerant estimator, seed 001); P stays the exact covariance of that
+        sub-optimal estimate (Joseph form)
 
     Returns
     -------
-    :class:`Correction`
+    (x, P, ν, S, NIS) : corrected state and covariance, innovation, its covariance, and
+    νᵀ S⁻¹ ν
     """
     nu, S, nis = innovation(x, P, z, H, R)
     PHt = P @ H.T
-    K = scipy.linalg.solve(S, PHt.T, assume_a="pos", check_finite=False).T
-    if frozen is not None:
-        K[frozen] = 0.0
+    K = np.linalg.solve(S, PHt.T).T          # S symmetric: K = P Hᵀ S⁻¹
+    for i in range(x.size):
+        if frozen[i]:
+            K[i, :] = 0.0
     A = np.eye(x.size) - K @ H
-    P = A @ P @ A.T + K @ R @ K.T
-    return Correction(x + K @ nu, 0.5 * (P + P.T), nu, S, nis)
+    Pn = A @ P @ A.T + K @ R @ K.T
+    return x + K @ nu, 0.5 * (Pn + Pn.T), nu, S, nis
 
 
-__all__ = ["Correction", "correct", "innovation", "predict"]
+@njit(cache=True)
+def correct_delayed(x, P, z, H, R, phi_lag, q_lag, frozen):
+    """Correction with a measurement valid before the filter's time (latency), exact when no
+    other measurement was used in between.
+
+    With x(t) = Φ x(t_m) + w (w ~ N(0, Q_lag), independent of x(t_m)) and z = H x(t_m) + v:
+    H_m = H Φ⁻¹, ν = z - H_m x̂(t), C = (P - Q_lag) H_mᵀ = Cov(x(t) - x̂, ν),
+    S = H_m (P - Q_lag) H_mᵀ + R, K = C S⁻¹, x̂ += K ν,
+    P ← P - K Cᵀ - C Kᵀ + K S Kᵀ (valid for any K, e.g. frozen rows; with Φ = I, Q_lag = 0 it is
+    the Joseph form of :func:`correct`).
+
+    Parameters
+    ----------
+    x, P : the filter's state and covariance at its time t
+    z, H, R : measurement valid at t_m, its matrix for the state at t_m, its noise covariance
+    phi_lag : Φ(t, t_m);  q_lag : process-noise covariance accumulated over (t_m, t]
+    frozen : (n,) bool, states whose gain rows are zeroed
+
+    Returns
+    -------
+    (x, P, ν, S, NIS)
+    """
+    Hm = np.linalg.solve(phi_lag.T, H.T).T           # H Φ⁻¹
+    Pm = P - q_lag
+    C = Pm @ Hm.T
+    S = Hm @ C + R
+    S = 0.5 * (S + S.T)
+    nu = z - Hm @ x
+    nis = float(nu @ np.linalg.solve(S, nu))
+    K = np.linalg.solve(S, C.T).T
+    for i in range(x.size):
+        if frozen[i]:
+            K[i, :] = 0.0
+    KC = K @ C.T
+    Pn = P - KC - KC.T + K @ S @ K.T
+    return x + K @ nu, 0.5 * (Pn + Pn.T), nu, S, nis
+
+
+__all__ = ["correct", "correct_delayed", "innovation", "predict"]

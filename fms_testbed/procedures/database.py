@@ -165,7 +165,9 @@ class Database:
                for e in self._rejected_refs.get(("airport", airport), ())]
         for lg in legs:
             for what, ref in (("fix", lg.fix), ("navaid", lg.navaid), ("centre fix", lg.centre)):
-                for e in self._rejected_refs.get(("fix", ref.ident), ()) if ref else ():
+                found = (self._rejected_refs.get((airport, ref.ident), [])
+                         + self._rejected_refs.get(("", ref.ident), [])) if ref else []
+                for e in found:
                     out.append(Defect("fix-rejected", (lg.line, e.line), what,
                                       f"leg {lg.seq:03d} names {ref.ident}, whose record "
                                       f"(line {e.line}) was rejected: {e.field}: {e.reason}",

@@ -51,9 +51,9 @@ class Scan:
     raw_procs: airport -> [(line, record)] of the primary procedure records whose key reads;
     key_lines: transition -> every line of it (primary, continuation, rejected) in file order;
     keys_by_airport: airport -> its transitions in file order; owner: line -> transition;
-    key_defects: transition -> defects found here; rejected_refs: ('fix', ident) or
-    ('airport', ident) -> the rejected records that carried that ident; errors: every rejected
-    record.
+    key_defects: transition -> defects found here; rejected_refs: (airport, ident) for a
+    terminal fix, ('', ident) for an enroute one, ('airport', ident) for an airport reference
+    point -> the rejected records that carried it; errors: every rejected record.
     """
 
     file: str
@@ -211,8 +211,12 @@ def scan_text(text: str, file: str) -> Scan:
             cols = _IDENT_COLS.get(sec)
             ident = rec[cols[0] - 1:cols[1]].strip() if cols else ""
             if ident:
-                kind = "airport" if sec == "PA" else "fix"
-                scan.rejected_refs.setdefault((kind, ident), []).append(bad)
+                apt = rec[6:10].strip()
+                scopes = (("airport", ident),) if sec == "PA" else (
+                    (("", ident),) if sec in ("EA", "DB") or not apt else
+                    ((apt, ident),) if sec != "D " else (("", ident), (apt, ident)))
+                for scope in scopes:
+                    scan.rejected_refs.setdefault(scope, []).append(bad)
     skip = {e.line for e in unattributed}
     for err in unattributed:
         for key in {k for k in (_neighbour(scan, lines, err.line, -1, skip),

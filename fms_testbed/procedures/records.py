@@ -83,7 +83,8 @@ def parse_vhf(rec: str, line: int) -> Fix:
                region=read_ident(rec, 20, 21, "ICAO region"), section="D ",
                lat_deg=lat, lon_deg=lon, magvar_deg=parse_magvar(rec, 75),
                elev_m=None if elev is None else elev * FT_M,
-               airport=read_ident(rec, 7, 10, "airport ident"), dme_lat_deg=dme_lat, dme_lon_deg=dme_lon, line=line)
+               airport=read_ident(rec, 7, 10, "airport ident"), dme_lat_deg=dme_lat,
+               dme_lon_deg=dme_lon, line=line)
 
 
 def parse_ndb(rec: str, line: int) -> Fix:

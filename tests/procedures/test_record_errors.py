@@ -318,3 +318,12 @@ def test_the_size_is_checked_before_reading(monkeypatch):
     monkeypatch.setattr(dbmod, "MAX_DB_BYTES", 100_000)
     with pytest.raises(UserError, match="larger than"):
         load_database(EXCERPT)
+
+
+def test_the_documented_ranges_are_the_ones_checked():
+    from pathlib import Path
+
+    from fms_testbed.procedures.fields import RANGES
+    doc = (Path(__file__).resolve().parents[2] / "docs" / "procedures-integrity.md").read_text()
+    for name, (lo, hi, unit) in RANGES.items():
+        assert f"| {name} | {lo} – {hi} | {unit} |" in doc, name

@@ -1,0 +1,314 @@
+"""``regress report DIR``: one self-contained HTML page (``DIR/report.html``, figures embedded
+as PNG data) on a regression run.
+
+Sections: the run (command, version, database and its SHA-256, size, speed); outcome counts
+by status, by procedure type, by airport and by leg code; the FTE/TSE distributions; the worst
+cases with their ground tracks; monitor findings by class; error classes (Danilin 1/2/3) with
+the class-1 cross-check; the residual-error rate per Danilin phase; the cases that raised.
+
+Residual-error rate (Danilin, seed 000: the residual error rate of each phase decides whether
+the software goes on to the next): the share of the cases that were flown (or tried to be:
+every case but those not built, :data:`~.rows.NOT_FLOWN`) that failed for a reason of the
+software under test — error class 1 or 2, a timeout or an exception — with a 95 % Wilson
+interval. Class 3 (database coding errors) are findings about the database, counted apart.
+
+Class-1 cross-check: a failure in wind, turbulence or on a navigation source is class 1 by its
+row; where the run also flew the same sequence with the same aircraft in nominal conditions and
+that flight failed too, the conditions are not the cause: the report counts it as class 2.
+
+Worst cases: the flown cases that are not ``ok``, most severe status first, then the largest
+max TSE (all cases by max TSE when every case is ``ok``). Their tracks are drawn by flying them
+again from the run's database (the same case id gives the same seed, so the same flight; the
+report says whether the re-flown status and max TSE equal the recorded ones) unless
+``--no-refly``.
+"""
+
+from __future__ import annotations
+
+import base64
+import html
+import io
+import logging
+from functools import lru_cache
+from pathlib import Path
+
+import pandas as pd
+
+from fms_testbed.campaign import figures
+from fms_testbed.campaign.rows import ERROR_CLASSES, NOT_FLOWN, STATUSES
+from fms_testbed.campaign.store import read_flights, read_run_json
+from fms_testbed.core.errors import UserError
+
+log = logging.getLogger(__name__)
+
+PHASES = (
+    ("test database", "≈ 50 synthesised procedures; nominal and varied conditions",
+     "≤ 100 procedures"),
+    ("integration", "≈ 100 airports, > 5,000 procedure flights under varied conditions",
+     "≥ 100 airports and ≥ 5,000 flights"),
+)
+"""Danilin's phases: name, what the paper flies, the criterion a run is held to."""
+
+
+def png_data_uri(fig, dpi: int = 90) -> str:
+    """A Figure as a ``data:image/png;base64,…`` URI (the report embeds every figure)."""
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=dpi)
+    return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
+
+
+def wilson_interval(k: int, n: int) -> tuple[float, float]:
+    """95 % Wilson score interval of a proportion k/n (scipy's ``binomtest``)."""
+    from scipy.stats import binomtest
+
+    if n == 0:
+        return float("nan"), float("nan")
+    ci = binomtest(k, n).proportion_ci(confidence_level=0.95, method="wilson")
+    return float(ci.low), float(ci.high)
+
+
+def refined_classes(df: pd.DataFrame) -> pd.Series:
+    """The error class of each row after the class-1 cross-check (module docstring)."""
+    cls = df["error_class"].astype("Float64")
+    nominal = df["conditions_json"].map(_is_nominal)
+    seq = ["airport", "type", "procedure", "runway", "transition", "aircraft"]
+    nom = df[nominal].set_index(seq)["status"]
+    nom = nom[~nom.index.duplicated()]
+    idx = pd.MultiIndex.from_frame(df[seq])
+    twin = pd.Series(nom.reindex(idx).to_numpy(), index=df.index)
+    bad_twin = twin.notna() & (twin != "ok") & ~twin.isin(NOT_FLOWN)
+    return cls.mask((cls == 1) & bad_twin, 2)
+
+
+def _is_nominal(cond_json: str) -> bool:
+    import json
+
+    from fms_testbed.campaign.conditions import make_conditions
+
+    return make_conditions(json.loads(cond_json), "conditions").nominal
+
+
+def class_counts(df: pd.DataFrame) -> dict[str, int]:
+    """Cases per error class after the cross-check, and the failures no class applies to."""
+    cls = refined_classes(df)
+    out = {f"{k}: {v.split(':')[0]}": int((cls == k).sum()) for k, v in ERROR_CLASSES.items()}
+    out["refused by the monitor (impossible)"] = int((df["status"] == "impossible").sum())
+    out["timeout / error"] = int(df["status"].isin(("timeout", "error")).sum())
+    return out
+
+
+def residual(df: pd.DataFrame) -> dict:
+    """Residual-error rate of a run (module docstring)."""
+    tried = df[~df["status"].isin(NOT_FLOWN)]
+    cls = refined_classes(tried)
+    k = int(((cls == 1) | (cls == 2)).sum() + tried["status"].isin(("timeout", "error")).sum())
+    n = len(tried)
+    lo, hi = wilson_interval(k, n)
+    return {"flown": n, "residual_errors": k, "rate": k / n if n else float("nan"),
+            "ci_low": lo, "ci_high": hi, "class3": int((df["status"] == "degraded").sum())}
+
+
+def phase_row(folder: Path, df: pd.DataFrame, info: dict) -> dict:
+    """One row of the phase table."""
+    r = residual(df)
+    n_air = df["airport"].nunique()
+    n_proc = len(df.groupby(["airport", "procedure"]))
+    phase = info.get("phase") or "?"
+    crit = {"integration": n_air >= 100 and len(df) >= 5000, "test database": n_proc <= 100}
+    return {"run": folder.name, "phase": phase,
+            "criterion met": {True: "yes", False: "no"}.get(crit.get(phase), "—"),
+            "airports": n_air, "procedures": n_proc, "cases": len(df), "flown": r["flown"],
+            "residual errors": r["residual_errors"],
+            "residual-error rate": f"{100 * r['rate']:.2f} % "
+                                   f"[{100 * r['ci_low']:.2f}, {100 * r['ci_high']:.2f}]",
+            "class 3 found": r["class3"]}
+
+
+def worst_cases(df: pd.DataFrame, n: int) -> pd.DataFrame:
+    """The ``n`` worst flown cases (module docstring)."""
+    flown = df[~df["status"].isin(NOT_FLOWN)].copy()
+    bad = flown[flown["status"] != "ok"]
+    pool = bad if len(bad) else flown
+    pool = pool.assign(_sev=pool["status"].map(STATUSES.index),
+                       _tse=pool["tse_max_m"].fillna(-1.0))
+    return pool.sort_values(["_sev", "_tse"], ascending=[True, False], kind="stable").head(n)
+
+
+@lru_cache(maxsize=2)
+def _index(path: str):
+    from fms_testbed.procedures.index import load_index
+
+    return load_index(path)
+
+
+def _track(row, info: dict) -> tuple[str | None, str]:
+    """The re-flown ground-track figure of a case (data URI) and a note."""
+    from fms_testbed.campaign.cases import case_from_row
+    from fms_testbed.campaign.worker import fly_on
+    from fms_testbed.viz.procedure import plot_ground_track
+
+    dbinfo = info.get("database", {})
+    ix = _index(dbinfo.get("path"))
+    if ix.sha256 != dbinfo.get("sha256"):
+        return None, f"not re-flown: {ix.path} changed since the run"
+    again, res = fly_on(case_from_row(row), ix.db, str(ix.path))
+    if res is None:
+        return None, f"not re-flown: {again['reason']}"
+    same = again["status"] == row["status"] and (
+        again["tse_max_m"] == row["tse_max_m"]
+        or (pd.isna(again["tse_max_m"]) and pd.isna(row["tse_max_m"])))
+    note = ("re-flown: same status and max TSE as recorded" if same else
+            f"re-flown: now {again['status']}, max TSE {again['tse_max_m']} m (recorded "
+            f"{row['status']}, {row['tse_max_m']} m): the code or the machine changed since")
+    fig = plot_ground_track(res.df, res.summary, res.procedure.path, tuple(res.flown_paths))
+    return png_data_uri(fig), note
+
+
+_CSS = """
+body{font-family:system-ui,sans-serif;margin:2em auto;max-width:1100px;color:#222}
+h1{font-size:1.5em} h2{font-size:1.2em;margin-top:2em;border-bottom:1px solid #ccc}
+table.t{border-collapse:collapse;font-size:0.85em;margin:0.5em 0}
+table.t td,table.t th{border:1px solid #ccc;padding:2px 6px;text-align:left}
+table.t th{background:#f2f2f2} img{max-width:100%;display:block;margin:0.5em 0}
+code{background:#f5f5f5;padding:0 3px} .note{color:#555;font-size:0.85em}
+"""
+_RENDER_CHECK = """<script>
+window.addEventListener('load', function () {
+  var imgs = document.images, ok = 0;
+  for (var i = 0; i < imgs.length; i++) { if (imgs[i].naturalWidth > 0) ok++; }
+  document.body.setAttribute('data-figures', imgs.length);
+  document.body.setAttribute('data-figures-rendered', ok);
+  document.getElementById('render-check').textContent =
+    ok + ' of ' + imgs.length + ' figures rendered in this browser';
+});
+</script>"""
+
+
+def _table(df: pd.DataFrame) -> str:
+    return df.to_html(index=False, escape=True, na_rep="—", classes="t", border=0,
+                      float_format=lambda v: f"{v:.4g}")
+
+
+def _img(fig, alt: str) -> str:
+    return f'<img alt="{html.escape(alt)}" src="{png_data_uri(fig)}">'
+
+
+def build_html(folder: Path, df: pd.DataFrame, info: dict, worst: int = 6,
+               others: list[tuple[Path, pd.DataFrame, dict]] = (), refly: bool = True) -> str:
+    """The report page (module docstring) as HTML text."""
+    e = html.escape
+    db = info.get("database", {})
+    sess = (info.get("sessions") or [{}])[-1]
+    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+             f"<title>regress report: {e(folder.name)}</title><style>{_CSS}</style></head>"
+             f"<body><h1>Regression run <code>{e(folder.name)}</code></h1>",
+             "<table class='t'>" + "".join(
+                 f"<tr><th>{e(k)}</th><td>{e(str(v))}</td></tr>" for k, v in (
+                     ("command", " ".join(map(str, info.get("command", [])))),
+                     ("fms-testbed", info.get("version")),
+                     ("database", f"{db.get('path')} (SHA-256 {db.get('sha256')})"),
+                     ("status", f"{info.get('status')}: {len(df)} of "
+                                f"{info.get('cases', {}).get('count')} cases written"),
+                     ("phase", info.get("phase")),
+                     ("last session", f"{sess.get('cases_flown')} cases in "
+                                      f"{sess.get('elapsed_s')} s, {sess.get('flights_per_hour')} "
+                                      f"flights/h, workers {sess.get('workers')}, scheduler "
+                                      f"{sess.get('scheduler')}"),
+                     ("finished (UTC)", info.get("finished_utc")))) + "</table>"]
+    counts = df["status"].value_counts().reindex([s for s in STATUSES
+                                                  if s in set(df["status"])])
+    parts += ["<h2>Outcomes</h2>", _table(pd.DataFrame({
+        "status": counts.index, "cases": counts.to_numpy(),
+        "share": [f"{100 * v / len(df):.1f} %" for v in counts.to_numpy()]}))]
+    if not len(df):
+        parts.append("<p>No case written yet.</p>")
+    else:
+        parts += [_img(figures.plot_outcomes_by_type(df), "outcome by type"),
+                  _img(figures.plot_outcomes_by_airport(df), "outcome by airport"),
+                  _img(figures.plot_outcomes_by_leg_code(df), "outcome by leg code"),
+                  "<h2>FTE / TSE</h2>",
+                  _img(figures.plot_error_distributions(df), "FTE/TSE distributions")]
+        parts += _worst_section(df, info, worst, refly)
+        parts += ["<h2>Monitor findings</h2>", _img(figures.plot_findings(df), "findings")]
+        fc = figures.finding_counts(df)
+        if len(fc):
+            parts.append(_table(fc.rename_axis("class").reset_index(name="cases")))
+        parts += _class_section(df)
+    rows = [phase_row(folder, df, info)] + [phase_row(f, d, i) for f, d, i in others]
+    parts += ["<h2>Residual-error rate per Danilin phase</h2>",
+              "<p class='note'>Residual errors: class 1 or 2 failures, timeouts and exceptions, "
+              "over the cases flown (all but those not built); 95 % Wilson interval in "
+              "brackets. Class 3 (database coding errors) counted apart.</p>",
+              _table(pd.DataFrame(rows)),
+              _table(pd.DataFrame(PHASES, columns=["phase", "Danilin (seed 000)",
+                                                   "criterion here"]))]
+    err = df[df["status"] == "error"]
+    if len(err):
+        parts += ["<h2>Cases that raised</h2>", _table(
+            err.groupby(["error_type"]).agg(cases=("case_id", "size"),
+                                            example=("reason", "first")).reset_index())]
+        tb = err["traceback"].dropna()
+        tb = tb[tb != ""]
+        if len(tb):
+            parts.append(f"<pre>{e(tb.iloc[0])}</pre>")
+    parts += ["<p class='note' id='render-check'></p>", _RENDER_CHECK, "</body></html>"]
+    return "\n".join(parts)
+
+
+def _worst_section(df: pd.DataFrame, info: dict, n: int, refly: bool) -> list[str]:
+    w = worst_cases(df, n)
+    cols = ["case_id", "airport", "type", "procedure", "runway", "transition", "aircraft",
+            "conditions", "status", "reason", "fte_p95_m", "tse_p95_m", "tse_max_m"]
+    out = [f"<h2>Worst cases ({len(w)})</h2>", _table(w[cols])]
+    if not refly:
+        return out + ["<p class='note'>Tracks not drawn (--no-refly).</p>"]
+    for _, row in w.iterrows():
+        try:
+            uri, note = _track(row, info)
+        except UserError as exc:
+            uri, note = None, f"not re-flown: {exc}"
+        title = " ".join(str(row[c]) for c in ("airport", "type", "procedure", "runway",
+                                               "transition", "aircraft", "conditions") if row[c])
+        out.append(f"<h3>{html.escape(title)}: {html.escape(row['status'])}</h3>"
+                   f"<p class='note'>{html.escape(note)}</p>")
+        if uri:
+            out.append(f'<img alt="track of {html.escape(row["case_id"])}" src="{uri}">')
+    return out
+
+
+def _class_section(df: pd.DataFrame) -> list[str]:
+    counts = class_counts(df)
+    cls = refined_classes(df)
+    moved = int(((df["error_class"] == 1) & (cls == 2)).sum())
+    text = "".join(f"<li><b>{k}</b>: {html.escape(v)}</li>" for k, v in ERROR_CLASSES.items())
+    return ["<h2>Error classes</h2>", f"<ul>{text}</ul>",
+            f"<p class='note'>Cross-check: {moved} failure(s) in non-nominal conditions whose "
+            "nominal flight also failed are counted as class 2.</p>",
+            _img(figures.plot_error_classes(counts), "error classes")]
+
+
+def write_report(folder: str | Path, worst: int = 6, others: list = (),
+                 refly: bool = True) -> Path:
+    """Write ``DIR/report.html`` (module docstring); return its path."""
+    folder = Path(folder)
+    info = read_run_json(folder)
+    if info is None:
+        raise UserError(f"{folder}: not a regress run folder (no run.json)")
+    df = read_flights(folder)
+    more = []
+    for o in others:
+        o = Path(o)
+        oi = read_run_json(o)
+        if oi is None:
+            raise UserError(f"--with {o}: not a regress run folder (no run.json)")
+        more.append((o, read_flights(o), oi))
+    text = build_html(folder, df, info, worst, more, refly)
+    out = folder / "report.html"
+    tmp = folder / ".report.html.tmp"
+    tmp.write_text(text, encoding="utf-8")
+    tmp.replace(out)
+    return out
+
+
+__all__ = ["PHASES", "build_html", "class_counts", "phase_row", "png_data_uri",
+           "refined_classes", "residual", "wilson_interval", "worst_cases", "write_report"]

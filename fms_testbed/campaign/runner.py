@@ -1,0 +1,261 @@
+"""A regression run: plan the cases, fly those not yet flown, write the dataset and ``run.json``.
+
+:func:`plan` loads the database through its index, picks the airports (given, all, or a seeded
+sample: :func:`~.cases.sample_airports`) and enumerates the cases (:mod:`.cases`).
+:func:`run_campaign` checks the output folder, resumes what a previous run of the same cases
+left there (same case set, or a one-line refusal), flies the rest on the local pool or a Dask
+cluster (:mod:`.executors`) and writes rows as they arrive (:mod:`.store`), with a progress bar
+(cases/s and ETA) on a terminal. Interrupted (Ctrl-C, SIGTERM, SIGKILL), it leaves ``run.json``
+with ``status: running`` and every finished batch; the same command resumes.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import sys
+import time
+from collections import Counter
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from fms_testbed.campaign.cases import (TYPE_NAMES, Case, aircraft_files, enumerate_cases,
+                                        sample_airports)
+from fms_testbed.campaign.conditions import Conditions, check_sources
+from fms_testbed.campaign.executors import run_dask, run_local
+from fms_testbed.campaign.store import (CASES, RUN_JSON, BatchWriter, RunLock,
+                                        clean_partial, finished_ids, part_files, read_run_json,
+                                        utc_now, write_json_atomic)
+from fms_testbed.campaign.worker import FlyOptions
+from fms_testbed.core.errors import UserError
+from fms_testbed.procedures.index import DatabaseIndex, load_index, parser_hash
+from fms_testbed.run.outputs import check_out_dir
+
+RUN_KIND = "regress-run"
+"""``run.json`` ``kind`` of a regression run folder."""
+KEEP = ("timeseries", "plots")
+"""Per-case artefacts ``--keep`` can keep."""
+
+
+@dataclass
+class RunConfig:
+    """A regression run's options (the ``regress run`` command line; units in the names).
+
+    Attributes
+    ----------
+    out : campaign folder
+    db : ARINC-424 file (None/'embedded': the embedded excerpt)
+    airports : ICAO idents (None: every airport with procedures)
+    sample_airports, sample_seed, sample_min_transitions : a seeded sample of the airports
+        (:func:`~.cases.sample_airports`); None: no sampling
+    types : subsection codes to fly ('D', 'E', 'F')
+    aircraft : aircraft names or files
+    conditions : condition sets (:mod:`.conditions`)
+    combinations : 'each' or 'all' (:mod:`.cases`)
+    limit : fly the first ``limit`` cases only
+    seed : campaign seed (part of every case id)
+    workers : local pool size; scheduler : Dask scheduler address (instead of the pool)
+    case_timeout_s : wall-time limit of one case, s (None: none)
+    keep : per-case artefacts (:data:`KEEP`)
+    progress : progress bar (None: on a terminal)
+    command : the command line recorded in ``run.json`` (default ``sys.argv``)
+    cache_dir : database index cache folder (None: the default)
+    phase : Danilin phase label for the report (None: inferred from the run's size)
+    batch_rows, batch_s : rows per part file, longest a row waits in memory (s)
+    """
+
+    out: Path
+    conditions: list[Conditions]
+    db: str | None = None
+    airports: list[str] | None = None
+    sample_airports: int | None = None
+    sample_seed: int = 0
+    sample_min_transitions: int = 1
+    types: list[str] = field(default_factory=lambda: ["D", "E", "F"])
+    aircraft: list[str] = field(default_factory=lambda: ["737"])
+    combinations: str = "each"
+    limit: int | None = None
+    seed: int = 0
+    workers: int = 1
+    scheduler: str | None = None
+    case_timeout_s: float | None = None
+    keep: tuple[str, ...] = ()
+    progress: bool | None = None
+    command: list[str] | None = None
+    cache_dir: str | None = None
+    phase: str | None = None
+    batch_rows: int = 64
+    batch_s: float = 15.0
+
+
+def select_airports(index: DatabaseIndex, cfg: RunConfig) -> list[str]:
+    """The airports of the run: given (checked, upper-cased, repeats merged) or all, then
+    sampled when asked."""
+    from fms_testbed.evaluation.check import merge_airports
+    from fms_testbed.procedures.catalogue import check_airport
+
+    db = index.db
+    given = merge_airports(cfg.airports)
+    airports = [check_airport(db, a) for a in given] if given else db.airport_idents()
+    if cfg.sample_airports is not None:
+        airports = sample_airports(db, airports, cfg.sample_airports, cfg.sample_seed,
+                                   cfg.types, cfg.sample_min_transitions)
+    return airports
+
+
+def plan(cfg: RunConfig) -> tuple[DatabaseIndex, list[str], list[Case]]:
+    """The database index, the airports and the cases of a run (module docstring)."""
+    if cfg.combinations not in ("each", "all"):
+        raise UserError(f"--combinations {cfg.combinations!r}: expected 'each' or 'all'")
+    if cfg.limit is not None and cfg.limit < 1:
+        raise UserError(f"--limit {cfg.limit}: must be at least 1")
+    bad = sorted(set(cfg.keep) - set(KEEP))
+    if bad:
+        raise UserError(f"--keep {','.join(cfg.keep)}: {bad[0]!r} is not one of "
+                        f"{', '.join(KEEP)}")
+    if cfg.case_timeout_s is not None and not cfg.case_timeout_s > 0:
+        raise UserError(f"--case-timeout {cfg.case_timeout_s:g}: must be > 0 s")
+    check_sources(cfg.conditions)
+    aircraft = aircraft_files(cfg.aircraft)
+    index = load_index(cfg.db, cfg.cache_dir)
+    airports = select_airports(index, cfg)
+    cases = enumerate_cases(index, airports, cfg.types, aircraft, cfg.conditions,
+                            cfg.combinations, cfg.seed, cfg.limit)
+    if not cases:
+        kinds = ", ".join(TYPE_NAMES[t] for t in cfg.types)
+        raise UserError(f"{index.path}: no {kinds} procedure at {', '.join(airports[:5])}"
+                        f"{' …' if len(airports) > 5 else ''}: no case to fly")
+    return index, airports, cases
+
+
+def case_set_sha256(cases: list[Case]) -> str:
+    """SHA-256 of the sorted case ids: what a resumed run must match."""
+    return hashlib.sha256("\n".join(sorted(c.case_id for c in cases)).encode()).hexdigest()
+
+
+def infer_phase(n_airports: int, n_cases: int, n_procedures: int) -> str:
+    """Danilin's phase a run's size corresponds to: 'integration' (≥ 100 airports and ≥ 5,000
+    flights), 'test database' (≤ 100 procedures), else 'between phases'."""
+    if n_airports >= 100 and n_cases >= 5000:
+        return "integration"
+    if n_procedures <= 100:
+        return "test database"
+    return "between phases"
+
+
+def _status_counts(out: Path) -> Counter:
+    import pyarrow.parquet as pq
+
+    c: Counter = Counter()
+    for p in part_files(out):
+        c.update(pq.read_table(p, columns=["status"]).column("status").to_pylist())
+    return c
+
+
+def _bar(total: int, initial: int, progress: bool | None):
+    if progress is False:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, initial=initial, unit="case", desc="regress run", smoothing=0.05,
+                dynamic_ncols=True, disable=None if progress is None else False)
+
+
+def run_campaign(cfg: RunConfig) -> dict:
+    """Fly a campaign into ``cfg.out`` (module docstring); return the final ``run.json``."""
+    out = check_out_dir(cfg.out)
+    prev = read_run_json(out)
+    if prev is not None and prev.get("kind") != RUN_KIND:
+        raise UserError(f"--out {out}: holds another kind of testbed run "
+                        f"({prev.get('command', ['?'])[1:2] or '?'}); give a new folder")
+    if cfg.scheduler is None and cfg.workers < 1:
+        raise UserError(f"--workers {cfg.workers}: must be at least 1")
+    t_plan = time.perf_counter()
+    index, airports, cases = plan(cfg)
+    t_plan = time.perf_counter() - t_plan
+    set_sha = case_set_sha256(cases)
+    if prev is not None and prev.get("cases", {}).get("set_sha256") != set_sha:
+        raise UserError(f"--out {out}: holds a run of other cases ({prev['cases'].get('count')} "
+                        f"cases, database SHA-256 {prev.get('database', {}).get('sha256', '?')[:12]}…); "
+                        "give the same options to resume it, or a new folder")
+    out.mkdir(parents=True, exist_ok=True)
+    with RunLock(out):
+        clean_partial(out)
+        done = finished_ids(out)
+        todo = [c for c in cases if c.case_id not in done]
+        n_proc = len({(c.airport, c.procedure) for c in cases})
+        info = {
+            "tool": "fms-testbed", "kind": RUN_KIND, "version": _version(),
+            "command": cfg.command if cfg.command is not None else sys.argv,
+            "status": "running",
+            "database": {"path": str(index.path), "sha256": index.sha256,
+                         "parser_sha256": parser_hash(), "index": index.source,
+                         "index_load_s": round(index.load_s, 3)},
+            "cases": {"count": len(cases), "set_sha256": set_sha, "airports": len(airports),
+                      "procedures": n_proc},
+            "phase": cfg.phase or infer_phase(len(airports), len(cases), n_proc),
+            "options": {"airports": airports, "types": [TYPE_NAMES[t] for t in cfg.types],
+                        "aircraft": cfg.aircraft,
+                        "conditions": [c.canonical() for c in cfg.conditions],
+                        "combinations": cfg.combinations, "limit": cfg.limit, "seed": cfg.seed,
+                        "sample": None if cfg.sample_airports is None else {
+                            "airports": cfg.sample_airports, "seed": cfg.sample_seed,
+                            "min_transitions": cfg.sample_min_transitions},
+                        "case_timeout_s": cfg.case_timeout_s, "keep": list(cfg.keep)},
+            "execution": {"workers": None if cfg.scheduler else cfg.workers,
+                          "scheduler": cfg.scheduler},
+            "started_utc": (prev or {}).get("started_utc") or utc_now(),
+            "sessions": list((prev or {}).get("sessions", [])),
+        }
+        write_json_atomic(out / RUN_JSON, info)
+        opts = FlyOptions(str(index.path), index.sha256, cfg.case_timeout_s, tuple(cfg.keep),
+                          str(out / CASES) if cfg.keep else None, cfg.cache_dir)
+        writer = BatchWriter(out, cfg.batch_rows, cfg.batch_s)
+        bar = _bar(len(cases), len(done), cfg.progress)
+        session = Counter()
+        loop_wall = [0.0, 0.0]
+
+        def on_row(row: dict) -> None:
+            writer.add(row)
+            session[row["status"]] += 1
+            loop_wall[0] += row["loop_wall_s"] or 0.0
+            loop_wall[1] += row["wall_s"] or 0.0
+            if bar is not None:
+                bar.update(1)
+                bad = sum(v for k, v in session.items() if k != "ok")
+                bar.set_postfix_str(f"not ok {bad}", refresh=False)
+
+        t0, started = time.perf_counter(), utc_now()
+        try:
+            if todo:
+                if cfg.scheduler:
+                    run_dask(cfg.scheduler, todo, opts, on_row)
+                else:
+                    run_local(todo, opts, min(cfg.workers, len(todo)), on_row)
+        finally:
+            writer.flush()
+            if bar is not None:
+                bar.close()
+        elapsed = time.perf_counter() - t0
+        n = sum(session.values())
+        info["sessions"].append({
+            "started_utc": started, "cases_flown": n, "cases_skipped": len(done),
+            "plan_s": round(t_plan, 2), "elapsed_s": round(elapsed, 2),
+            "flights_per_hour": round(3600.0 * n / elapsed) if n and elapsed > 0 else None,
+            "sum_wall_s": round(loop_wall[1], 2), "sum_loop_wall_s": round(loop_wall[0], 2),
+            "workers": None if cfg.scheduler else cfg.workers, "scheduler": cfg.scheduler})
+        counts = _status_counts(out)
+        info["status"] = "complete" if sum(counts.values()) == len(cases) else "running"
+        info["counts"] = dict(sorted(counts.items()))
+        info["finished_utc"] = utc_now()
+        write_json_atomic(out / RUN_JSON, info)
+    return info
+
+
+def _version() -> str:
+    from fms_testbed import __version__
+
+    return __version__
+
+
+__all__ = ["KEEP", "RUN_KIND", "RunConfig", "case_set_sha256", "infer_phase", "plan",
+           "run_campaign", "select_airports"]

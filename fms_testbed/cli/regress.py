@@ -1,0 +1,198 @@
+"""``fms-testbed regress``: procedure-database regression runs (``docs/regression.md``).
+
+    fms-testbed regress run --db FILE [--airports ICAO …] [--sample-airports N --sample-seed S
+        [--sample-min-transitions K]] [--types SID,STAR,APPROACH] [--aircraft 737,global5000 …]
+        [--wind FROM_DEG/SPEED_KT …] [--nav truth|sins[:PRESET] …] [--imu PRESET]
+        [--conditions FILE.yaml] [--combinations each|all] [--limit N] [--seed N]
+        [--case-timeout S] [--keep timeseries,plots] (--workers N | --scheduler tcp://HOST:PORT)
+        --out DIR
+    fms-testbed regress diff RUN_A RUN_B [--tolerance FILE.yaml] [--markdown FILE.md]
+    fms-testbed regress report DIR [--worst N] [--with OTHER_DIR …]
+
+``run`` exits 0 once every case is flown (whatever the flights' outcomes: they are the data;
+``diff`` is the gate), 2 on a user error; re-running the same command resumes. ``diff`` exits 0
+when nothing changed beyond tolerance, 1 otherwise. ``--isa-dev-c`` and ``--missed`` are refused:
+the flight stack does not model them yet.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from pathlib import Path
+
+from fms_testbed.cli.common import WIND_HELP, parse_wind
+from fms_testbed.core.errors import UserError
+
+
+def _split(values: list[str] | None) -> list[str]:
+    """``['737,global5000', 'c172p']`` → ``['737', 'global5000', 'c172p']``."""
+    return [v.strip() for item in values or [] for v in item.split(",") if v.strip()]
+
+
+def _winds(values: list[str] | None) -> list[dict | None]:
+    if not values:
+        return [None]
+    return [None if w.lower() == "calm" else parse_wind(w) for w in values]
+
+
+def _navs(values: list[str] | None, imu: str | None) -> list[dict]:
+    if not values:
+        if imu:
+            raise UserError("--imu is only used with --nav sins")
+        return [{"source": "truth"}]
+    out = []
+    for v in values:
+        name, _, preset = v.partition(":")
+        if name == "truth" and not preset:
+            out.append({"source": "truth"})
+        elif name == "sins":
+            preset = preset or imu
+            if not preset:
+                raise UserError(f"--nav {v}: give the IMU preset (sins:HG1700, or --imu PRESET)")
+            out.append({"source": "sins", "imu": preset})
+        else:
+            raise UserError(f"--nav {v!r}: expected truth, sins or sins:PRESET")
+    return out
+
+
+def config_from_args(args):
+    """The :class:`~fms_testbed.campaign.runner.RunConfig` of ``regress run``'s options."""
+    from fms_testbed.campaign.cases import parse_types
+    from fms_testbed.campaign.conditions import NOT_YET, command_line_sets, read_conditions
+    from fms_testbed.campaign.runner import RunConfig
+
+    if args.isa_dev_c:
+        raise UserError(f"--isa-dev-c: {NOT_YET['isa_dev_c']}")
+    if args.missed:
+        raise UserError(f"--missed: {NOT_YET['missed']}")
+    if args.conditions:
+        if args.wind or args.nav or args.imu:
+            raise UserError("--conditions FILE names the condition sets; --wind/--nav/--imu are "
+                            "not used with it")
+        sets = read_conditions(args.conditions)
+    else:
+        sets = command_line_sets(_winds(args.wind), _navs(args.nav, args.imu))
+    if args.sample_airports is None and (args.sample_seed is not None
+                                         or args.sample_min_transitions is not None):
+        raise UserError("--sample-seed/--sample-min-transitions need --sample-airports N")
+    return RunConfig(
+        out=Path(args.out), conditions=sets, db=args.db, airports=args.airports,
+        sample_airports=args.sample_airports, sample_seed=args.sample_seed or 0,
+        sample_min_transitions=args.sample_min_transitions or 1,
+        types=parse_types(args.types), aircraft=_split(args.aircraft) or ["737"],
+        combinations=args.combinations, limit=args.limit, seed=args.seed,
+        workers=args.workers or os.cpu_count() or 1, scheduler=args.scheduler,
+        case_timeout_s=args.case_timeout, keep=tuple(_split(args.keep)),
+        progress=False if args.no_progress else None, command=list(sys.argv), phase=args.phase)
+
+
+def cmd_run(args) -> int:
+    """Plan, fly (resuming) and summarise a regression run."""
+    from fms_testbed.campaign.runner import run_campaign
+
+    info = run_campaign(config_from_args(args))
+    s = info["sessions"][-1]
+    c = info["cases"]
+    print(f"{c['count']} cases ({c['procedures']} procedures at {c['airports']} airports) in "
+          f"{args.out}: {s['cases_flown']} flown now, {s['cases_skipped']} already done; "
+          f"{s['elapsed_s']:.0f} s" + (f", {s['flights_per_hour']} flights/h"
+                                       if s["flights_per_hour"] else ""))
+    print("  status: " + ", ".join(f"{k} {v}" for k, v in info["counts"].items()))
+    if s["sum_loop_wall_s"]:
+        over = 100.0 * (s["sum_wall_s"] - s["sum_loop_wall_s"]) / s["sum_loop_wall_s"]
+        print(f"  per-case overhead (wall_s - loop_wall_s) / loop_wall_s: {over:.1f} %")
+    if info["status"] != "complete":
+        print("  not every case is written: run the same command again to resume")
+    return 0
+
+
+def cmd_diff(args) -> int:
+    """Compare two runs; exit 1 when something changed beyond tolerance."""
+    from fms_testbed.campaign.diff import diff_runs, read_tolerances
+
+    tol = read_tolerances(args.tolerance) if args.tolerance else None
+    res = diff_runs(args.run_a, args.run_b, tol)
+    print(res.text())
+    if args.markdown:
+        Path(args.markdown).write_text(res.markdown())
+        print(f"  Markdown summary: {args.markdown}")
+    return 0 if res.clean else 1
+
+
+def cmd_report(args) -> int:
+    """Write DIR/report.html."""
+    from fms_testbed.campaign.report import write_report
+
+    path = write_report(args.dir, worst=args.worst, others=args.others or [],
+                        refly=not args.no_refly)
+    print(f"wrote {path}")
+    return 0
+
+
+def register(sub) -> None:
+    """Add ``regress run|diff|report``."""
+    p = sub.add_parser("regress", help="procedure-database regression runs: run, diff, report")
+    rs = p.add_subparsers(dest="regress_command", metavar="SUBCOMMAND")
+
+    r = rs.add_parser("run", help="fly every procedure of a database (resumable)")
+    r.add_argument("--db", help="ARINC-424 file (default: the embedded excerpt)")
+    r.add_argument("--airports", nargs="+", metavar="ICAO", help="airports (default: all)")
+    r.add_argument("--sample-airports", type=int, metavar="N",
+                   help="fly a seeded sample of N airports (of --airports, or of all)")
+    r.add_argument("--sample-seed", type=int, metavar="S", help="seed of the sample (default 0)")
+    r.add_argument("--sample-min-transitions", type=int, metavar="K",
+                   help="sample only airports with ≥ K transitions of the --types (default 1)")
+    r.add_argument("--types", help="SID,STAR,APPROACH (default all three)")
+    r.add_argument("--aircraft", nargs="+", help="aircraft names or files, e.g. 737,global5000 "
+                                                 "(default 737)")
+    r.add_argument("--wind", nargs="+", metavar="FROM/SPEED",
+                   help=WIND_HELP + "; several give several condition sets; 'calm' for none")
+    r.add_argument("--isa-dev-c", nargs="+", metavar="DEG_C",
+                   help="ISA temperature deviation, °C (refused: not modelled yet)")
+    r.add_argument("--nav", nargs="+", metavar="SOURCE",
+                   help="navigation sources: truth, sins, sins:PRESET (default truth)")
+    r.add_argument("--imu", help="IMU preset for --nav sins")
+    r.add_argument("--conditions", metavar="FILE.yaml",
+                   help="condition sets from a YAML file (instead of --wind/--nav)")
+    r.add_argument("--missed", action="store_true",
+                   help="fly the missed approach (refused: not flown yet)")
+    r.add_argument("--combinations", choices=("each", "all"), default="each",
+                   help="each: fewest sequences flying every transition once (default); all: "
+                        "every runway × en-route/approach transition")
+    r.add_argument("--limit", type=int, metavar="N", help="fly only the first N cases")
+    r.add_argument("--seed", type=int, default=0, help="campaign seed (default 0)")
+    ex = r.add_mutually_exclusive_group()
+    ex.add_argument("--workers", type=int, metavar="N",
+                    help="local worker processes (default: the number of CPUs)")
+    ex.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                    help="an existing dask.distributed scheduler (workers with --nthreads 1)")
+    r.add_argument("--case-timeout", type=float, metavar="S",
+                   help="wall-time limit of one case, s")
+    r.add_argument("--keep", help="per-case artefacts to keep: timeseries,plots (in DIR/cases)")
+    r.add_argument("--phase", help="Danilin phase label for the report (default: inferred)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--out", required=True, help="campaign folder (resumed when it holds one)")
+    r.set_defaults(func=cmd_run)
+
+    d = rs.add_parser("diff", help="compare two runs (exit 1 when something changed)")
+    d.add_argument("run_a", help="campaign folder A (the reference)")
+    d.add_argument("run_b", help="campaign folder B")
+    d.add_argument("--tolerance", metavar="FILE.yaml", help="per-column tolerances")
+    d.add_argument("--markdown", metavar="FILE.md", help="also write the summary as Markdown")
+    d.set_defaults(func=cmd_diff)
+
+    q = rs.add_parser("report", help="write DIR/report.html (self-contained)")
+    q.add_argument("dir", help="campaign folder")
+    q.add_argument("--worst", type=int, default=6, help="worst cases drawn (default 6)")
+    q.add_argument("--with", dest="others", nargs="+", metavar="DIR",
+                   help="other runs for the phase table (e.g. the test-database phase)")
+    q.add_argument("--no-refly", action="store_true",
+                   help="do not re-fly worst cases whose timeseries were not kept")
+    q.set_defaults(func=cmd_report)
+
+    def _help(args) -> int:
+        p.print_help()
+        return 2
+
+    p.set_defaults(func=_help)

@@ -1,0 +1,319 @@
+"""Loosely coupled error-state INS/GNSS Kalman filter for one INS (seed 004's 15 + 6 states).
+
+State (SI, errors are *indicated minus true*, the SINS model's convention)::
+
+    0:3   δp   INS position error E, N, U, m          3:6   δV   INS velocity error, m/s
+    6:9   ε    INS attitude error about E, N, U, rad   9:12  b_a  accelerometer bias, body, m/s²
+    12:15 b_g  gyro bias, body, rad/s                  15:18 m_p  GNSS position Markov error, m
+    18:21 m_v  GNSS velocity Markov error, m/s         21    b_h  baro bias, m (with a baro)
+
+The INS block of F is the first 15×15 of the project's 33-state model
+(:func:`fms_testbed.sensors.sins.model.build_F`, free vertical channel), built at the INS's
+*indicated* position, velocity and attitude with the IMU's rates and specific force; the GNSS and
+baro states are first-order Gauss-Markov. Φ_k, Q_k come from the Picard series
+(:func:`fms_testbed.sensors.sins.discretize.discretize_sins`, Babich 2017 eq. 2.5-2.9/4.3-4.5) or
+Van Loan. Measurements (ENU, m and m/s)::
+
+    z_p = p_INS - p_GNSS = δp - m_p - w_p           H_p = [I 0 0 0 0 -I 0]
+    z_v = V_INS - V_GNSS = δV - m_v - w_v           H_v = [0 I 0 0 0 0 -I]
+    z_h = h_INS - h_baro = δp_U - b_h - w_h
+
+A fix valid at t_m and used at t (latency) is compared with the INS output of t_m against the
+estimate carried back, x̂(t_m) = Φ(t, t_m)⁻¹ x̂(t) (the process noise over the lag is neglected in
+the cross-covariance). Each group passes an innovation gate (|ν_i| ≤ gate·√S_ii) before the
+Joseph-form correction (:mod:`.kalman`). Feedback: at every GNSS update the INS block of x̂ is
+handed back (the INS subtracts it from its position, velocity, attitude and sensor-bias
+compensation) and zeroed; the GNSS/baro states stay in the filter.
+
+The truth INS has 33 states; the 18 scale-factor and misalignment errors the filter does not
+carry are covered by (a) an equivalent-bias prior at 1 g (accelerometer misalignment and
+scale factor seen as a bias in level flight), and (b) white process noise on δV and ε of density
+2 σ² |Δf|² τ_u and 2 σ² |ω|² τ_u (σ² the declared scale-factor + misalignment variance, Δf the
+specific force's departure from 1 g, ω the body rate, τ_u = ``unmodelled_tau_s``): they vanish
+for an IMU without those errors, where the filter's model is the truth's.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+
+from fms_testbed.core.earth import OMEGA_IE_RPS, radii_m
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.state import AircraftState, NavSolution
+from fms_testbed.core.units import G0_MPS2
+from fms_testbed.navigation.kalman import correct, correct_delayed, innovation, predict
+from fms_testbed.navigation.sins import _c_bn
+from fms_testbed.sensors.baro import BaroReading, BaroSpec
+from fms_testbed.sensors.gnss import GnssFix, GnssSpec
+from fms_testbed.sensors.sins._blas import single_thread_blas
+from fms_testbed.sensors.sins.analysis import SinsOptions, initial_map, system_matrix
+from fms_testbed.sensors.sins.discretize import (PICARD_MAX_ORDER, PICARD_MAX_RATE_DT,
+                                                 DiscretisationError, _picard_sins, discretize)
+from fms_testbed.sensors.sins.model import build_F
+from fms_testbed.sensors.sins.presets import ImuModel
+
+N_INS = 15
+POS, VEL, ATT, BA, BG = (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 15))
+MP, MV = slice(15, 18), slice(18, 21)
+BARO = 21
+STATE_NAMES = (
+    [f"dp_{c}_m" for c in "enu"] + [f"dv_{c}_mps" for c in "enu"]
+    + [f"eps_{c}_rad" for c in "enu"] + [f"ba_{c}_mps2" for c in "xyz"]
+    + [f"bg_{c}_rps" for c in "xyz"] + [f"gnss_mp_{c}_m" for c in "enu"]
+    + [f"gnss_mv_{c}_mps" for c in "enu"] + ["baro_bias_m"])
+_FREE = SinsOptions(vertical="free")
+
+
+@dataclass(frozen=True)
+class FilterTuning:
+    """Filter settings.
+
+    gate_sigma : innovation gate, in σ of each innovation component (PX4/ArduPilot use 5)
+    unmodelled_tau_s : correlation time τ_u of the process noise standing in for the scale
+        factors and misalignments the filter does not carry, s
+    method : discretisation, ``picard`` or ``vanloan``
+    """
+
+    gate_sigma: float = 5.0
+    unmodelled_tau_s: float = 100.0
+    method: str = "picard"
+
+    def __post_init__(self):
+        if not self.gate_sigma > 0:
+            raise ConfigError("navigation.filter.gate_sigma: must be > 0")
+        if not self.unmodelled_tau_s >= 0:
+            raise ConfigError("navigation.filter.unmodelled_tau_s: must be >= 0 s")
+        if self.method not in ("picard", "vanloan"):
+            raise ConfigError("navigation.filter.method: picard or vanloan")
+
+
+@dataclass(frozen=True)
+class GroupResult:
+    """One measurement group at one update: name (``gnss_pos``, ``gnss_vel``, ``baro``), its
+    innovation (units of the group), S, NIS, and whether it passed the gate and was used."""
+
+    name: str
+    innovation: np.ndarray
+    S: np.ndarray
+    nis: float
+    used: bool
+
+
+def enu_difference_m(a_lat_rad, a_lon_rad, a_alt_m, b_lat_rad, b_lon_rad, b_alt_m) -> np.ndarray:
+    """Position a - b in local ENU at a, m (small differences: radii of curvature at a)."""
+    rm, rn = radii_m(a_lat_rad)
+    return np.array([(a_lon_rad - b_lon_rad) * (rn + a_alt_m) * math.cos(a_lat_rad),
+                     (a_lat_rad - b_lat_rad) * (rm + a_alt_m), a_alt_m - b_alt_m])
+
+
+def _unmodelled_variances(imu: ImuModel) -> tuple[float, float]:
+    """(accelerometer, gyro) scale-factor + misalignment variance per axis, dimensionless/rad²."""
+    p = imu.p0_var
+    return (float(p[15:18].mean() + 2.0 * p[21:27].mean()),
+            float(p[18:21].mean() + 2.0 * p[27:33].mean()))
+
+
+@njit(cache=True)
+def _predict_step(x, P, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol):
+    """Fused prediction: F at the INS output (33-state model's INS block, free vertical; the
+    GNSS/baro states' decay) → Picard (Φ, Q_k) → (Φ x, Φ P Φᵀ + Q_k, Φ, status); status 0 ok,
+    1 Δt/τ beyond the Picard range, 2 no convergence. Returns (x, P, Φ, Q_k, status)."""
+    n = x.size
+    c = _c_bn(rpy[0], rpy[1], rpy[2])
+    w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(lat), OMEGA_IE_RPS * math.sin(lat)])
+    w_ib = w_eb + c.T @ w_ie
+    F33 = build_F(lat, alt, v, f_b, w_ib, c, decay24, 0.0, 0.0)
+    F = np.zeros((n, n))
+    F[:15, :15] = F33[:15, :15]
+    rate = 0.0
+    for i in range(n):
+        if i >= 15:
+            F[i, i] = -decay[i]
+        rate = max(rate, abs(F[i, i]))
+    if rate * dt > PICARD_MAX_RATE_DT:
+        return x, P, F, F, 1
+    phi, qk, _, ok = _picard_sins(F, q, dt, tol, PICARD_MAX_ORDER)
+    if not ok:
+        return x, P, F, F, 2
+    xn, Pn = predict(x, P, phi, qk)
+    return xn, Pn, phi, qk, 0
+
+
+class InsGnssFilter:
+    """The error-state filter of one INS (see the module docstring).
+
+    Parameters
+    ----------
+    imu : the INS's declared IMU model (its biases and noise densities are the filter's)
+    gnss : the GNSS receiver's declared error model
+    baro : the baro's declared model, or None (no baro measurement, 21 states)
+    tuning : gate and unmodelled-error settings
+    """
+
+    def __init__(self, imu: ImuModel, gnss: GnssSpec, baro: BaroSpec | None,
+                 tuning: FilterTuning = FilterTuning()):
+        self.imu, self.gnss, self.baro, self.tuning = imu, gnss, baro, tuning
+        self.n = n = 21 + (baro is not None)
+        decay = np.zeros(n)
+        decay[9:15] = imu.decay_rps[:6]
+        decay[15:21] = 1.0 / gnss.markov_tau_s
+        q = np.zeros(n)
+        q[:15] = imu.q_psd[:15]
+        q[15:21] = 2.0 * gnss.markov_sigma ** 2 / gnss.markov_tau_s
+        if baro is not None:
+            decay[BARO] = 1.0 / baro.markov_tau_s
+            q[BARO] = 2.0 * baro.markov_sigma_m ** 2 / baro.markov_tau_s
+        self.decay, self.q = decay, q
+        self._var_acc, self._var_gyro = _unmodelled_variances(imu)
+        self.x = np.zeros(n)
+        self.P = np.zeros((n, n))
+        self._decay24 = np.ascontiguousarray(imu.decay_rps, float)
+        self._no_freeze = np.zeros(n, np.bool_)
+        self._lag: list[tuple[float, np.ndarray, np.ndarray]] = []   # (t_start_s, Φ, Q_k)
+        self.t_s: float | None = None
+        R = np.zeros(n)
+        R[:6] = gnss.white_sigma ** 2
+        self._r_pos, self._r_vel = np.diag(R[:3]), np.diag(R[3:6])
+        self._H_pos = np.zeros((3, n))
+        self._H_pos[:, POS] = np.eye(3)
+        self._H_pos[:, MP] = -np.eye(3)
+        self._H_vel = np.zeros((3, n))
+        self._H_vel[:, VEL] = np.eye(3)
+        self._H_vel[:, MV] = -np.eye(3)
+        if baro is not None:
+            self._H_baro = np.zeros((1, n))
+            self._H_baro[0, 2], self._H_baro[0, BARO] = 1.0, -1.0
+            self._r_baro = np.array([[baro.white_sigma_m ** 2]])
+
+    # -- initialisation and prediction ----------------------------------------------------
+    def initialise(self, ins: NavSolution) -> None:
+        """P0 at the first INS output: the INS block from the alignment (A diag(p0) Aᵀ of the
+        33-state model, :func:`~fms_testbed.sensors.sins.analysis.initial_map`) plus the
+        equivalent-bias variance of the unmodelled accelerometer errors at 1 g; the GNSS and baro
+        states at their stationary variance."""
+        imu = self.imu
+        rpy = (ins.roll_rad, ins.pitch_rad, ins.heading_rad)
+        A = initial_map(ins.lat_rad, rpy, imu, SinsOptions())
+        P33 = (A * imu.p0_var) @ A.T
+        P = np.zeros((self.n, self.n))
+        P[:15, :15] = P33[:15, :15]
+        g2 = G0_MPS2 ** 2
+        P[9, 9] += g2 * imu.p0_var[22]        # x: misalignment of x towards z, times a_z
+        P[10, 10] += g2 * imu.p0_var[24]      # y: misalignment of y towards z, times a_z
+        P[11, 11] += g2 * imu.p0_var[17]      # z: scale factor of z, times a_z
+        P[15:21, 15:21] = np.diag(self.gnss.markov_sigma ** 2)
+        if self.baro is not None:
+            P[BARO, BARO] = self.baro.markov_sigma_m ** 2
+        self.P = P
+        self.x[:] = 0.0
+        self.t_s = ins.t_s
+
+    def system_matrix(self, ins: NavSolution, truth: AircraftState) -> np.ndarray:
+        """F (n×n) at the INS's indicated state; IMU rates and specific force from ``truth``
+        (the IMU's errors change them by < 1e-3 relative, far below what F is sensitive to)."""
+        F33 = system_matrix(ins.lat_rad, ins.alt_m, ins.v_enu_mps,
+                            (ins.roll_rad, ins.pitch_rad, ins.heading_rad),
+                            (truth.p_rps, truth.q_rps, truth.r_rps), truth.f_body_mps2,
+                            self.imu, _FREE)
+        F = np.zeros((self.n, self.n))
+        F[:15, :15] = F33[:15, :15]
+        F[np.arange(15, self.n), np.arange(15, self.n)] = -self.decay[15:]
+        return F
+
+    def _process_noise(self, truth: AircraftState) -> np.ndarray:
+        q = self.q.copy()
+        tau = self.tuning.unmodelled_tau_s
+        if tau > 0 and (self._var_acc > 0 or self._var_gyro > 0):
+            f = np.asarray(truth.f_body_mps2, float)
+            df2 = float(f @ f) - 2.0 * G0_MPS2 * abs(float(f[2])) + G0_MPS2 ** 2
+            w2 = truth.p_rps ** 2 + truth.q_rps ** 2 + truth.r_rps ** 2
+            q[VEL] += 2.0 * self._var_acc * max(df2, 0.0) * tau
+            q[ATT] += 2.0 * self._var_gyro * w2 * tau
+        return q
+
+    def predict(self, ins: NavSolution, truth: AircraftState, dt_s: float) -> None:
+        """Propagate x, P over ``dt_s`` (s) with F at the INS output ``ins`` of the step start.
+
+        Raises
+        ------
+        DiscretisationError : Picard asked for Δt/τ > 0.1 or did not converge (use vanloan)
+        """
+        q = self._process_noise(truth)
+        if self.tuning.method == "picard":
+            x, P, phi, qk, status = _predict_step(
+                self.x, self.P, ins.lat_rad, ins.alt_m, np.asarray(ins.v_enu_mps, float),
+                np.array([ins.roll_rad, ins.pitch_rad, ins.heading_rad]),
+                np.array([truth.p_rps, truth.q_rps, truth.r_rps]),
+                np.asarray(truth.f_body_mps2, float), self._decay24, self.decay, q, float(dt_s),
+                1e-12)
+            if status:
+                raise DiscretisationError(
+                    f"navigation.filter: Picard series unsuitable at dt = {dt_s:g} s (Δt/τ > "
+                    f"{PICARD_MAX_RATE_DT} or no convergence); set navigation.filter.method: "
+                    "vanloan")
+        else:
+            F = self.system_matrix(ins, truth)
+            with single_thread_blas():
+                phi, qk = discretize(F, np.diag(q), dt_s, method="vanloan")
+            x, P = predict(self.x, self.P, phi, qk)
+        self.x, self.P = x, P
+        self._lag.append((ins.t_s, phi, qk))
+        if len(self._lag) > 64:
+            del self._lag[:-64]
+        self.t_s = ins.t_s + dt_s
+
+    # -- measurements ----------------------------------------------------------------------
+    def _lag_since(self, t_m: float):
+        """(Φ(t, t_m), Q_lag) over the prediction steps since ``t_m`` (None: no step since)."""
+        steps = [(phi, qk) for t0, phi, qk in self._lag if t0 >= t_m - 1e-9]
+        if not steps:
+            return None
+        phi_lag, q_lag = steps[0]
+        for phi, qk in steps[1:]:
+            phi_lag = phi @ phi_lag
+            q_lag = phi @ q_lag @ phi.T + qk
+        return phi_lag, q_lag
+
+    def _group(self, name, z, H, R, lag) -> GroupResult:
+        if lag is None:
+            nu, S, nis = innovation(self.x, self.P, z, H, R)
+        else:
+            _, _, nu, S, nis = correct_delayed(self.x, self.P, z, H, R, lag[0], lag[1],
+                                               self._no_freeze)
+        used = bool(np.all(np.abs(nu) <= self.tuning.gate_sigma * np.sqrt(np.diag(S))))
+        if used:
+            if lag is None:
+                self.x, self.P, _, _, _ = correct(self.x, self.P, z, H, R, self._no_freeze)
+            else:
+                self.x, self.P, _, _, _ = correct_delayed(self.x, self.P, z, H, R, lag[0],
+                                                          lag[1], self._no_freeze)
+        return GroupResult(name, nu, S, nis, used)
+
+    def gnss_update(self, fix: GnssFix, ins_at_fix: NavSolution) -> list[GroupResult]:
+        """Use a fix (position, then velocity) against the INS output at its time of validity."""
+        lag = self._lag_since(fix.t_s)
+        zp = enu_difference_m(ins_at_fix.lat_rad, ins_at_fix.lon_rad, ins_at_fix.alt_m,
+                              fix.lat_rad, fix.lon_rad, fix.alt_m)
+        zv = np.asarray(ins_at_fix.v_enu_mps, float) - fix.v_enu_mps
+        return [self._group("gnss_pos", zp, self._H_pos, self._r_pos, lag),
+                self._group("gnss_vel", zv, self._H_vel, self._r_vel, lag)]
+
+    def baro_update(self, reading: BaroReading, ins: NavSolution) -> GroupResult:
+        """Use a baro reading taken at the time of the INS output ``ins``."""
+        if self.baro is None:
+            raise ConfigError("navigation.baro: this filter has no baro state")
+        z = np.array([ins.alt_m - reading.alt_m])
+        return self._group("baro", z, self._H_baro, self._r_baro, None)
+
+    def take_feedback(self) -> np.ndarray:
+        """The INS block of x̂ (15,), handed to the INS; the filter's INS block is zeroed."""
+        dx = self.x[:N_INS].copy()
+        self.x[:N_INS] = 0.0
+        return dx
+
+
+__all__ = ["FilterTuning", "GroupResult", "InsGnssFilter", "STATE_NAMES", "enu_difference_m"]
