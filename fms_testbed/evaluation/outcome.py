@@ -9,6 +9,8 @@ status                 meaning                                                  
                        contact, stall, overspeed > 1.1 VMO, upset) or guidance
                        abandoned the procedure
 ``incomplete``         the duration ended before the procedure did                1
+``degraded``           flown with ``--allow-degraded`` from a procedure with a    1
+                       rejected, duplicated or misplaced record of its own
 ``envelope_exceeded``  above the ceiling, above VMO or MMO, or outside the        1
                        limit load factors of the aircraft file
 ``not_contained``      RNP containment lost: on some leg TSE95 > RNP or max       1
@@ -32,7 +34,8 @@ from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
 
-ORDER = ("diverged", "incomplete", "envelope_exceeded", "not_contained", "constraints_missed")
+ORDER = ("diverged", "incomplete", "degraded", "envelope_exceeded", "not_contained",
+         "constraints_missed")
 """Statuses other than ``ok``, most severe first."""
 
 EXIT_CODES = {"ok": 0, **{s: 1 for s in ORDER}}
@@ -132,6 +135,11 @@ def decide(summary: dict, df: pd.DataFrame, cfg: AircraftConfig,
     checks: dict = {}
     if summary["status"] in ("diverged", "incomplete"):
         found[summary["status"]].append(summary["reason"])
+    degraded = (summary.get("procedure") or {}).get("degraded") or []
+    checks["records"] = {"ok": not degraded, "defects": len(degraded)}
+    if degraded:
+        found["degraded"].append(f"built from a degraded procedure ({len(degraded)} record "
+                                 f"defect(s), first: {degraded[0]})")
     env = envelope_violations(df, cfg)
     checks["envelope"] = {"ok": not env, "violations": env}
     found["envelope_exceeded"] += env

@@ -84,3 +84,11 @@ def test_haversine_distance():
 
 def test_exit_codes():
     assert EXIT_CODES["ok"] == 0 and all(EXIT_CODES[s] == 1 for s in ORDER)
+
+
+def test_a_flight_from_degraded_records_is_not_ok(cfg):
+    summary = {"status": "ok", "reason": "guidance complete",
+               "procedure": {"degraded": ["f.dat:12: sequence number: coded twice"]}}
+    s = decide(summary, _df(), cfg)
+    assert s["status"] == "degraded" and "f.dat:12" in s["reason"]
+    assert EXIT_CODES["degraded"] == 1
