@@ -155,3 +155,10 @@ def print_results(res) -> None:
         print(f"  outputs in {res.out_dir}: "
               + ", ".join(["timeseries.parquet", "summary.json"] + s.get("plots", [])
                         + s.get("tracks", [])))
+
+
+def add_overwrite_option(p) -> None:
+    """``--overwrite``: replace an ``--out`` folder that holds other files than a previous run
+    (a previous run of the testbed is always replaced as a whole)."""
+    p.add_argument("--overwrite", action="store_true",
+                   help="replace an --out folder that holds other files than a previous run")

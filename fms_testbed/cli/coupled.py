@@ -22,7 +22,9 @@ import pandas as pd
 
 from fms_testbed.config.aircraft import load_aircraft
 from fms_testbed.cli.common import WIND_HELP, markdown_table, parse_wind
+from fms_testbed.cli.common import add_overwrite_option
 from fms_testbed.core.errors import UserError
+from fms_testbed.run.outputs import OutputFolder
 from fms_testbed.core.units import KMH_MPS
 from fms_testbed.data import results_dir, scenarios_dir
 
@@ -77,7 +79,8 @@ def cmd_compare(args) -> int:
             for e in s0.events]})
         scns.insert(1, small)
     out = _out_dir(args.out, "compare")
-    out.mkdir(parents=True, exist_ok=True)
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
+    tmp = folder.open()
     rows = []
     for scn in scns:
         cfg = load_aircraft(scn.aircraft)
@@ -89,28 +92,29 @@ def cmd_compare(args) -> int:
         runs["ideal"] = cmp.ideal
         head = _headline(scn_rows)
         title = f"{scn.name} — {cfg.name}: {scn.description or ''}" + (f"\n{head}" if head else "")
-        save(plot_comparison(runs, title), out / f"{scn.name}-comparison.png")
+        save(plot_comparison(runs, title), tmp / f"{scn.name}-comparison.png")
         if args.paper_plot or scn.name == "paper-fig2":
             fig2 = {k: runs[k] for k in ("coupled", "ideal", "pi") if k in runs}
             save(plot_paper_fig2(fig2, f"{scn.name} — {cfg.name} (layout of the paper's Fig. 2)"
                                  + (f"\n{head}" if head else "")),
-                 out / f"{scn.name}-paper-fig2.png")
+                 tmp / f"{scn.name}-paper-fig2.png")
         for law, df in cmp.runs.items():
-            df.to_parquet(out / f"{scn.name}-{law}.parquet", index=False)
+            df.to_parquet(tmp / f"{scn.name}-{law}.parquet", index=False)
     table = pd.DataFrame(rows)
     goals = check_goals(table) if "coupled" in laws else []
-    table.to_csv(out / "comparison.csv", index=False)
+    table.to_csv(tmp / "comparison.csv", index=False)
     show = table.drop(columns=[c for c in ("status",) if c in table and (table[c] == "ok").all()])
     md = markdown_table(show)
     gl = "\n".join(f"- {'PASS' if g.ok else 'FAIL'}: {g.name} = {g.value:.3g} {g.unit} "
                    f"(goal {'≤' if g.unit != '×' else '≥'} {g.limit:g} {g.unit})" for g in goals)
-    (out / "comparison.md").write_text(f"# Coupled law vs baselines\n\n{md}\n\n## Goals\n\n{gl}\n")
-    (out / "goals.json").write_text(json.dumps([asdict(g) for g in goals], indent=2,
+    (tmp / "comparison.md").write_text(f"# Coupled law vs baselines\n\n{md}\n\n## Goals\n\n{gl}\n")
+    (tmp / "goals.json").write_text(json.dumps([asdict(g) for g in goals], indent=2,
                                                default=float))
     print(md)
     if gl:
         print("\nGoals:\n" + gl)
     print(f"\nwritten to {out}/ (comparison.csv, comparison.md, *.png, *.parquet)")
+    folder.commit()
     return 0 if all(g.ok for g in goals) else 1
 
 
@@ -164,17 +168,19 @@ def _compare_envelope(args, laws) -> int:
     if args.scenarios:
         raise UserError("compare --envelope takes no scenarios (it builds its own steps)")
     names = [args.aircraft] if args.aircraft else list_aircraft()
+    out = _out_dir(args.out, "envelope")
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
     rows = []
     for name in names:
         rows.extend(envelope_rows(load_aircraft(name), laws, seed=args.seed))
     table = pd.DataFrame(rows)
-    out = _out_dir(args.out, "envelope")
-    out.mkdir(parents=True, exist_ok=True)
-    table.to_csv(out / "envelope.csv", index=False)
+    tmp = folder.open()
+    table.to_csv(tmp / "envelope.csv", index=False)
     md = markdown_table(table)
-    (out / "envelope.md").write_text(f"# Coupled law across the envelope\n\n{md}\n")
+    (tmp / "envelope.md").write_text(f"# Coupled law across the envelope\n\n{md}\n")
     print(md)
     print(f"\nwritten to {out}/ (envelope.csv, envelope.md)")
+    folder.commit()
     return 0
 
 
@@ -191,7 +197,8 @@ def cmd_analyse(args) -> int:
     p = params_from_config(cfg)
     V0 = args.speed * KMH_MPS if args.speed else cfg.default_condition.tas_mps
     out = _out_dir(args.out, f"analyse-{cfg.name}")
-    out.mkdir(parents=True, exist_ok=True)
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
+    tmp = folder.open()
     if args.identify:
         from fms_testbed.evaluation.law_tuning import OperatingPoint, identify_lags
 
@@ -236,15 +243,16 @@ def cmd_analyse(args) -> int:
     save(plot_bode_coupling(w, freq, f"{cfg.name}: closed-loop W(jω) at {V0 / KMH_MPS:.0f} km/h "
                             f"— diagonal and cross terms\nlargest cross term |W_V,Hcmd|/|W_V,Vcmd| "
                             f"= {worst['max|W_V,Hcmd|/max|W_V,Vcmd|']:.2g} ({lag_label})"),
-         out / "bode.png")
+         tmp / "bode.png")
     dv_key = f"max|dV| in {args.dh:g} m step, km/h"
     save(plot_linear_steps(t, steps, args.dv * KMH_MPS, args.dh,
                            f"{cfg.name}: linear closed-loop steps, with and without inner-loop "
                            f"lags\nmax|ΔV| in the {args.dh:g} m step: " + ", ".join(
                                f"{r[dv_key]:.2g}" for r in report.values()) + " km/h"),
-         out / "steps.png")
-    (out / "analysis.json").write_text(json.dumps(report, indent=2, default=str))
+         tmp / "steps.png")
+    (tmp / "analysis.json").write_text(json.dumps(report, indent=2, default=str))
     print(f"\nwritten to {out}/ (bode.png, steps.png, analysis.json)")
+    folder.commit()
     return 0
 
 
@@ -266,7 +274,8 @@ def cmd_tune(args) -> int:
     duration = 60.0 if args.quick else 100.0
     op = OperatingPoint(alt, tas, dH_m=args.dh, dV_mps=args.dv * KMH_MPS if args.dv else 0.0)
     out = _out_dir(args.out, f"tune-{cfg.name}")
-    out.mkdir(parents=True, exist_ok=True)
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
+    tmp = folder.open()
     print(f"tuning {cfg.name} at {alt:.0f} m / {tas / KMH_MPS:.0f} km/h TAS: {op.dH_m:g} m and "
           f"{op.speed_step_mps / KMH_MPS:.0f} km/h steps, budget {budget} evaluations ({args.plant})")
 
@@ -278,8 +287,8 @@ def cmd_tune(args) -> int:
     res = tune(cfg, op, max_evals=budget, duration_s=duration, plant=args.plant, progress=show)
     b = res.best
     hist = pd.DataFrame([e.row() for e in res.history])
-    hist.to_csv(out / "history.csv", index=False)
-    (out / "gains.yaml").write_text(
+    hist.to_csv(tmp / "history.csv", index=False)
+    (tmp / "gains.yaml").write_text(
         f"# tuned by `fms-testbed tune --aircraft {args.aircraft}` at {alt:.0f} m / "
         f"{tas / KMH_MPS:.0f} km/h; paste into aircraft/{cfg.name}.yaml\n{gains_yaml(b.params)}\n")
     lin = linear_prediction(b.params, op, res.lags_s[0], res.lags_s[1], duration)
@@ -290,7 +299,7 @@ def cmd_tune(args) -> int:
                              f"{b.params.T_V_s:.2f} s, ξ_V {b.params.xi_V:.2f}, T_H "
                              f"{b.params.T_H_s:.2f} s, ξ_H {b.params.xi_H:.2f}",
                              plant={"jsbsim": "JSBSim"}.get(args.plant, "point mass")),
-         out / "tuned-vs-linear.png")
+         tmp / "tuned-vs-linear.png")
     start, best = res.start.row(), b.row()
     keys = [k for k in best if k not in ("note",)]
     tab = pd.DataFrame({"start": [start.get(k) for k in keys], "tuned": [best.get(k) for k in keys]},
@@ -303,7 +312,7 @@ def cmd_tune(args) -> int:
               f"{res.lags_s[1]:.2f} s.\n\n```yaml\n{gains_yaml(b.params)}\n```\n\n"
               f"{markdown_table(tab.reset_index().rename(columns={'index': 'quantity'}))}\n\n"
               f"![tuned vs linear](tuned-vs-linear.png)\n\n## History\n\n{markdown_table(hist)}\n")
-    (out / "report.md").write_text(report)
+    (tmp / "report.md").write_text(report)
     print(f"\nbest: {gains_yaml(b.params)}  (cost {b.cost:.3f}, start {res.start.cost:.3f})")
     if args.write:
         if not cfg.source_file:
@@ -311,6 +320,7 @@ def cmd_tune(args) -> int:
         write_gains_to_config(cfg.source_file, b.params)
         print(f"gains written to {cfg.source_file}")
     print(f"written to {out}/ (gains.yaml, report.md, history.csv, tuned-vs-linear.png)")
+    folder.commit()
     return 0
 
 
@@ -341,6 +351,7 @@ def register(subparsers) -> None:
     p.add_argument("--wind", metavar="FROM_DEG/SPEED_KT", help=WIND_HELP)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--out", help="output folder (default results/compare-<time>)")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_compare)
 
     p = subparsers.add_parser(
@@ -357,6 +368,7 @@ def register(subparsers) -> None:
     p.add_argument("--dh", type=float, default=100.0, help="altitude step for the plots, m")
     p.add_argument("--dv", type=float, default=50.0, help="speed step for the plots, km/h")
     p.add_argument("--out", help="output folder (default results/analyse-<aircraft>-<time>)")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_analyse)
 
     p = subparsers.add_parser(
@@ -375,4 +387,5 @@ def register(subparsers) -> None:
     p.add_argument("--write", action="store_true",
                    help="write the tuned coupled_law block into the aircraft's YAML file")
     p.add_argument("--out", help="output folder (default results/tune-<aircraft>-<time>)")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_tune)

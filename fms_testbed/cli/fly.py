@@ -15,7 +15,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fms_testbed.cli.common import add_override_options, overrides_from_args, print_results
+from fms_testbed.cli.common import (add_override_options, add_overwrite_option, overrides_from_args,
+                                    print_results)
 from fms_testbed.run.outputs import check_out_dir
 from fms_testbed.core.errors import UserError
 from fms_testbed.data import results_dir
@@ -70,6 +71,5 @@ def register(sub) -> None:
     p.add_argument("--out", help="output folder (default results/<airport>-<procedure>)")
     p.add_argument("--csv", action="store_true", help="also write timeseries.csv")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace an --out folder that holds other files than a previous run")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_fly)

@@ -18,7 +18,9 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+from fms_testbed.cli.common import add_overwrite_option
 from fms_testbed.core.errors import UserError
+from fms_testbed.run.outputs import OutputFolder
 from fms_testbed.data import results_dir
 
 DEFAULT_STAGES = "none,temperature,run-to-run,slow-drift"
@@ -36,11 +38,12 @@ def cmd_imu_test(args) -> int:
     stages = parse_stages(args.stages)
     if not args.duration_h > 0:
         raise UserError(f"--duration-h must be > 0 h, got {args.duration_h}")
+    out = Path(args.out) if args.out else results_dir() / f"imu-test-{Path(args.imu).stem}"
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
     res = run_static_test(args.imu, args.duration_h * 3600.0, args.temperature_profile, stages,
                           args.seed, allan=args.allan)
-    out = Path(args.out) if args.out else results_dir() / f"imu-test-{res.imu}"
-    out.mkdir(parents=True, exist_ok=True)
-    res.angle_frame().to_csv(out / "accumulated_angle.csv", index=False, float_format="%.7g")
+    tmp = folder.open()
+    res.angle_frame().to_csv(tmp / "accumulated_angle.csv", index=False, float_format="%.7g")
     plots = {"accumulated_angle.png": plot_accumulated_angle}
     if res.calibration is not None:
         plots["zero_signal_vs_temperature.png"] = plot_zero_signal_vs_temperature
@@ -49,10 +52,10 @@ def cmd_imu_test(args) -> int:
     if res.allan is not None:
         plots["allan.png"] = plot_allan
     for name, plot in plots.items():
-        save(plot(res), out / name)
+        save(plot(res), tmp / name)
     summary = res.summary()
     summary["outputs"] = ["accumulated_angle.csv", "summary.json", *sorted(plots)]
-    (out / "summary.json").write_text(json.dumps(summary, indent=1, allow_nan=False) + "\n")
+    (tmp / "summary.json").write_text(json.dumps(summary, indent=1, allow_nan=False) + "\n")
     print(f"{res.imu}: {res.duration_s / 3600:g} h static at {res.rate_hz:g} Hz, profile "
           f"{res.profile.name}, seed {res.seed} ({res.wall_time_s:.1f} s)")
     for st, r in res.stage.items():
@@ -64,6 +67,7 @@ def cmd_imu_test(args) -> int:
               f" deg/sqrt(h), bias instability "
               f"{', '.join(f'{v:.3f}' for v in a.bias_instability_deg_per_h)} deg/h")
     print(f"  outputs in {out}: {', '.join(summary['outputs'])}")
+    folder.commit()
     return 0
 
 
@@ -85,4 +89,5 @@ def register(sub) -> None:
     p.add_argument("--allan", action="store_true",
                    help="fit ARW and bias instability from the overlapping Allan deviation")
     p.add_argument("--out", help="output folder (default results/imu-test-<imu>)")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_imu_test)

@@ -26,9 +26,10 @@ from pathlib import Path
 import pandas as pd
 import yaml
 
-from fms_testbed.cli.common import markdown_table, text_table
+from fms_testbed.cli.common import add_overwrite_option, markdown_table, text_table
 from fms_testbed.core.units import mps_to_kmh
 from fms_testbed.data import results_dir
+from fms_testbed.run.outputs import OutputFolder
 
 LOOPS = ("bank", "ny", "nx")
 
@@ -75,7 +76,8 @@ def cmd_inner(args) -> int:
 
     cfg = load_aircraft(args.aircraft)
     out = Path(args.out) if args.out else results_dir() / f"inner-{cfg.name}"
-    out.mkdir(parents=True, exist_ok=True)
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
+    tmp = folder.open()
     written = []
     if args.tune:
         for loop in LOOPS:
@@ -83,15 +85,15 @@ def cmd_inner(args) -> int:
             cfg = replace_gains(cfg, loop, g)
             print(f"tuned {loop}: kp {g.kp:.4g}, ki {g.ki:.4g}, kd {g.kd:.4g} (cost {cost:.3f})")
         gains = yaml.safe_dump({"inner_loops": cfg.inner_loops.model_dump()}, sort_keys=False)
-        (out / "inner_loops.yaml").write_text(
+        (tmp / "inner_loops.yaml").write_text(
             f"# tuned by `fms-testbed inner --aircraft {args.aircraft} --tune`; paste into the "
             f"aircraft file\n{gains}")
         written.append("inner_loops.yaml")
     points = list(cfg.envelope) if args.envelope else [cfg.default_condition]
     results = [(pt, r) for pt in points for r in check_aircraft(cfg, pt)]
     df = step_rows(results)
-    df.to_csv(out / "inner_steps.csv", index=False)
-    (out / "inner_steps.md").write_text(
+    df.to_csv(tmp / "inner_steps.csv", index=False)
+    (tmp / "inner_steps.md").write_text(
         f"# Inner-loop steps — {cfg.name}\n\nSettling: last time outside ±5 % of the step "
         f"around the target (— : not settled within the run); overshoot in % of the step.\n\n"
         f"{markdown_table(df)}\n")
@@ -101,13 +103,14 @@ def cmd_inner(args) -> int:
                 if r.spec.loop == loop]
         if runs:
             written.append(save(plot_loop_steps(loop, runs, cfg.name),
-                                out / f"inner_{loop}.png").name)
+                                tmp / f"inner_{loop}.png").name)
     ok = bool(df["ok"].all())
     print(f"{cfg.name}: inner-loop steps at {len(points)} condition(s) — "
           f"{int(df['ok'].sum())}/{len(df)} meet the spec")
     print(text_table(human_table(df), right=("alt, m", "TAS, km/h", "step", "settle, s",
                                               "overshoot, %")))
     print(f"written to {out}/ ({', '.join(written)})")
+    folder.commit()
     return 0 if ok else 1
 
 
@@ -119,4 +122,5 @@ def register(sub) -> None:
     p.add_argument("--tune", action="store_true", help="search the gains first (Nelder-Mead)")
     p.add_argument("--envelope", action="store_true", help="check at every envelope point")
     p.add_argument("--out", help="output folder (default results/inner-<aircraft>)")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_inner)

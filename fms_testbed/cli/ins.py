@@ -11,12 +11,14 @@ import logging
 import time
 from pathlib import Path
 
+from fms_testbed.cli.common import add_overwrite_option
 from fms_testbed.core.errors import UserError
+from fms_testbed.run.outputs import OutputFolder
 
 log = logging.getLogger("fms_testbed.sensors.sins")
 
 
-def _trajectory(args):
+def _trajectory(args, run_dir: Path):
     from fms_testbed.sensors.sins import trajectory as tj
 
     target = args.target
@@ -34,7 +36,7 @@ def _trajectory(args):
     if p.is_file() and p.suffix in (".yaml", ".yml"):
         from fms_testbed.run import run_scenario
 
-        out = Path(args.out) / "run"
+        out = run_dir / "run"
         log.info("flying %s first (output in %s)", p, out)
         res = run_scenario(p, out_dir=out, seed=args.seed, plots=False)
         df = res.df if hasattr(res, "df") else res[0]
@@ -56,8 +58,9 @@ def _handler(args) -> int:
     opts = SinsOptions(method=args.method, vertical=args.vertical, baro_tau_s=args.baro_tau_s,
                        alignment=args.alignment)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
-    traj = _trajectory(args).resample(args.dt_s)
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
+    tmp = folder.open()
+    traj = _trajectory(args, tmp).resample(args.dt_s)
     log.info("%s along %s: %d steps of %.3g s", imu.summary(), traj.label, len(traj), args.dt_s)
     t0 = time.perf_counter()
     cov = covariance_run(traj, imu, opts)
@@ -69,26 +72,27 @@ def _handler(args) -> int:
         mc = montecarlo_run(traj, imu, args.n, args.seed, opts)
         log.info("Monte-Carlo %d realisations: %.1f s", args.n, time.perf_counter() - t0)
         results[f"Monte-Carlo (N = {args.n})"] = mc
-        mc.to_frame().to_csv(out / "ins_montecarlo_sigma.csv", index=False)
-        mc.realisations_frame().to_parquet(out / "ins_realisations.parquet", index=False)
-    cov.to_frame().to_csv(out / "ins_covariance_sigma.csv", index=False)
+        mc.to_frame().to_csv(tmp / "ins_montecarlo_sigma.csv", index=False)
+        mc.realisations_frame().to_parquet(tmp / "ins_realisations.parquet", index=False)
+    cov.to_frame().to_csv(tmp / "ins_covariance_sigma.csv", index=False)
     main = mc if mc is not None else cov
     table = error_table(main, args.table_every_s)
     if mc is not None:
         ct = error_table(cov, args.table_every_s)
         table["h95_cov_m"], table["v95_cov_m"] = ct["h95_m"].to_numpy(), ct["v95_m"].to_numpy()
-    table.to_csv(out / "ins_p95_table.csv", index=False)
+    table.to_csv(tmp / "ins_p95_table.csv", index=False)
     title = (f"{imu.name} along {traj.label} — {args.mode}, vertical {args.vertical}, "
              f"alignment {args.alignment}, {args.method}")
     h95 = main.h95_m[-1]
     end_min = (main.t_s[-1] - main.t_s[0]) / 60.0
     head = f"{title}\n95 % horizontal error {h95:.0f} m after {end_min:.0f} min"
-    plots = [save(plot_envelopes(cov, mc, "position", head), out / "ins_position.png"),
-             save(plot_envelopes(cov, mc, "attitude", head), out / "ins_attitude.png"),
-             save(plot_p95(results, head), out / "ins_p95.png")]
+    plots = [save(plot_envelopes(cov, mc, "position", head), tmp / "ins_position.png"),
+             save(plot_envelopes(cov, mc, "attitude", head), tmp / "ins_attitude.png"),
+             save(plot_p95(results, head), tmp / "ins_p95.png")]
     print(f"{imu.summary()}; covariance {t_cov:.1f} s")
     print(table.to_string(index=False, float_format=lambda v: f"{v:.1f}"))
     print("wrote " + ", ".join(str(p) for p in plots))
+    folder.commit()
     return 0
 
 
@@ -107,6 +111,7 @@ def register(subparsers) -> None:
                    help="covariance propagation only, or plus a vectorised Monte-Carlo")
     p.add_argument("-n", type=int, default=1000, help="Monte-Carlo realisations (default 1000)")
     p.add_argument("--out", default="results/ins", help="output folder")
+    add_overwrite_option(p)
     p.add_argument("--seed", type=int, default=0, help="seed of the Monte-Carlo / flight")
     p.add_argument("--method", choices=("picard", "vanloan", "trapezoid"), default="picard")
     p.add_argument("--vertical", choices=("baro", "free"), default="baro",

@@ -10,12 +10,14 @@ transition), ``rejected_records.csv`` (file, line, columns, field, reason, recor
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
 
 from fms_testbed.cli.procedures_list import register as register_list
+from fms_testbed.cli.common import add_overwrite_option
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.jsonio import dumps
+from fms_testbed.run.outputs import OutputFolder
 from fms_testbed.core.units import NM_M
 
 
@@ -57,7 +59,8 @@ def cmd_build(args) -> int:
         more = f" ({len(degraded)} of {len(seqs)} transitions degraded)" if len(seqs) > 1 else ""
         raise UserError(refusal(degraded[0].name, degraded[0].defects) + more)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
+    tmp = folder.open()
     apt = db.airports.get(args.airport.upper())
     g = gravity_mps2(apt.lat_deg if apt else 45.0)
     for seq in seqs:
@@ -67,8 +70,8 @@ def cmd_build(args) -> int:
                 print(f"    {d.finding}")
             continue
         path = check_path(build_sequence(db, seq, perf, params), perf, params, g)
-        gj = write_geojson(path, out)
-        png = save(plot_path(path), out / f"{safe_name(path)}.png") if path.segments else None
+        gj = write_geojson(path, tmp)
+        png = save(plot_path(path), tmp / f"{safe_name(path)}.png") if path.segments else None
         status = f"degraded (monitor: {path.status})" if seq.degraded else path.status
         print(f"{path.name}: {status} ({len(path.legs)} legs, {len(path.segments)} "
               f"segments, {path.length_m() / NM_M:.1f} NM) -> {gj.name}"
@@ -82,6 +85,7 @@ def cmd_build(args) -> int:
         print(f"    rejected record: {issue}")
     if len(db.issues) > 20:
         print(f"    ... {len(db.issues) - 20} more rejected records")
+    folder.commit()
     return 0
 
 
@@ -96,18 +100,19 @@ def cmd_check(args) -> int:
         raise UserError(f"--workers must be at least 1, got {args.workers}")
     params = _params(args)
     perf = _perf(args.aircraft)
+    out = Path(args.out)
+    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
     res = run_check(args.db, perf, merge_airports(args.airports), args.workers, params,
                     progress=not args.no_progress)
     rows, summary = res.rows, res.summary
-    out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
+    tmp = folder.open()
     df = pd.DataFrame(rows, columns=list(rows[0]) if rows else list(ROW_COLUMNS))
     df = df.drop(columns=["order"])
-    df.to_parquet(out / "procedures_check.parquet", index=False)
-    df.to_csv(out / "procedures_check.csv", index=False)
+    df.to_parquet(tmp / "procedures_check.parquet", index=False)
+    df.to_csv(tmp / "procedures_check.csv", index=False)
     pd.DataFrame([e.row() for e in res.rejected], columns=list(REJECTED_COLUMNS)).to_csv(
-        out / "rejected_records.csv", index=False)
-    (out / "summary.json").write_text(json.dumps(summary, indent=1, default=float))
+        tmp / "rejected_records.csv", index=False)
+    (tmp / "summary.json").write_text(dumps(summary, indent=1))
     st = summary["by_status"]
     print(f"{summary['transitions']} procedure transitions from {summary['database']} "
           f"({summary['lines']} lines, {summary['parse_issues']} rejected records) in "
@@ -115,7 +120,7 @@ def cmd_check(args) -> int:
     print("  status: " + ", ".join(f"{k} {v}" for k, v in sorted(st.items()))
           + f"  -> ok or corrected {summary['ok_or_corrected_pct']:.2f}% of all transitions")
     print(f"  {summary['rejected_records']} rejected records -> "
-          f"{out / 'rejected_records.csv'}; degraded transitions by defect: "
+          f"{tmp / 'rejected_records.csv'}; degraded transitions by defect: "
           f"{summary['degraded_by_defect'] or 'none'}; internal errors: "
           f"{summary['internal_errors']}")
     print("  leg types (coded/built): " + ", ".join(
@@ -129,6 +134,7 @@ def cmd_check(args) -> int:
           f"{summary['turn_mismatches']}")
     print(f"  corrections by branch: {summary['branches']}; flags: {summary['flags']}")
     print(f"  wrote {out / 'procedures_check.parquet'}, .csv and summary.json")
+    folder.commit()
     return 0 if not math.isnan(summary["ok_or_corrected_pct"]) else 1
 
 
@@ -152,6 +158,7 @@ def register(subparsers) -> None:
                    help="build transitions with rejected, duplicated or misplaced records too "
                         "(refused by default, exit 2)")
     b.add_argument("--out", required=True, help="output folder")
+    add_overwrite_option(b)
     b.set_defaults(func=cmd_build)
     c = sub.add_parser("check", help="build and monitor every procedure transition")
     c.add_argument("--db", **common)
@@ -162,6 +169,7 @@ def register(subparsers) -> None:
                    help="distance flown on FM/VM legs, NM (default 5)")
     c.add_argument("--no-progress", action="store_true", help="no progress bar")
     c.add_argument("--out", required=True, help="output folder")
+    add_overwrite_option(c)
     c.set_defaults(func=cmd_check)
     register_list(sub, common)
     p.set_defaults(func=lambda a: (p.print_help(), 2)[1])

@@ -84,7 +84,8 @@ def config_from_args(args):
         combinations=args.combinations, limit=args.limit, seed=args.seed,
         workers=args.workers or os.cpu_count() or 1, scheduler=args.scheduler,
         case_timeout_s=args.case_timeout, keep=tuple(_split(args.keep)),
-        progress=False if args.no_progress else None, command=list(sys.argv), phase=args.phase)
+        progress=False if args.no_progress else None, command=list(sys.argv), phase=args.phase,
+        batch_rows=args.batch_rows)
 
 
 def cmd_run(args) -> int:
@@ -171,6 +172,9 @@ def register(sub) -> None:
                    help="wall-time limit of one case, s")
     r.add_argument("--keep", help="per-case artefacts to keep: timeseries,plots (in DIR/cases)")
     r.add_argument("--phase", help="Danilin phase label for the report (default: inferred)")
+    r.add_argument("--batch-rows", type=int, default=64, metavar="N",
+                   help="rows per Parquet part file at most (default 64; a part is also "
+                        "written every 15 s)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.add_argument("--out", required=True, help="campaign folder (resumed when it holds one)")
     r.set_defaults(func=cmd_run)

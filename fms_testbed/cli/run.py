@@ -6,7 +6,8 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-from fms_testbed.cli.common import add_override_options, overrides_from_args, print_results
+from fms_testbed.cli.common import (add_override_options, add_overwrite_option, overrides_from_args,
+                                    print_results)
 from fms_testbed.run.outputs import check_out_dir
 from fms_testbed.data import results_dir, scenarios_dir
 
@@ -49,15 +50,13 @@ def register(sub) -> None:
     add_override_options(p)
     p.add_argument("--csv", action="store_true", help="also write timeseries.csv")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace an --out folder that holds other files than a previous run")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_run)
     p = sub.add_parser("demo", help="fly the embedded demo (KJFK DEEZZ5 SID) into results/demo")
     p.add_argument("--out", help="output folder (default results/demo)")
     p.add_argument("--seed", type=int, default=0, help="seed (default 0)")
     p.add_argument("--csv", action="store_true", help="also write timeseries.csv")
-    p.add_argument("--overwrite", action="store_true",
-                   help="replace an --out folder that holds other files than a previous run")
+    add_overwrite_option(p)
     p.set_defaults(func=cmd_demo)
 
 

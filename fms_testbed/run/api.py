@@ -61,10 +61,31 @@ def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedPro
                             "block")
     raw.update(overrides)
     raw.pop("source_file", None)
+    _relative_to(raw, source)
     if raw.get("procedure") is not None:
         return prepare_procedure(raw, source)
     raw.pop("procedure", None)
     return parse_scenario(raw, source), None
+
+
+def _relative_to(raw: dict, source: str) -> None:
+    """Relative file paths in a scenario file (aircraft YAML, IMU YAML) are relative to the
+    scenario's folder, not to the current one (``procedure.db`` is resolved the same way by
+    :func:`fms_testbed.path.plan.load_db`)."""
+    if source.startswith("<"):
+        return
+    base = Path(source).parent
+
+    def fix(v):
+        if isinstance(v, str) and Path(v).suffix in (".yaml", ".yml") and not Path(v).is_absolute():
+            return str(base / v)
+        return v
+
+    if "aircraft" in raw:
+        raw["aircraft"] = fix(raw["aircraft"])
+    nav = raw.get("navigation")
+    if isinstance(nav, dict) and "imu" in nav:
+        raw["navigation"] = {**nav, "imu": fix(nav["imu"])}
 
 
 def _procedure_summary(scn: Scenario, proc: PreparedProcedure) -> dict[str, Any]:

@@ -107,6 +107,12 @@ class OutputFolder:
         self.info: dict = {}
         self.started = datetime.now(timezone.utc)
 
+    def open(self) -> Path:
+        """Create the temporary folder beside the target and return it (what ``with`` does);
+        finish with :meth:`commit`. If the command fails first, the hidden
+        ``.NAME.partial-*`` folder is left behind and removed by the next run into the target."""
+        return self.__enter__()
+
     def __enter__(self) -> Path:
         parent = self.out.parent
         try:

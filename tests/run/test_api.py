@@ -83,3 +83,18 @@ def test_cli_refuses_contradicting_options(capsys):
     assert "not used with it" in capsys.readouterr().err
     assert main(["run", str(SCEN / "demo.yaml"), "--imu", "STIM300"]) == 2
     assert "--imu is only used with --nav sins" in capsys.readouterr().err
+
+
+def test_relative_paths_in_a_scenario_resolve_against_its_folder(tmp_path, monkeypatch):
+    import shutil
+
+    from fms_testbed.data import aircraft_dir
+    sub = tmp_path / "cases"
+    sub.mkdir()
+    shutil.copy(aircraft_dir() / "737.yaml", sub / "my737.yaml")
+    (sub / "s.yaml").write_text(
+        'aircraft: my737.yaml\nduration_s: 2\n'
+        "initial: {lat_deg: 47, lon_deg: 8, alt_m: 3000, tas_kmh: 400}\n")
+    monkeypatch.chdir(tmp_path)                      # not the scenario's folder
+    scn, _ = load(str(sub / "s.yaml"))
+    assert scn.aircraft == str(sub / "my737.yaml")
