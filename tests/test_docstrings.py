@@ -20,6 +20,10 @@ MODULES = [
     # the run path and its contracts
     "core.contracts", "core.earth", "core.processes", "evaluation.outcome", "run.results",
     "run.outputs", "navigation.truth", "sim.divergence", "viz.figure",
+    # regression runs
+    "procedures.index", "campaign.cases", "campaign.conditions", "campaign.rows",
+    "campaign.worker", "campaign.executors", "campaign.store", "campaign.runner",
+    "campaign.diff", "campaign.report", "campaign.figures", "cli.regress",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")

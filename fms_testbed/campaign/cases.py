@@ -102,7 +102,12 @@ class Case:
 
 def case_seed(case_id: str) -> int:
     """The seed of a case from its id alone: ``numpy.random.SeedSequence`` of the id's integer
-    value, first 32-bit word, top bit cleared (JSBSim takes a signed 32-bit seed)."""
+    value, first 32-bit word, top bit cleared (JSBSim takes a signed 32-bit seed).
+
+    Parameters
+    ----------
+    case_id : the case id (hex digits)
+    """
     state = np.random.SeedSequence(int(case_id, 16)).generate_state(1, dtype=np.uint32)
     return int(state[0]) & 0x7FFFFFFF
 
@@ -112,8 +117,15 @@ def _distinct(idents) -> list[str]:
 
 
 def flyable_sequences(seqs: list, combinations: str = "each") -> list[tuple[str, str]]:
-    """The (runway, transition) pairs to fly for one procedure's database sequences (module
-    docstring); '' where a part is not flown."""
+    """The (runway, transition) pairs to fly for one procedure (module docstring); '' where a
+    part is not flown.
+
+    Parameters
+    ----------
+    seqs : the database sequences of one procedure (``proc_type``, ``transition``,
+        ``route_type``)
+    combinations : 'each' or 'all'
+    """
     if combinations not in ("each", "all"):
         raise UserError(f"--combinations {combinations!r}: expected 'each' or 'all'")
     if seqs[0].proc_type == "F":
@@ -133,7 +145,12 @@ def flyable_sequences(seqs: list, combinations: str = "each") -> list[tuple[str,
 
 def used_lines(db, parts: list) -> list[int]:
     """File lines a sequence uses (module docstring), procedure records first in flying order,
-    then the named fixes' records (sorted)."""
+    then the named fixes' records (sorted).
+
+    Parameters
+    ----------
+    db : the database; parts : the sequences flown, in flying order
+    """
     lines = [ln for p in parts for ln in p.lines]
     if not parts:
         return lines
@@ -167,8 +184,13 @@ def _parts(db, airport: str, procedure: str, runway: str, transition: str, seqs:
 
 
 def records_sha256(index: DatabaseIndex, seqs: list, runway: str, transition: str) -> str:
-    """:attr:`Case.records_sha256` of (runway, transition) of the procedure whose database
-    sequences are ``seqs``."""
+    """:attr:`Case.records_sha256` of (runway, transition) of a procedure.
+
+    Parameters
+    ----------
+    index : the database index; seqs : the procedure's database sequences
+    runway, transition : the transitions flown ('' for none)
+    """
     s0 = seqs[0]
     parts = _parts(index.db, s0.airport, s0.proc_id, runway, transition, seqs)
     return index.record_digest(used_lines(index.db, parts))
@@ -176,8 +198,15 @@ def records_sha256(index: DatabaseIndex, seqs: list, runway: str, transition: st
 
 def make_case(seqs: list, runway: str, transition: str, records: str, aircraft: str,
               aircraft_sha256: str, conditions: Conditions, campaign_seed: int) -> Case:
-    """The case flying (runway, transition) of the procedure whose sequences are ``seqs``
-    (``records``: :func:`records_sha256`)."""
+    """The case flying (runway, transition) of a procedure (module docstring: the case id).
+
+    Parameters
+    ----------
+    seqs : the procedure's database sequences; runway, transition : the transitions flown
+    records : :func:`records_sha256` of them
+    aircraft, aircraft_sha256 : the aircraft as given and its file's SHA-256
+    conditions : the condition set; campaign_seed : the campaign's seed
+    """
     s0 = seqs[0]
     ident = {"v": 1, "airport": s0.airport, "type": TYPE_NAMES[s0.proc_type],
              "procedure": s0.proc_id, "runway": runway, "transition": transition,
@@ -190,7 +219,12 @@ def make_case(seqs: list, runway: str, transition: str, records: str, aircraft: 
 
 
 def parse_types(text: str | None) -> list[str]:
-    """``SID,STAR,APPROACH`` (any case, any subset; None: all) → subsection codes."""
+    """``SID,STAR,APPROACH`` (any case, any subset; None: all) → subsection codes.
+
+    Parameters
+    ----------
+    text : the ``--types`` value
+    """
     if not text:
         return list(TYPES.values())
     out = []
@@ -208,6 +242,12 @@ def sample_airports(db, candidates: list[str], n: int, seed: int, types: list[st
     Rule: of ``candidates``, those with at least ``min_transitions`` database transitions of
     the selected ``types`` (counted from the raw records), ranked by the SHA-256 of
     ``'<seed>:<ICAO>'``; the first ``n``. Independent of the Python and numpy versions.
+
+    Parameters
+    ----------
+    db : the database; candidates : ICAO idents to choose from; n : how many
+    seed : the sample seed; types : subsection codes counted; min_transitions : the least
+        number of transitions of those types an airport must have
     """
     if n < 1:
         raise UserError(f"--sample-airports {n}: must be at least 1")
@@ -222,7 +262,12 @@ def sample_airports(db, candidates: list[str], n: int, seed: int, types: list[st
 
 def aircraft_files(names: list[str]) -> list[tuple[str, str]]:
     """(name as given, SHA-256 of its file) for each aircraft; a user error in one line for an
-    unknown aircraft or an unreadable file."""
+    unknown aircraft or an unreadable file.
+
+    Parameters
+    ----------
+    names : aircraft names (``aircraft/NAME.yaml``) or YAML files
+    """
     from fms_testbed.config.aircraft import load_aircraft
 
     out = []
@@ -278,7 +323,12 @@ def enumerate_cases(index: DatabaseIndex, airports: list[str], types: list[str],
 
 def case_from_row(row) -> Case:
     """The case a ``flights`` row records (to fly it again: same id, so the same seed). The
-    aircraft file's SHA-256 is not in the row: it is left empty."""
+    aircraft file's SHA-256 is not in the row: it is left empty.
+
+    Parameters
+    ----------
+    row : a row of the ``flights`` table (mapping or pandas Series)
+    """
     from fms_testbed.campaign.conditions import make_conditions
 
     cond = json.loads(row["conditions_json"])

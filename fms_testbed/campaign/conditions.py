@@ -112,7 +112,13 @@ def _check_block(where: str, key: str, value, model) -> dict:
 
 def make_conditions(raw: dict, where: str) -> Conditions:
     """Validate one condition-set mapping (module docstring); :class:`ConfigError` naming
-    ``where`` and the field."""
+    ``where`` and the field.
+
+    Parameters
+    ----------
+    raw : the mapping (``name``, ``wind``, ``turbulence``, ``navigation``)
+    where : what to name in an error (file and list position, or the options)
+    """
     if not isinstance(raw, dict):
         raise ConfigError(f"{where}: expected a mapping with name/wind/turbulence/navigation")
     for k in raw:
@@ -133,7 +139,12 @@ def make_conditions(raw: dict, where: str) -> Conditions:
 
 
 def default_name(wind: dict | None, turbulence: dict | None, navigation: dict) -> str:
-    """'calm', 'wind 270/30kt', '... turbulence light', '... sins HG1700'."""
+    """'calm', 'wind 270/30kt', '... turbulence light', '... sins HG1700'.
+
+    Parameters
+    ----------
+    wind, turbulence, navigation : the set's validated scenario blocks (None: absent)
+    """
     parts = []
     if wind is None:
         parts.append("calm")
@@ -151,7 +162,12 @@ def default_name(wind: dict | None, turbulence: dict | None, navigation: dict) -
 
 def check_sources(sets: list[Conditions]) -> None:
     """Build each distinct navigation source once (an unknown IMU preset is refused before any
-    flight, naming the condition set)."""
+    flight, naming the condition set).
+
+    Parameters
+    ----------
+    sets : the condition sets
+    """
     from fms_testbed.navigation import make_source
 
     seen = set()
@@ -176,7 +192,12 @@ def _unique(sets: list[Conditions], where: str) -> list[Conditions]:
 
 
 def read_conditions(path: str | Path) -> list[Conditions]:
-    """The condition sets of a YAML file (module docstring)."""
+    """The condition sets of a YAML file (module docstring).
+
+    Parameters
+    ----------
+    path : the file
+    """
     path = Path(path)
     raw = read_mapping(path, "conditions file")
     extra = sorted(set(raw) - {"conditions"})
@@ -192,8 +213,13 @@ def read_conditions(path: str | Path) -> list[Conditions]:
 
 
 def command_line_sets(winds: list[dict | None], navs: list[dict]) -> list[Conditions]:
-    """The product of the ``--wind`` values (None: calm) and the ``--nav`` blocks, winds
-    varying slowest."""
+    """The product of the ``--wind`` values and the ``--nav`` blocks, winds varying slowest.
+
+    Parameters
+    ----------
+    winds : scenario wind mappings (None: calm air)
+    navs : scenario navigation mappings
+    """
     sets = [make_conditions({"wind": w, "navigation": n}, "--wind/--nav")
             for w in winds for n in navs]
     return _unique(sets, "--wind/--nav")

@@ -12,6 +12,10 @@ versions of the testbed compare case by case. For each matched pair the diff rep
   cycle that recodes a procedure changes its records, and its flight is then compared as any
   other).
 
+With ``--across-conditions`` the condition set is left out of the match: a run in calm air
+against the same cases in a 30 kt wind (each run must then hold one condition set per
+sequence and aircraft).
+
 Cases only in one run are listed (a procedure added or removed by a new cycle, a narrower
 selection) and count as changes. The tolerance file is a mapping of column to
 ``{abs: X, rel: Y}`` (or a bare number: ``abs``), e.g.::
@@ -39,6 +43,8 @@ from fms_testbed.core.errors import ConfigError, UserError
 
 KEY = ("airport", "type", "procedure", "runway", "transition", "aircraft", "conditions")
 """Columns that match a case to its twin in the other run."""
+KEY_ACROSS = KEY[:-1]
+"""The match without the condition set (``--across-conditions``)."""
 
 COMPARED = tuple(c for c in ERROR_COLUMNS if c.startswith(("fte", "tse"))) + (
     "constraints_checked", "constraints_missed", "legs_entered", "legs_skipped",
@@ -55,7 +61,12 @@ none on counts."""
 
 def read_tolerances(path: str | Path) -> dict[str, dict[str, float]]:
     """A tolerance file (module docstring), merged over :data:`DEFAULT_TOLERANCES`;
-    :class:`ConfigError` naming the file and the field."""
+    :class:`ConfigError` naming the file and the field.
+
+    Parameters
+    ----------
+    path : the YAML file
+    """
     raw = read_mapping(Path(path), "tolerance file")
     out = {k: dict(v) for k, v in DEFAULT_TOLERANCES.items()}
     for col, val in raw.items():
@@ -85,13 +96,15 @@ def beyond(a: np.ndarray, b: np.ndarray, abs_tol: float, rel_tol: float) -> np.n
     return (na != nb) | (~na & ~nb & far)
 
 
-def _indexed(df: pd.DataFrame, where: str) -> pd.DataFrame:
-    dup = df.duplicated(list(KEY), keep=False)
+def _indexed(df: pd.DataFrame, where: str, key: tuple[str, ...]) -> pd.DataFrame:
+    dup = df.duplicated(list(key), keep=False)
     if dup.any():
         first = df[dup].iloc[0]
+        hint = ("; the run has several condition sets: compare it without --across-conditions"
+                if "conditions" not in key else "")
         raise UserError(f"{where}: {int(dup.sum())} rows share a case key, e.g. "
-                        + " ".join(str(first[k]) for k in KEY if first[k]))
-    return df.set_index(list(KEY))
+                        + " ".join(str(first[k]) for k in key if first[k]) + hint)
+    return df.set_index(list(key))
 
 
 @dataclass
@@ -107,6 +120,7 @@ class DiffResult:
     value_changes : key, ``column``, ``a``, ``b``, ``delta`` (b − a)
     records_changed : matched cases whose database records differ
     tolerances : the tolerance per compared column
+    key : the columns cases were matched by
     """
 
     run_a: str
@@ -118,12 +132,13 @@ class DiffResult:
     value_changes: pd.DataFrame
     records_changed: int
     tolerances: dict = field(default_factory=dict)
+    key: tuple[str, ...] = KEY
 
     @property
     def changed_cases(self) -> int:
         """Matched cases with a status change or a value change beyond tolerance."""
-        keys = set(map(tuple, self.status_changes[list(KEY)].to_numpy())) | \
-            set(map(tuple, self.value_changes[list(KEY)].to_numpy()))
+        keys = set(map(tuple, self.status_changes[list(self.key)].to_numpy())) | \
+            set(map(tuple, self.value_changes[list(self.key)].to_numpy()))
         return len(keys)
 
     @property
@@ -192,10 +207,18 @@ def _md(df: pd.DataFrame) -> str:
 
 
 def diff_frames(a: pd.DataFrame, b: pd.DataFrame, tolerances: dict | None = None,
-                names: tuple[str, str] = ("A", "B")) -> DiffResult:
-    """Compare two ``flights`` tables (module docstring)."""
+                names: tuple[str, str] = ("A", "B"), key: tuple[str, ...] = KEY) -> DiffResult:
+    """Compare two ``flights`` tables (module docstring).
+
+    Parameters
+    ----------
+    a, b : the tables (A is the reference)
+    tolerances : per compared column ``{abs, rel}`` (default :data:`DEFAULT_TOLERANCES`)
+    names : what to call A and B in the result
+    key : the columns that match a case (:data:`KEY`, or :data:`KEY_ACROSS`)
+    """
     tol = tolerances or DEFAULT_TOLERANCES
-    ia, ib = _indexed(a, names[0]), _indexed(b, names[1])
+    ia, ib = _indexed(a, names[0], key), _indexed(b, names[1], key)
     both = ia.index.intersection(ib.index, sort=False).sort_values()
     only_a = ia.loc[ia.index.difference(ib.index).sort_values(), ["status"]].reset_index()
     only_b = ib.loc[ib.index.difference(ia.index).sort_values(), ["status"]].reset_index()
@@ -213,20 +236,28 @@ def diff_frames(a: pd.DataFrame, b: pd.DataFrame, tolerances: dict | None = None
         if m.any():
             changes.append(pd.DataFrame({"column": col, "a": va[m], "b": vb[m],
                                          "delta": vb[m] - va[m]}, index=both[m]).reset_index())
-    cols = list(KEY) + ["column", "a", "b", "delta"]
+    cols = list(key) + ["column", "a", "b", "delta"]
     value_changes = (pd.concat(changes, ignore_index=True)[cols] if changes
                      else pd.DataFrame(columns=cols))
     records = int((pa_["records_sha256"].to_numpy() != pb_["records_sha256"].to_numpy()).sum())
     return DiffResult(names[0], names[1], len(both), only_a, only_b, status_changes,
-                      value_changes, records, tol)
+                      value_changes, records, tol, tuple(key))
 
 
-def diff_runs(run_a: str | Path, run_b: str | Path,
-              tolerances: dict | None = None) -> DiffResult:
-    """Compare the ``flights/`` datasets of two campaign folders (module docstring)."""
+def diff_runs(run_a: str | Path, run_b: str | Path, tolerances: dict | None = None,
+              across_conditions: bool = False) -> DiffResult:
+    """Compare the ``flights/`` datasets of two campaign folders (module docstring).
+
+    Parameters
+    ----------
+    run_a, run_b : the campaign folders (A is the reference)
+    tolerances : per compared column ``{abs, rel}`` (default :data:`DEFAULT_TOLERANCES`)
+    across_conditions : match cases without their condition set (:data:`KEY_ACROSS`)
+    """
     return diff_frames(read_flights(run_a), read_flights(run_b), tolerances,
-                       (str(run_a), str(run_b)))
+                       (str(run_a), str(run_b)), KEY_ACROSS if across_conditions else KEY)
 
 
-__all__ = ["COMPARED", "DEFAULT_TOLERANCES", "KEY", "DiffResult", "beyond", "diff_frames",
+__all__ = ["COMPARED", "DEFAULT_TOLERANCES", "KEY", "KEY_ACROSS", "DiffResult", "beyond",
+           "diff_frames",
            "diff_runs", "read_tolerances"]

@@ -6,12 +6,12 @@ every row to ``on_row`` as it arrives (in completion order; the dataset does not
 Local pool (:func:`run_local`): ``concurrent.futures.ProcessPoolExecutor`` on the
 ``forkserver`` start method (a clean process with the testbed imported once, forked for every
 worker: the parent's threads and open files never reach a worker), at most
-:data:`WINDOW_PER_WORKER` × workers cases in flight. Each worker dies with its parent
-(:func:`~fms_testbed.core.processes.die_with_parent`). When a worker process dies (a crash in
-native code, the out-of-memory killer, the watchdog of ``--case-timeout``) every case in flight
-is suspect: the pool is restarted and the suspects are flown again one at a time, so the case
-that kills a worker again is found and recorded as ``error`` ("the worker process died"), and
-no other case is lost.
+:data:`WINDOW_PER_WORKER` × workers cases in flight. Each worker ends as soon as the campaign
+process does, even after a SIGKILL of it alone (:func:`~.worker.init_pool_worker`). When a
+worker process dies (a crash in native code, the out-of-memory killer, the watchdog of
+``--case-timeout``) every case in flight is suspect: the pool is restarted and the suspects are
+flown again one at a time, so the case that kills a worker again is found and recorded as
+``error`` ("the worker process died"), and no other case is lost.
 
 Dask (:func:`run_dask`): an existing cluster at ``tcp://HOST:PORT``. Its workers must be
 processes with one thread each (JSBSim is one instance per process): a worker with more threads
@@ -26,6 +26,7 @@ stays inside this code path.
 from __future__ import annotations
 
 import multiprocessing
+import os
 import time
 import uuid
 from collections import deque
@@ -49,7 +50,7 @@ def _pool(workers: int) -> ProcessPoolExecutor:
     ctx = multiprocessing.get_context("forkserver")
     ctx.set_forkserver_preload(["fms_testbed.campaign.worker", "fms_testbed.run.api"])
     return ProcessPoolExecutor(max_workers=workers, mp_context=ctx,
-                               initializer=init_pool_worker)
+                               initializer=init_pool_worker, initargs=(os.getpid(),))
 
 
 def _died(case, alone: bool, elapsed_s: float, opts: FlyOptions) -> dict:
@@ -61,8 +62,19 @@ def _died(case, alone: bool, elapsed_s: float, opts: FlyOptions) -> dict:
     return failed_row(case, "error", why, "WorkerDied")
 
 
-def run_local(cases: Iterable, opts: FlyOptions, workers: int, on_row: OnRow) -> None:
-    """Fly ``cases`` on a local pool of ``workers`` processes (module docstring)."""
+def run_local(cases: Iterable, opts: FlyOptions, workers: int, on_row: OnRow,
+              fly: Callable = fly_case) -> None:
+    """Fly ``cases`` on a local pool of ``workers`` processes (module docstring).
+
+    Parameters
+    ----------
+    cases : the cases to fly
+    opts : what every case shares (:class:`~fms_testbed.campaign.worker.FlyOptions`)
+    workers : number of worker processes
+    on_row : called with each row as it arrives
+    fly : the function a worker calls per case, ``fly(case, opts) -> row`` (a module-level
+        function, importable by the workers; default :func:`~.worker.fly_case`)
+    """
     if workers < 1:
         raise UserError(f"--workers {workers}: must be at least 1")
     todo = deque(cases)
@@ -75,11 +87,11 @@ def run_local(cases: Iterable, opts: FlyOptions, workers: int, on_row: OnRow) ->
             if suspects:            # isolation: one suspect at a time, nothing beside it
                 if not inflight:
                     c = suspects.popleft()
-                    inflight[pool.submit(fly_case, c, opts)] = (c, True, time.perf_counter())
+                    inflight[pool.submit(fly, c, opts)] = (c, True, time.perf_counter())
             else:
                 while todo and len(inflight) < window:
                     c = todo.popleft()
-                    inflight[pool.submit(fly_case, c, opts)] = (c, False, time.perf_counter())
+                    inflight[pool.submit(fly, c, opts)] = (c, False, time.perf_counter())
             done, _ = wait(list(inflight), return_when=FIRST_COMPLETED)
             broken = []
             for f in done:
@@ -116,12 +128,23 @@ def _probe_db(path: str, sha: str) -> str:
             got = hashlib.sha256(fh.read()).hexdigest()
     except OSError as exc:
         return f"cannot read {path}: {exc.strerror}"
-    return "" if got == sha else f"{path} has SHA-256 {got[:12]}…, the campaign's is {sha[:12]}…"
+    if got == sha:
+        return ""
+    return f"{path} has SHA-256 {got[:12]}…, the campaign's is {sha[:12]}…"
 
 
 def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
              chunk: int = DASK_CHUNK) -> None:
-    """Fly ``cases`` on the dask.distributed cluster at ``address`` (module docstring)."""
+    """Fly ``cases`` on the dask.distributed cluster at ``address`` (module docstring).
+
+    Parameters
+    ----------
+    address : the scheduler, ``tcp://HOST:PORT``
+    cases : the cases to fly
+    opts : what every case shares (:class:`~fms_testbed.campaign.worker.FlyOptions`)
+    on_row : called with each row as it arrives
+    chunk : futures held at a time at most
+    """
     try:
         from distributed import Client, as_completed
     except ImportError:
@@ -149,17 +172,18 @@ def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
         token = uuid.uuid4().hex[:8]
         it = iter(cases)
         held: dict = {}
-        ac = as_completed()
 
-        def submit(c) -> None:
+        def submit(c):
             f = client.submit(fly_case, c, opts, key=f"fly-{c.case_id}-{token}", pure=False)
             held[f.key] = c
-            ac.add(f)
+            return f
 
+        first = []
         for c in it:
-            submit(c)
-            if len(held) >= chunk:
+            first.append(submit(c))
+            if len(first) >= chunk:
                 break
+        ac = as_completed(first, loop=client.loop)
         for f in ac:
             c = held.pop(f.key)
             try:
@@ -171,7 +195,7 @@ def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
             on_row(row)
             nxt = next(it, None)
             if nxt is not None:
-                submit(nxt)
+                ac.add(submit(nxt))
     finally:
         client.close()
 

@@ -44,13 +44,23 @@ def _stacked(counts: pd.DataFrame, title: str, ylabel: str, height: float) -> Fi
 
 
 def status_counts(df: pd.DataFrame, by: str) -> pd.DataFrame:
-    """Cases per (``by`` value, status), statuses in :data:`STATUSES` order."""
+    """Cases per (``by`` value, status), statuses in :data:`STATUSES` order.
+
+    Parameters
+    ----------
+    df : a table with a ``status`` column; by : the column to group by
+    """
     c = df.groupby([by, "status"]).size().unstack(fill_value=0)
     return c[[s for s in STATUSES if s in c.columns]]
 
 
 def plot_outcomes_by_type(df: pd.DataFrame) -> Figure:
-    """Outcome counts per procedure type; the title gives the share ``ok``."""
+    """Outcome counts per procedure type; the title gives the share ``ok``.
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     c = status_counts(df, "type")
     ok = 100.0 * (df["status"] == "ok").mean() if len(df) else float("nan")
     return _stacked(c, f"Outcome by procedure type: {len(df)} cases, {ok:.1f} % ok",
@@ -59,7 +69,12 @@ def plot_outcomes_by_type(df: pd.DataFrame) -> Figure:
 
 def plot_outcomes_by_airport(df: pd.DataFrame, top: int = 30) -> Figure:
     """Outcome counts of the ``top`` airports with the most cases not ``ok`` (all airports
-    when there are no more)."""
+    when there are no more).
+
+    Parameters
+    ----------
+    df : the ``flights`` table; top : airports drawn at most
+    """
     c = status_counts(df, "airport")
     bad = c.drop(columns=["ok"], errors="ignore").sum(axis=1)
     order = bad.sort_values(ascending=False, kind="stable").index[:top]
@@ -72,7 +87,12 @@ def plot_outcomes_by_airport(df: pd.DataFrame, top: int = 30) -> Figure:
 
 def leg_code_counts(df: pd.DataFrame) -> pd.DataFrame:
     """Cases per (leg code present in the case, status): a case counts once for each distinct
-    path terminator it flies."""
+    path terminator it flies.
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     codes = df["leg_codes"].fillna("").str.split().apply(lambda xs: sorted(set(xs)))
     long = pd.DataFrame({"code": codes, "status": df["status"]}).explode("code")
     long = long.dropna(subset=["code"])
@@ -83,7 +103,12 @@ def leg_code_counts(df: pd.DataFrame) -> pd.DataFrame:
 
 def plot_outcomes_by_leg_code(df: pd.DataFrame) -> Figure:
     """Outcome counts per path terminator flown (a case counts once per distinct code); the
-    title names the code with the highest share not ``ok``."""
+    title names the code with the highest share not ``ok``.
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     c = leg_code_counts(df)
     if not len(c):
         fig, ax = subplots(figsize=(6, 2))
@@ -102,18 +127,25 @@ def plot_outcomes_by_leg_code(df: pd.DataFrame) -> Figure:
 
 def plot_error_distributions(df: pd.DataFrame) -> Figure:
     """Empirical distributions (1 − CDF, log scales) of FTE95, TSE95 and max TSE of the flown
-    cases, with the RNP 0.3 / 1 NM lines; the title gives the medians."""
+    cases, with the RNP 0.3 / 1 NM lines; the title gives the medians. With navigation = truth
+    FTE equals TSE: the wide FTE line is drawn under the dashed TSE one.
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     fig, ax = subplots(figsize=(9.0, 5.0))
     med = []
-    for col, label, colour in (("fte_p95_m", "FTE95", "tab:blue"),
-                               ("tse_p95_m", "TSE95", "tab:orange"),
-                               ("tse_max_m", "max TSE", "tab:red")):
+    for col, label, colour, lw, ls in (("fte_p95_m", "FTE95", "tab:blue", 3.5, "-"),
+                                       ("tse_p95_m", "TSE95", "tab:orange", 1.5, "--"),
+                                       ("tse_max_m", "max TSE", "tab:red", 1.5, "-")):
         x = np.sort(df[col].to_numpy(dtype=float))
         x = x[np.isfinite(x) & (x > 0)]
         if not x.size:
             continue
         exceed = 1.0 - np.arange(x.size) / x.size
-        ax.step(x, exceed, where="post", color=colour, label=f"{label} ({x.size} cases)")
+        ax.step(x, exceed, where="post", color=colour, lw=lw, ls=ls, alpha=0.8,
+                label=f"{label} ({x.size} cases)")
         med.append(f"{label} {np.median(x):.1f} m")
     for rnp_nm, ls in ((0.3, "--"), (1.0, ":")):
         ax.axvline(rnp_nm * NM_M, color="k", ls=ls, lw=0.8, label=f"RNP {rnp_nm:g} NM")
@@ -129,14 +161,24 @@ def plot_error_distributions(df: pd.DataFrame) -> Figure:
 
 
 def finding_counts(df: pd.DataFrame) -> pd.Series:
-    """Cases per monitor finding class (a case counts once per class it has)."""
+    """Cases per monitor finding class (a case counts once per class it has).
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     cls = df["finding_classes"].fillna("").str.split(",").explode()
     cls = cls[cls != ""]
     return cls.value_counts()
 
 
 def plot_findings(df: pd.DataFrame) -> Figure:
-    """Monitor findings by class (cases with at least one), split by outcome ok / not ok."""
+    """Monitor findings by class (cases with at least one), split by outcome ok / not ok.
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     fig, ax = subplots(figsize=(9.0, 3.5))
     ok = finding_counts(df[df["status"] == "ok"])
     bad = finding_counts(df[df["status"] != "ok"])
@@ -158,7 +200,12 @@ def plot_findings(df: pd.DataFrame) -> Figure:
 
 
 def plot_error_classes(counts: dict[str, int]) -> Figure:
-    """Cases per Danilin error class (and the cases no class applies to but not ok)."""
+    """Cases per Danilin error class (and the cases no class applies to but not ok).
+
+    Parameters
+    ----------
+    counts : cases per label (:func:`fms_testbed.campaign.report.class_counts`)
+    """
     fig, ax = subplots(figsize=(9.0, 3.0))
     names = list(counts)
     v = [counts[k] for k in names]

@@ -51,14 +51,24 @@ PHASES = (
 
 
 def png_data_uri(fig, dpi: int = 90) -> str:
-    """A Figure as a ``data:image/png;base64,…`` URI (the report embeds every figure)."""
+    """A Figure as a ``data:image/png;base64,…`` URI (the report embeds every figure).
+
+    Parameters
+    ----------
+    fig : the matplotlib Figure; dpi : resolution, dots per inch
+    """
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=dpi)
     return "data:image/png;base64," + base64.b64encode(buf.getvalue()).decode("ascii")
 
 
 def wilson_interval(k: int, n: int) -> tuple[float, float]:
-    """95 % Wilson score interval of a proportion k/n (scipy's ``binomtest``)."""
+    """95 % Wilson score interval of a proportion k/n (scipy's ``binomtest``).
+
+    Parameters
+    ----------
+    k : successes (here: residual errors); n : trials (cases flown)
+    """
     from scipy.stats import binomtest
 
     if n == 0:
@@ -68,9 +78,16 @@ def wilson_interval(k: int, n: int) -> tuple[float, float]:
 
 
 def refined_classes(df: pd.DataFrame) -> pd.Series:
-    """The error class of each row after the class-1 cross-check (module docstring)."""
+    """The error class of each row after the class-1 cross-check (module docstring).
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     cls = df["error_class"].astype("Float64")
-    nominal = df["conditions_json"].map(_is_nominal)
+    if not len(df):
+        return cls
+    nominal = df["conditions_json"].map(_is_nominal).astype(bool)
     seq = ["airport", "type", "procedure", "runway", "transition", "aircraft"]
     nom = df[nominal].set_index(seq)["status"]
     nom = nom[~nom.index.duplicated()]
@@ -89,7 +106,12 @@ def _is_nominal(cond_json: str) -> bool:
 
 
 def class_counts(df: pd.DataFrame) -> dict[str, int]:
-    """Cases per error class after the cross-check, and the failures no class applies to."""
+    """Cases per error class after the cross-check, and the failures no class applies to.
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     cls = refined_classes(df)
     out = {f"{k}: {v.split(':')[0]}": int((cls == k).sum()) for k, v in ERROR_CLASSES.items()}
     out["refused by the monitor (impossible)"] = int((df["status"] == "impossible").sum())
@@ -98,7 +120,12 @@ def class_counts(df: pd.DataFrame) -> dict[str, int]:
 
 
 def residual(df: pd.DataFrame) -> dict:
-    """Residual-error rate of a run (module docstring)."""
+    """Residual-error rate of a run (module docstring).
+
+    Parameters
+    ----------
+    df : the ``flights`` table (:data:`~fms_testbed.campaign.rows.SCHEMA`)
+    """
     tried = df[~df["status"].isin(NOT_FLOWN)]
     cls = refined_classes(tried)
     k = int(((cls == 1) | (cls == 2)).sum() + tried["status"].isin(("timeout", "error")).sum())
@@ -109,7 +136,12 @@ def residual(df: pd.DataFrame) -> dict:
 
 
 def phase_row(folder: Path, df: pd.DataFrame, info: dict) -> dict:
-    """One row of the phase table."""
+    """One row of the phase table.
+
+    Parameters
+    ----------
+    folder : the run's folder; df : its ``flights`` table; info : its ``run.json``
+    """
     r = residual(df)
     n_air = df["airport"].nunique()
     n_proc = len(df.groupby(["airport", "procedure"]))
@@ -125,7 +157,12 @@ def phase_row(folder: Path, df: pd.DataFrame, info: dict) -> dict:
 
 
 def worst_cases(df: pd.DataFrame, n: int) -> pd.DataFrame:
-    """The ``n`` worst flown cases (module docstring)."""
+    """The ``n`` worst flown cases (module docstring).
+
+    Parameters
+    ----------
+    df : the ``flights`` table; n : how many
+    """
     flown = df[~df["status"].isin(NOT_FLOWN)].copy()
     bad = flown[flown["status"] != "ok"]
     pool = bad if len(bad) else flown
@@ -195,7 +232,15 @@ def _img(fig, alt: str) -> str:
 
 def build_html(folder: Path, df: pd.DataFrame, info: dict, worst: int = 6,
                others: list[tuple[Path, pd.DataFrame, dict]] = (), refly: bool = True) -> str:
-    """The report page (module docstring) as HTML text."""
+    """The report page (module docstring) as HTML text.
+
+    Parameters
+    ----------
+    folder : the run's folder; df : its ``flights`` table; info : its ``run.json``
+    worst : worst cases drawn
+    others : (folder, flights, run.json) of other runs for the phase table
+    refly : fly the worst cases again to draw their tracks
+    """
     e = html.escape
     db = info.get("database", {})
     sess = (info.get("sessions") or [{}])[-1]
@@ -257,9 +302,12 @@ def build_html(folder: Path, df: pd.DataFrame, info: dict, worst: int = 6,
 
 def _worst_section(df: pd.DataFrame, info: dict, n: int, refly: bool) -> list[str]:
     w = worst_cases(df, n)
-    cols = ["case_id", "airport", "type", "procedure", "runway", "transition", "aircraft",
-            "conditions", "status", "reason", "fte_p95_m", "tse_p95_m", "tse_max_m"]
-    out = [f"<h2>Worst cases ({len(w)})</h2>", _table(w[cols])]
+    shown = pd.DataFrame({
+        "case": [_label(r) for _, r in w.iterrows()], "case_id": w["case_id"],
+        "status": w["status"],
+        "reason": [r if len(r) <= 140 else r[:137] + "…" for r in w["reason"].fillna("")],
+        "FTE95, m": w["fte_p95_m"], "TSE95, m": w["tse_p95_m"], "max TSE, m": w["tse_max_m"]})
+    out = [f"<h2>Worst cases ({len(w)})</h2>", _table(shown)]
     if not refly:
         return out + ["<p class='note'>Tracks not drawn (--no-refly).</p>"]
     for _, row in w.iterrows():
@@ -267,13 +315,16 @@ def _worst_section(df: pd.DataFrame, info: dict, n: int, refly: bool) -> list[st
             uri, note = _track(row, info)
         except UserError as exc:
             uri, note = None, f"not re-flown: {exc}"
-        title = " ".join(str(row[c]) for c in ("airport", "type", "procedure", "runway",
-                                               "transition", "aircraft", "conditions") if row[c])
-        out.append(f"<h3>{html.escape(title)}: {html.escape(row['status'])}</h3>"
+        out.append(f"<h3>{html.escape(_label(row))}: {html.escape(row['status'])}</h3>"
                    f"<p class='note'>{html.escape(note)}</p>")
         if uri:
             out.append(f'<img alt="track of {html.escape(row["case_id"])}" src="{uri}">')
     return out
+
+
+def _label(row) -> str:
+    return " ".join(str(row[c]) for c in ("airport", "type", "procedure", "runway",
+                                          "transition", "aircraft", "conditions") if row[c])
 
 
 def _class_section(df: pd.DataFrame) -> list[str]:
@@ -289,7 +340,14 @@ def _class_section(df: pd.DataFrame) -> list[str]:
 
 def write_report(folder: str | Path, worst: int = 6, others: list = (),
                  refly: bool = True) -> Path:
-    """Write ``DIR/report.html`` (module docstring); return its path."""
+    """Write ``DIR/report.html`` (module docstring); return its path.
+
+    Parameters
+    ----------
+    folder : the campaign folder; worst : worst cases drawn
+    others : other campaign folders for the phase table
+    refly : fly the worst cases again to draw their tracks
+    """
     folder = Path(folder)
     info = read_run_json(folder)
     if info is None:

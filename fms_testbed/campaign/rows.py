@@ -39,9 +39,10 @@ monitor refuses the procedure)."""
 RUN_FAILURES = ("timeout", "error")
 """``timeout`` (``--case-timeout`` reached; what was flown is evaluated) and ``error`` (an
 exception, or the worker process died: a bug, with its traceback)."""
-STATUSES = ("ok",) + ORDER + NOT_FLOWN + RUN_FAILURES
+STATUSES = ("ok",) + ORDER + tuple(s for s in NOT_FLOWN if s not in ORDER) + RUN_FAILURES
 """Every status a case can have: the flight outcomes of :mod:`fms_testbed.evaluation.outcome`,
-then :data:`NOT_FLOWN`, then :data:`RUN_FAILURES`."""
+then :data:`NOT_FLOWN`, then :data:`RUN_FAILURES`, each once (``degraded`` is also a flight
+outcome there: a flight built from degraded records; a campaign does not fly those)."""
 
 ERROR_CLASSES = {
     1: "current conditions: the flight failed in wind, turbulence or on a navigation source "
@@ -57,7 +58,13 @@ _STATS = [(q, part) for q in ("fte", "tse", "nse") for part in ("all", "straight
 
 
 def stat_column(quantity: str, part: str, stat: str) -> str:
-    """Column name of one error statistic, e.g. ('fte', 'straight', 'p95') → fte_straight_p95_m."""
+    """Column name of one error statistic, e.g. ('fte', 'straight', 'p95') → fte_straight_p95_m.
+
+    Parameters
+    ----------
+    quantity : 'fte', 'tse' or 'nse'; part : 'all', 'straight' or 'turns'
+    stat : 'p95' or 'max'
+    """
     mid = "" if part == "all" else f"_{part}"
     return f"{quantity}{mid}_{stat}_m"
 
@@ -107,7 +114,12 @@ def error_class(status: str, nominal: bool) -> int | None:
 
 
 def blank_row(case) -> dict:
-    """A row with the case's identity and every other column null (``''`` for text)."""
+    """A row with the case's identity and every other column null (``''`` for text).
+
+    Parameters
+    ----------
+    case : the :class:`~fms_testbed.campaign.cases.Case`
+    """
     row = {c: None for c in COLUMNS}
     row.update(case_id=case.case_id, airport=case.airport, type=case.type,
                procedure=case.procedure, runway=case.runway, transition=case.transition,
@@ -122,7 +134,14 @@ def blank_row(case) -> dict:
 
 def failed_row(case, status: str, reason: str, error_type: str = "",
                traceback: str = "") -> dict:
-    """The row of a case that has no flight to evaluate (not built, raised, worker died)."""
+    """The row of a case that has no flight to evaluate (not built, raised, worker died).
+
+    Parameters
+    ----------
+    case : the case; status : its status (:data:`STATUSES`); reason : why, one line
+    error_type : the exception's class name (status ``error``)
+    traceback : the exception's last frames (status ``error``)
+    """
     row = blank_row(case)
     row.update(status=status, reason=reason, error_type=error_type, traceback=traceback,
                error_class=error_class(status, case.conditions.nominal))
@@ -130,7 +149,12 @@ def failed_row(case, status: str, reason: str, error_type: str = "",
 
 
 def add_sequence(row: dict, seq) -> None:
-    """The merged sequence's name, leg codes and defect kinds (known before building)."""
+    """Set the merged sequence's name, leg codes and defect kinds (known before building).
+
+    Parameters
+    ----------
+    row : the row, updated in place; seq : the merged database sequence
+    """
     row["sequence"] = seq.name
     row["leg_codes"] = " ".join(lg.path_term for lg in seq.legs)
     row["n_legs"] = len(seq.legs)
@@ -138,8 +162,14 @@ def add_sequence(row: dict, seq) -> None:
 
 
 def flown_row(case, summary: dict) -> dict:
-    """The row of a flown case from its flight summary (:class:`~fms_testbed.run.results.
-    Summary`, after :func:`~fms_testbed.evaluation.outcome.decide`)."""
+    """The row of a flown case from its flight summary.
+
+    Parameters
+    ----------
+    case : the case
+    summary : the flight's :class:`~fms_testbed.run.results.Summary` (after
+        :func:`~fms_testbed.evaluation.outcome.decide`)
+    """
     row = blank_row(case)
     proc = summary.get("procedure", {})
     findings = proc.get("findings", [])
@@ -175,7 +205,12 @@ def flown_row(case, summary: dict) -> dict:
 
 
 def table(rows: list[dict]) -> pa.Table:
-    """Rows as an Arrow table with :data:`SCHEMA` (a missing or extra column is an error)."""
+    """Rows as an Arrow table with :data:`SCHEMA` (a missing or extra column is an error).
+
+    Parameters
+    ----------
+    rows : row mappings (:data:`COLUMNS` exactly)
+    """
     for r in rows:
         if set(r) != set(COLUMNS):
             bad = sorted(set(r) ^ set(COLUMNS))

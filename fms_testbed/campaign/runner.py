@@ -27,7 +27,7 @@ from fms_testbed.campaign.store import (CASES, RUN_JSON, BatchWriter, RunLock,
                                         utc_now, write_json_atomic)
 from fms_testbed.campaign.worker import FlyOptions
 from fms_testbed.core.errors import UserError
-from fms_testbed.procedures.index import DatabaseIndex, load_index, parser_hash
+from fms_testbed.procedures.index import DatabaseIndex, cache_dir, load_index, parser_hash
 from fms_testbed.run.outputs import check_out_dir
 
 RUN_KIND = "regress-run"
@@ -89,7 +89,12 @@ class RunConfig:
 
 def select_airports(index: DatabaseIndex, cfg: RunConfig) -> list[str]:
     """The airports of the run: given (checked, upper-cased, repeats merged) or all, then
-    sampled when asked."""
+    sampled when asked.
+
+    Parameters
+    ----------
+    index : the database index; cfg : the run's options
+    """
     from fms_testbed.evaluation.check import merge_airports
     from fms_testbed.procedures.catalogue import check_airport
 
@@ -103,15 +108,22 @@ def select_airports(index: DatabaseIndex, cfg: RunConfig) -> list[str]:
 
 
 def plan(cfg: RunConfig) -> tuple[DatabaseIndex, list[str], list[Case]]:
-    """The database index, the airports and the cases of a run (module docstring)."""
+    """The database index, the airports and the cases of a run (module docstring).
+
+    Parameters
+    ----------
+    cfg : the run's options
+    """
     if cfg.combinations not in ("each", "all"):
         raise UserError(f"--combinations {cfg.combinations!r}: expected 'each' or 'all'")
     if cfg.limit is not None and cfg.limit < 1:
         raise UserError(f"--limit {cfg.limit}: must be at least 1")
-    bad = sorted(set(cfg.keep) - set(KEEP))
+    bad = [k for k in cfg.keep if k not in KEEP]
     if bad:
         raise UserError(f"--keep {','.join(cfg.keep)}: {bad[0]!r} is not one of "
                         f"{', '.join(KEEP)}")
+    if cfg.batch_rows < 1:
+        raise UserError(f"--batch-rows {cfg.batch_rows}: must be at least 1")
     if cfg.case_timeout_s is not None and not cfg.case_timeout_s > 0:
         raise UserError(f"--case-timeout {cfg.case_timeout_s:g}: must be > 0 s")
     check_sources(cfg.conditions)
@@ -128,13 +140,23 @@ def plan(cfg: RunConfig) -> tuple[DatabaseIndex, list[str], list[Case]]:
 
 
 def case_set_sha256(cases: list[Case]) -> str:
-    """SHA-256 of the sorted case ids: what a resumed run must match."""
+    """SHA-256 of the sorted case ids: what a resumed run must match.
+
+    Parameters
+    ----------
+    cases : the run's cases
+    """
     return hashlib.sha256("\n".join(sorted(c.case_id for c in cases)).encode()).hexdigest()
 
 
 def infer_phase(n_airports: int, n_cases: int, n_procedures: int) -> str:
     """Danilin's phase a run's size corresponds to: 'integration' (≥ 100 airports and ≥ 5,000
-    flights), 'test database' (≤ 100 procedures), else 'between phases'."""
+    flights), 'test database' (≤ 100 procedures), else 'between phases'.
+
+    Parameters
+    ----------
+    n_airports, n_cases, n_procedures : the run's size
+    """
     if n_airports >= 100 and n_cases >= 5000:
         return "integration"
     if n_procedures <= 100:
@@ -161,7 +183,12 @@ def _bar(total: int, initial: int, progress: bool | None):
 
 
 def run_campaign(cfg: RunConfig) -> dict:
-    """Fly a campaign into ``cfg.out`` (module docstring); return the final ``run.json``."""
+    """Fly a campaign into ``cfg.out`` (module docstring); return the final ``run.json``.
+
+    Parameters
+    ----------
+    cfg : the run's options
+    """
     out = check_out_dir(cfg.out)
     prev = read_run_json(out)
     if prev is not None and prev.get("kind") != RUN_KIND:
@@ -174,9 +201,10 @@ def run_campaign(cfg: RunConfig) -> dict:
     t_plan = time.perf_counter() - t_plan
     set_sha = case_set_sha256(cases)
     if prev is not None and prev.get("cases", {}).get("set_sha256") != set_sha:
+        old_sha = prev.get("database", {}).get("sha256", "?")
         raise UserError(f"--out {out}: holds a run of other cases ({prev['cases'].get('count')} "
-                        f"cases, database SHA-256 {prev.get('database', {}).get('sha256', '?')[:12]}…); "
-                        "give the same options to resume it, or a new folder")
+                        f"cases, database SHA-256 {old_sha[:12]}…); give the same options to "
+                        "resume it, or a new folder")
     out.mkdir(parents=True, exist_ok=True)
     with RunLock(out):
         clean_partial(out)
@@ -208,7 +236,8 @@ def run_campaign(cfg: RunConfig) -> dict:
         }
         write_json_atomic(out / RUN_JSON, info)
         opts = FlyOptions(str(index.path), index.sha256, cfg.case_timeout_s, tuple(cfg.keep),
-                          str(out / CASES) if cfg.keep else None, cfg.cache_dir)
+                          str(out / CASES) if cfg.keep else None,
+                          cfg.cache_dir or str(cache_dir()))
         writer = BatchWriter(out, cfg.batch_rows, cfg.batch_s)
         bar = _bar(len(cases), len(done), cfg.progress)
         session = Counter()

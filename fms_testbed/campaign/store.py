@@ -57,7 +57,12 @@ def _fsync_dir(folder: Path) -> None:
 
 
 def write_json_atomic(path: Path, data: dict) -> None:
-    """Strict JSON written to a temporary file beside ``path`` and renamed over it."""
+    """Strict JSON written to a temporary file beside ``path`` and renamed over it.
+
+    Parameters
+    ----------
+    path : the file; data : the mapping (:func:`fms_testbed.core.jsonio.dumps`)
+    """
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", dir=path.parent)
     os.fchmod(fd, _FILE_MODE)
     with os.fdopen(fd, "w") as fh:
@@ -69,7 +74,12 @@ def write_json_atomic(path: Path, data: dict) -> None:
 
 
 def read_run_json(out: Path) -> dict | None:
-    """``DIR/run.json`` of a previous run, or None."""
+    """``DIR/run.json`` of a previous run, or None.
+
+    Parameters
+    ----------
+    out : the campaign folder
+    """
     try:
         data = json.loads((out / RUN_JSON).read_text())
     except (OSError, ValueError):
@@ -78,7 +88,12 @@ def read_run_json(out: Path) -> dict | None:
 
 
 def part_files(out: Path) -> list[Path]:
-    """The complete part files of ``DIR/flights`` (sorted by name)."""
+    """The complete part files of ``DIR/flights`` (sorted by name).
+
+    Parameters
+    ----------
+    out : the campaign folder
+    """
     folder = out / FLIGHTS
     if not folder.is_dir():
         return []
@@ -87,7 +102,12 @@ def part_files(out: Path) -> list[Path]:
 
 
 def finished_ids(out: Path) -> set[str]:
-    """Case ids already written (read from the ``case_id`` column of every part file)."""
+    """Case ids already written (read from the ``case_id`` column of every part file).
+
+    Parameters
+    ----------
+    out : the campaign folder
+    """
     ids: set[str] = set()
     for p in part_files(out):
         ids.update(pq.read_table(p, columns=["case_id"]).column("case_id").to_pylist())
@@ -95,7 +115,12 @@ def finished_ids(out: Path) -> set[str]:
 
 
 def clean_partial(out: Path) -> int:
-    """Remove hidden temporary part files a killed run left; return how many."""
+    """Remove hidden temporary part files a killed run left; return how many.
+
+    Parameters
+    ----------
+    out : the campaign folder
+    """
     folder = out / FLIGHTS
     n = 0
     if folder.is_dir():
@@ -186,12 +211,18 @@ def utc_now() -> str:
 
 
 __all__ = ["CASES", "FLIGHTS", "RUN_JSON", "BatchWriter", "RunLock", "clean_partial",
-           "finished_ids", "part_files", "read_flights", "read_run_json", "utc_now", "write_json_atomic"]
+           "finished_ids", "part_files", "read_flights", "read_run_json", "utc_now",
+           "write_json_atomic"]
 
 
 def read_flights(out: str | Path):
     """The ``flights/`` dataset of a campaign folder as a DataFrame (every column of
-    :data:`~.rows.SCHEMA`, even when no part file is written yet)."""
+    :data:`~.rows.SCHEMA`, even when no part file is written yet).
+
+    Parameters
+    ----------
+    out : the campaign folder
+    """
     import pandas as pd
 
     from fms_testbed.campaign.rows import SCHEMA

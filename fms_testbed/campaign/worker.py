@@ -6,7 +6,7 @@ of the campaign's database on its first case (:func:`worker_index`) and keeps it
 load the garbage collector's view of it is frozen (``gc.freeze``), so the flight loop's
 collections do not walk the database's objects. The aircraft configuration is cached per
 process by :func:`fms_testbed.config.aircraft.load_aircraft`. The JSBSim instance is not
-reused between cases: a fresh instance costs ≈ 20 ms (load + trim; ``docs/regression.md``), and
+reused between cases: a fresh instance costs a few ms (load + trim; ``docs/regression.md``), and
 JSBSim keeps engine and FCS state across ``run_ic``, so a reused one would make a case's result
 depend on the case flown before it on that worker.
 
@@ -72,7 +72,12 @@ class CaseTimeout(Exception):
 
 
 def worker_index(opts: FlyOptions) -> DatabaseIndex:
-    """The database index of this process (loaded on first use, then kept)."""
+    """The database index of this process (loaded on first use, then kept).
+
+    Parameters
+    ----------
+    opts : the run's :class:`FlyOptions` (database path and SHA-256, cache folder)
+    """
     with _LOCK:
         ix = _STATE.get(opts.db_path)
         if ix is None:
@@ -86,11 +91,55 @@ def worker_index(opts: FlyOptions) -> DatabaseIndex:
         return ix
 
 
-def init_pool_worker() -> None:
-    """Initializer of a local pool worker: die with the parent (no orphan after a SIGKILL)."""
+def init_pool_worker(campaign_pid: int | None = None) -> None:
+    """Initializer of a local pool worker: never outlive the campaign (no orphan after a
+    SIGKILL of it).
+
+    A ``forkserver`` worker's parent is the fork server, which lives as long as any worker does,
+    so :func:`~fms_testbed.core.processes.die_with_parent` alone does not end it: a daemon
+    thread also waits on a pidfd of the campaign process (Linux ≥ 5.3) and ends the worker at
+    once when that process is gone.
+
+    Parameters
+    ----------
+    campaign_pid : process id of the campaign (the pool's owner); None: the parent only
+    """
     from fms_testbed.core.processes import die_with_parent
 
     die_with_parent()
+    if campaign_pid is not None:
+        exit_with(campaign_pid)
+
+
+def exit_with(pid: int) -> bool:
+    """End this process (``os._exit``) as soon as process ``pid`` ends; False where pidfds are
+    not available (then only :func:`~fms_testbed.core.processes.die_with_parent` applies).
+
+    Parameters
+    ----------
+    pid : the process to follow
+    """
+    import os
+    import select
+
+    if not hasattr(os, "pidfd_open"):
+        return False
+    try:
+        fd = os.pidfd_open(pid)
+    except ProcessLookupError:
+        os._exit(70)            # already gone
+    except OSError:
+        return False
+
+    def _wait() -> None:
+        p = select.poll()
+        p.register(fd, select.POLLIN)
+        while not p.poll():
+            pass
+        os._exit(70)            # EX_SOFTWARE: the campaign died; nothing of this case is kept
+
+    threading.Thread(target=_wait, name="exit-with-campaign", daemon=True).start()
+    return True
 
 
 @contextmanager
@@ -123,7 +172,13 @@ def _tail(exc: BaseException, frames: int = 6) -> str:
 
 def fly_case(case, opts: FlyOptions) -> dict:
     """Fly one case; return its row (:mod:`fms_testbed.campaign.rows`). Never raises (module
-    docstring)."""
+    docstring).
+
+    Parameters
+    ----------
+    case : the :class:`~fms_testbed.campaign.cases.Case`
+    opts : what every case of the run shares (:class:`FlyOptions`)
+    """
     t0 = time.perf_counter()
     stage = ["loading the database"]
     try:
@@ -212,5 +267,6 @@ def fly_on(case, db, db_path: str, timeout_s: float | None = None,
     return row, res
 
 
-__all__ = ["STEP_CHUNK", "WATCHDOG_FACTOR", "CaseTimeout", "FlyOptions", "fly_case", "fly_on",
+__all__ = ["STEP_CHUNK", "WATCHDOG_FACTOR", "CaseTimeout", "FlyOptions", "exit_with", "fly_case",
+           "fly_on",
            "init_pool_worker", "worker_index"]

@@ -7,6 +7,7 @@
         [--case-timeout S] [--keep timeseries,plots] (--workers N | --scheduler tcp://HOST:PORT)
         --out DIR
     fms-testbed regress diff RUN_A RUN_B [--tolerance FILE.yaml] [--markdown FILE.md]
+        [--across-conditions]
     fms-testbed regress report DIR [--worst N] [--with OTHER_DIR …]
 
 ``run`` exits 0 once every case is flown (whatever the flights' outcomes: they are the data;
@@ -83,7 +84,7 @@ def config_from_args(args):
         types=parse_types(args.types), aircraft=_split(args.aircraft) or ["737"],
         combinations=args.combinations, limit=args.limit, seed=args.seed,
         workers=args.workers or os.cpu_count() or 1, scheduler=args.scheduler,
-        case_timeout_s=args.case_timeout, keep=tuple(_split(args.keep)),
+        case_timeout_s=args.case_timeout, keep=tuple(_split([args.keep] if args.keep else [])),
         progress=False if args.no_progress else None, command=list(sys.argv), phase=args.phase,
         batch_rows=args.batch_rows)
 
@@ -113,7 +114,7 @@ def cmd_diff(args) -> int:
     from fms_testbed.campaign.diff import diff_runs, read_tolerances
 
     tol = read_tolerances(args.tolerance) if args.tolerance else None
-    res = diff_runs(args.run_a, args.run_b, tol)
+    res = diff_runs(args.run_a, args.run_b, tol, args.across_conditions)
     print(res.text())
     if args.markdown:
         Path(args.markdown).write_text(res.markdown())
@@ -184,6 +185,8 @@ def register(sub) -> None:
     d.add_argument("run_b", help="campaign folder B")
     d.add_argument("--tolerance", metavar="FILE.yaml", help="per-column tolerances")
     d.add_argument("--markdown", metavar="FILE.md", help="also write the summary as Markdown")
+    d.add_argument("--across-conditions", action="store_true",
+                   help="match cases without their condition set (e.g. calm run vs wind run)")
     d.set_defaults(func=cmd_diff)
 
     q = rs.add_parser("report", help="write DIR/report.html (self-contained)")

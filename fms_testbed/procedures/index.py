@@ -2,9 +2,11 @@
 
 :func:`load_index` reads a file with :func:`~.database.load_database` the first time and keeps
 the loaded :class:`~.database.Database` (before any airport's legs are parsed) as a pickle in a
-cache folder; every later load of the same file by the same parser unpickles it. The whole FAA
-CIFP (53 MB, 196,178 leg records) parses in about 6 s and loads from the index in about 0.4 s
-(``docs/regression.md`` gives the measurement and the command).
+cache folder; every later load of the same file by the same parser unpickles it. Its large
+read-only tables (fixes, airports, raw procedure records, line lists) are held as
+:class:`PackedMapping`: one blob per table, each value unpickled when a flight first looks it up.
+The whole FAA CIFP (53 MB, 196,178 leg records) parses in 3-6 s and loads through the index in
+about 0.1 s (``docs/results/regress.md`` gives the measurement and the command).
 
 Cache key (the file name of the index): the SHA-256 of the file's bytes, its absolute path (the
 database reports it in every message), the *parser hash* — the SHA-256 of the source of every
@@ -13,6 +15,10 @@ module of :mod:`fms_testbed.procedures` that reads records (all of them but this
 :data:`INDEX_FORMAT` and the Python version. A changed file, a changed parser or another Python
 gives another key, so a stale index is never used; the index of an older key for the same path
 is removed when a new one is written.
+
+The file's SHA-256 is remembered beside the index with the file's size, modification time (ns),
+inode and device; while these are unchanged the file is not read again to hash it (the stat
+trust of ``git`` and ``make``).
 
 Cache folder: ``$FMS_TESTBED_CACHE`` when set, else ``$XDG_CACHE_HOME/fms-testbed/index``, else
 ``~/.cache/fms-testbed/index``. An index file is written to a temporary name and renamed into
@@ -46,7 +52,6 @@ from pathlib import Path
 
 import numpy as np
 
-from fms_testbed.core.errors import UserError
 from fms_testbed.data import procedures_dir
 from fms_testbed.procedures.database import EMBEDDED_NAME, Database, _read, load_text
 from fms_testbed.procedures.loader import split_lines
@@ -194,7 +199,12 @@ class PackedMapping(Mapping):
 
 
 def packed(db: Database) -> Database:
-    """The database with its large read-only tables packed (:data:`PACKED_FIELDS`)."""
+    """The database with its large read-only tables packed (:data:`PACKED_FIELDS`).
+
+    Parameters
+    ----------
+    db : a loaded database (before any airport is parsed: ``_parsed`` is not packed)
+    """
     repl = {f: PackedMapping.pack(getattr(db, f)) for f in PACKED_FIELDS
             if isinstance(getattr(db, f, None), dict)}
     return dataclasses.replace(db, **repl)
@@ -367,5 +377,6 @@ def _bytes(path: Path) -> bytes:
     return text.encode("latin-1")
 
 
-__all__ = ["INDEX_FORMAT", "PACKED_FIELDS", "DatabaseIndex", "PackedMapping", "packed", "cache_dir", "line_digests", "load_index",
+__all__ = ["INDEX_FORMAT", "PACKED_FIELDS", "DatabaseIndex", "PackedMapping", "packed",
+           "cache_dir", "line_digests", "load_index",
            "parser_hash", "resolve_db_path"]

@@ -1,0 +1,135 @@
+"""Cases of a campaign: 'each' flies every transition at least once with the fewest sequences,
+'all' every combination; case ids are stable, change exactly with the records a case uses, and
+seed the case by themselves; the airport sample is a seeded rule; conditions the flight stack
+cannot honour are refused."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fms_testbed.campaign.cases import (aircraft_files, case_seed, enumerate_cases,
+                                        flyable_sequences, sample_airports)
+from fms_testbed.campaign.conditions import command_line_sets, make_conditions, read_conditions
+from fms_testbed.core.errors import ConfigError, UserError
+from fms_testbed.procedures.index import load_index
+
+from campaign_helpers import regress
+
+CALM = command_line_sets([None], [{"source": "truth"}])
+
+
+@dataclass(frozen=True)
+class _Seq:
+    proc_type: str
+    transition: str
+    route_type: str = "5"
+
+
+idents = st.lists(st.sampled_from(["RW01", "RW19B", "RW27L", "RW09"]), unique=True, max_size=4)
+enroute = st.lists(st.sampled_from(["ALPHA", "BRAVO", "CHRLY", "DELTA", "ECHO"]), unique=True,
+                   max_size=5)
+
+
+@settings(max_examples=80, deadline=None)
+@given(idents, enroute, st.booleans(), st.sampled_from("DE"))
+def test_each_covers_every_transition_with_the_fewest_sequences(rw, en, common, kind):
+    seqs = [_Seq(kind, t) for t in rw + en] + ([_Seq(kind, "ALL")] if common else [])
+    if not seqs:
+        return
+    each = flyable_sequences(seqs, "each")
+    assert {r for r, _ in each if r} == set(rw) and {t for _, t in each if t} == set(en)
+    assert len(each) == max(len(rw), len(en), 1)
+    every = flyable_sequences(seqs, "all")
+    assert len(every) == max(len(rw), 1) * max(len(en), 1) and len(set(every)) == len(every)
+    assert set(each) <= set(every)
+
+
+def test_approach_transitions_and_the_final_alone():
+    seqs = [_Seq("F", "", "R"), _Seq("F", "ALPHA", "A"), _Seq("F", "BRAVO", "A")]
+    assert flyable_sequences(seqs, "each") == [("", "ALPHA"), ("", "BRAVO")]
+    assert flyable_sequences(seqs, "all") == [("", "ALPHA"), ("", "BRAVO"), ("", "")]
+    assert flyable_sequences(seqs[:1], "each") == [("", "")]
+
+
+def _cases(db_path=None, seed=0):
+    ix = load_index(db_path)
+    return enumerate_cases(ix, ["KBFI", "KDLS"], ["D", "E", "F"], aircraft_files(["737"]),
+                           CALM, "each", seed)
+
+
+def test_case_ids_are_stable_unique_and_seed_the_case():
+    a, b = _cases(), _cases()
+    assert [c.case_id for c in a] == [c.case_id for c in b]
+    assert len({c.case_id for c in a}) == len(a)
+    assert len({c.key for c in a}) == len(a)
+    assert all(c.seed == case_seed(c.case_id) and 0 <= c.seed < 2**31 for c in a)
+    other = _cases(seed=1)
+    assert not {c.case_id for c in a} & {c.case_id for c in other}
+
+
+def test_case_id_changes_exactly_with_the_records_a_case_uses(tmp_path):
+    base = _cases()
+    src = load_index(None).path
+    lines = Path(src).read_text(encoding="latin-1").split("\n")
+    # recode the altitude of one leg of KBFI's CBAIN1 SID (cols 85-89)
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("SUSAP KBFIK1DCBAIN1")
+             and ln[84:89].strip())
+    lines[k] = lines[k][:84] + "09000" + lines[k][89:]
+    copy = tmp_path / "db.dat"
+    copy.write_text("\n".join(lines), encoding="latin-1")
+    after = _cases(copy)
+    changed = {a.key for a, b in zip(base, after) if a.case_id != b.case_id}
+    assert [a.key for a in base] == [b.key for b in after]
+    assert changed and all(key[2] == "CBAIN1" for key in changed)
+
+
+def test_airport_sample_is_a_seeded_rule():
+    db = load_index(None).db
+    known = db.airport_idents()
+    s1 = sample_airports(db, known, 4, 7, ["D", "E", "F"])
+    assert s1 == sample_airports(db, known, 4, 7, ["D", "E", "F"]) and len(s1) == 4
+    assert s1 == sorted(s1) and set(s1) <= set(known)
+    assert any(sample_airports(db, known, 4, s, ["D", "E", "F"]) != s1 for s in range(8))
+    big = sample_airports(db, known, 2, 7, ["D", "E", "F"], min_transitions=40)
+    assert all(len(db.procedure_index(a)) >= 40 for a in big)
+    with pytest.raises(UserError, match="only"):
+        sample_airports(db, known, 50, 7, ["D"])
+
+
+def test_conditions_refuse_what_the_stack_cannot_fly(tmp_path):
+    with pytest.raises(ConfigError, match="isa_dev_c.*not modelled"):
+        make_conditions({"isa_dev_c": 15}, "x")
+    with pytest.raises(ConfigError, match="missed.*not flown"):
+        make_conditions({"missed": True}, "x")
+    with pytest.raises(ConfigError, match="wind.from_deg"):
+        make_conditions({"wind": {"from_deg": 400, "speed_kt": 10}}, "x")
+    f = tmp_path / "c.yaml"
+    f.write_text("conditions:\n  - {name: a}\n  - {name: a, wind: {from_deg: 90, speed_kt: 5}}\n")
+    with pytest.raises(ConfigError, match="unique"):
+        read_conditions(f)
+    f.write_text("conditions:\n  - {name: calm}\n  - name: west\n    wind: {from_deg: 270, "
+                 "speed_kt: 30}\n")
+    sets = read_conditions(f)
+    assert [c.name for c in sets] == ["calm", "west"]
+    assert sets[0].nominal and not sets[1].nominal
+
+
+@pytest.mark.parametrize("argv, msg", [
+    (["--isa-dev-c", "10"], "--isa-dev-c: ISA temperature deviation"),
+    (["--missed"], "--missed: missed approaches are not flown"),
+    (["--nav", "sins"], "give the IMU preset"),
+    (["--nav", "sins:NOPE"], "unknown IMU preset"),
+    (["--keep", "movies"], "'movies' is not one of"),
+    (["--airports", "KXXX"], "no airport 'KXXX'"),
+    (["--types", "SIDS"], "is not one of SID, STAR, APPROACH"),
+])
+def test_run_refuses_in_one_line(argv, msg, tmp_path, capsys):
+    assert regress("run", *argv, "--out", str(tmp_path / "o"), "--no-progress") == 2
+    err = capsys.readouterr().err.strip()
+    assert msg in err and len(err.splitlines()) == 1
+    assert not (tmp_path / "o").exists()
