@@ -84,8 +84,9 @@ def add_override_options(p, aircraft_default: str | None = None) -> None:
                                                         if aircraft_default else
                                                         " (overrides the scenario's)"))
     p.add_argument("--wind", help=WIND_HELP)
-    p.add_argument("--nav", choices=("truth", "sins"), help="navigation source guidance flies on")
-    p.add_argument("--imu", help="IMU preset of the SINS (with --nav sins)")
+    p.add_argument("--nav", choices=("truth", "sins", "ins_gnss"),
+                   help="navigation source guidance flies on")
+    p.add_argument("--imu", help="IMU preset of the INS (with --nav sins or ins_gnss)")
     p.add_argument("--rnp", type=float, help="RNP, NM, where the procedure's records code none")
     p.add_argument("--allow-degraded", action="store_true",
                    help="fly a procedure with a rejected or duplicated record of its own "
@@ -103,12 +104,12 @@ def overrides_from_args(args) -> dict:
     if getattr(args, "wind", None):
         out["wind"] = parse_wind(args.wind)
     nav, imu = getattr(args, "nav", None), getattr(args, "imu", None)
-    if nav == "sins":
+    if nav in ("sins", "ins_gnss"):
         if not imu:
-            raise UserError("--nav sins needs --imu PRESET")
-        out["navigation"] = {"source": "sins", "imu": imu}
+            raise UserError(f"--nav {nav} needs --imu PRESET")
+        out["navigation"] = {"source": nav, "imu": imu}
     elif imu:
-        raise UserError("--imu is only used with --nav sins")
+        raise UserError("--imu is only used with --nav sins or --nav ins_gnss")
     elif nav == "truth":
         out["navigation"] = {"source": "truth"}
     proc: dict = {}

@@ -122,7 +122,7 @@ class BaroBlock(BaseModel):
     markov_tau_s: Annotated[float, Field(ge=1, le=1e6)] = Field(
         1800.0, description="bias correlation time, s")
     white_sigma_m: Annotated[float, Field(gt=0, le=100)] = Field(0.5, description="white σ, m")
-    rate_hz: Annotated[float, Field(gt=0, le=50)] = Field(10.0, description="reading rate, Hz")
+    rate_hz: Annotated[float, Field(gt=0, le=50)] = Field(1.0, description="reading rate, Hz")
     failed_from_s: Annotated[float, Field(ge=0)] | None = Field(
         None, description="the output freezes from this time (stuck static port), s")
 
@@ -134,7 +134,7 @@ class FilterBlock(BaseModel):
     gate_sigma: Annotated[float, Field(gt=0, le=100)] = Field(
         5.0, description="innovation gate per component, σ")
     unmodelled_tau_s: Annotated[float, Field(ge=0, le=1e5)] = Field(
-        100.0, description="correlation time of the noise standing in for the scale factors "
+        20.0, description="correlation time of the noise standing in for the scale factors "
                            "and misalignments the filter does not carry, s")
     method: Literal["picard", "vanloan"] = Field("picard", description="discretisation")
 

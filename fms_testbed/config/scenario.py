@@ -164,6 +164,56 @@ class When(_Strict):
         return self
 
 
+FAULT_KINDS = {
+    "gyro_bias_step": "ins", "accel_bias_step": "ins", "drift_scale": "ins", "stuck": "ins",
+    "gnss_outliers": "gnss", "gnss_ramp": "gnss", "gnss_outage": "gnss", "baro_failure": "baro"}
+"""Injectable navigation faults and the unit kind each applies to."""
+
+
+class Fault(_Strict):
+    """A navigation fault injected when its event fires (navigation source ``ins_gnss``).
+
+    INS (``unit: ins1``..``ins3``): ``gyro_bias_step`` (``axis``, ``size_dph``),
+    ``accel_bias_step`` (``axis``, ``size_ug``), ``drift_scale`` (``factor``: the gyro drift
+    becomes ``factor`` × its declared value), ``stuck`` (output frozen). GNSS (``unit: gnss``):
+    ``gnss_outliers`` (``sigma_m``, ``duration_s``), ``gnss_ramp`` (``rate_mps`` E, N, U),
+    ``gnss_outage`` (``duration_s``). Baro (``unit: baro``): ``baro_failure`` (stuck port).
+    """
+
+    unit: str = Field(description="ins1, ins2, ins3, gnss or baro")
+    kind: Literal["gyro_bias_step", "accel_bias_step", "drift_scale", "stuck", "gnss_outliers",
+                  "gnss_ramp", "gnss_outage", "baro_failure"] = Field(description="fault kind")
+    axis: Literal["x", "y", "z"] | None = Field(None, description="body axis (bias steps)")
+    size_dph: Annotated[float, Field(ge=-3.6e5, le=3.6e5)] | None = Field(
+        None, description="gyro bias step, deg/h")
+    size_ug: Annotated[float, Field(ge=-1e6, le=1e6)] | None = Field(
+        None, description="accelerometer bias step, µg")
+    factor: Annotated[float, Field(gt=0, le=100)] | None = Field(
+        None, description="drift scale factor (drift_scale)")
+    sigma_m: Annotated[float, Field(gt=0, le=1e5)] | None = Field(
+        None, description="outlier σ per axis, m (gnss_outliers)")
+    rate_mps: Annotated[list[Annotated[float, Field(ge=-100, le=100)]],
+                        Field(min_length=3, max_length=3)] | None = Field(
+        None, description="ramp rate E, N, U, m/s (gnss_ramp)")
+    duration_s: Annotated[float, Field(gt=0)] | None = Field(
+        None, description="how long it lasts, s (gnss_outliers, gnss_outage; default: to the end)")
+
+    @model_validator(mode="after")
+    def _fits(self):
+        want = FAULT_KINDS[self.kind]
+        ok_unit = (self.unit in ("ins1", "ins2", "ins3") if want == "ins" else self.unit == want)
+        if not ok_unit:
+            raise ValueError(f"fault {self.kind} applies to "
+                             f"{'ins1..ins3' if want == 'ins' else want}, not {self.unit!r}")
+        need = {"gyro_bias_step": ("axis", "size_dph"), "accel_bias_step": ("axis", "size_ug"),
+                "drift_scale": ("factor",), "gnss_outliers": ("sigma_m",),
+                "gnss_ramp": ("rate_mps",)}.get(self.kind, ())
+        missing = [k for k in need if getattr(self, k) is None]
+        if missing:
+            raise ValueError(f"fault {self.kind} needs {', '.join(missing)}")
+        return self
+
+
 class Event(_AltSpeed):
     """A target change at time ``t_s`` (or when ``when`` is met). Unset fields are unchanged."""
 
@@ -179,6 +229,7 @@ class Event(_AltSpeed):
         None, description="normal (lift-axis) load-factor target, g")
     throttle: Annotated[float, Field(ge=0, le=1)] | None = Field(
         None, description="direct throttle 0..1 (disengages the n_x loop)")
+    fault: Fault | None = Field(None, description="navigation fault injected when it fires")
 
     @model_validator(mode="after")
     def _check(self):

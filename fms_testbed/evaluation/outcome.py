@@ -15,7 +15,8 @@ status                 meaning                                                  
                        limit load factors of the aircraft file
 ``not_contained``      RNP containment lost: on some leg TSE95 > RNP or max       1
                        TSE > 2 × RNP (procedure flights); NSE95 > RNP or max
-                       NSE > 2 × RNP (other flights with a navigation source)
+                       NSE > 2 × RNP (other flights with a navigation source);
+                       or the on-board RNP alert was raised (ANP > RNP)
 ``constraints_missed`` a coded altitude/speed constraint was missed               1
 =====================  =========================================================  =========
 
@@ -155,6 +156,10 @@ def decide(summary: dict, df: pd.DataFrame, cfg: AircraftConfig,
             found["not_contained"].append(
                 f"navigation error NSE95 {nc['nse95_m']:.0f} m / max {nc['nse_max_m']:.0f} m "
                 f"outside RNP {rnp_nm:g} NM")
+    if "rnp_alert" in df and (df["rnp_alert"].to_numpy() > 0).any():
+        t_alert = float(df["t_s"].to_numpy()[np.argmax(df["rnp_alert"].to_numpy() > 0)])
+        checks["rnp_alert"] = {"ok": False, "first_t_s": round(t_alert, 2)}
+        found["not_contained"].append(f"RNP alert (ANP > RNP) from t={t_alert:.1f} s")
     if "constraints" in summary:
         bad = [c for c in summary["constraints"] if c.get("ok") is False]
         checks["constraints"] = {"ok": not bad, "checked": len(summary["constraints"]),

@@ -97,6 +97,13 @@ class Flight:
             where = scn.source_file or scn.name or "scenario"
             raise type(exc)(f"{where}: {exc}") from None
         self.navigation = source
+        faults = [ev.fault.model_dump(exclude_none=True) for ev in scn.events if ev.fault]
+        if faults and not hasattr(source, "inject"):
+            raise UserError(f"{scn.source_file or scn.name or 'scenario'}: events.fault needs a "
+                            f"navigation source that takes faults (ins_gnss), not "
+                            f"{nav_spec.get('source')!r}")
+        for fault in faults:
+            source.check_fault(fault)
         self.vertical_law = vertical_law or VERTICAL_LAWS[scn.vertical_law](cfg)
         self.guidance = guidance
         self.n_frames = max(1, int(round(1.0 / (scn.outer_rate_hz * ac.dt_s))))
@@ -182,6 +189,8 @@ class Flight:
             if events.pending:                              # events
                 for ev in events.due(s.t_s, s.alt_m):
                     apply_event(ev, tg)
+                    if ev.fault is not None:                # navigation fault injection
+                        self.navigation.inject(ev.fault.model_dump(exclude_none=True), s.t_s)
             gout = guide.update(dt_outer, nav, s) if guide is not None else None   # guide
             if gout is not None:
                 merge_guidance(gout, tg)

@@ -79,7 +79,7 @@ class FilterTuning:
     """
 
     gate_sigma: float = 5.0
-    unmodelled_tau_s: float = 100.0
+    unmodelled_tau_s: float = 20.0
     method: str = "picard"
 
     def __post_init__(self):
@@ -192,13 +192,21 @@ class InsGnssFilter:
     # -- initialisation and prediction ----------------------------------------------------
     def initialise(self, ins: NavSolution) -> None:
         """P0 at the first INS output: the INS block from the alignment (A diag(p0) Aᵀ of the
-        33-state model, :func:`~fms_testbed.sensors.sins.analysis.initial_map`) plus the
+        33-state model, :func:`~fms_testbed.sensors.sins.analysis.initial_map`, at the indicated
+        attitude, widened by the spread of A over the heading error σ_ψ) plus the
         equivalent-bias variance of the unmodelled accelerometer errors at 1 g; the GNSS and baro
         states at their stationary variance."""
         imu = self.imu
         rpy = (ins.roll_rad, ins.pitch_rad, ins.heading_rad)
         A = initial_map(ins.lat_rad, rpy, imu, SinsOptions())
         P33 = (A * imu.p0_var) @ A.T
+        # the map is built at the indicated heading, off by the alignment's own heading error:
+        # add the first-order spread of A over that error, σ_ψ² (∂A/∂ψ) diag(p0) (∂A/∂ψ)ᵀ —
+        # without it the nearly singular (ε_U, b_g) block of P0 is confidently wrong
+        h = 1e-4
+        dA = (initial_map(ins.lat_rad, (rpy[0], rpy[1], rpy[2] + h), imu, SinsOptions())
+              - initial_map(ins.lat_rad, (rpy[0], rpy[1], rpy[2] - h), imu, SinsOptions())) / (2 * h)
+        P33 += P33[8, 8] * (dA * imu.p0_var) @ dA.T
         P = np.zeros((self.n, self.n))
         P[:15, :15] = P33[:15, :15]
         g2 = G0_MPS2 ** 2

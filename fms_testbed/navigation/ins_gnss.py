@@ -9,22 +9,27 @@ Scenario block (``navigation:``, validated by :class:`~fms_testbed.config.naviga
     seed: 7                      # optional; otherwise the run seed
     gnss: {rate_hz: 1, latency_s: 0.1, pos_markov_sigma_m: [1, 1, 2], ...,
            outages: [{start_s: 300, end_s: 360}], outliers: [...], ramps: [...]}
-    baro: {markov_sigma_m: 5, markov_tau_s: 1800, white_sigma_m: 0.5, rate_hz: 10}   # or null
-    filter: {gate_sigma: 5, unmodelled_tau_s: 100, method: picard}
+    baro: {markov_sigma_m: 5, markov_tau_s: 1800, white_sigma_m: 0.5, rate_hz: 1}   # or null
+    filter: {gate_sigma: 5, unmodelled_tau_s: 20, method: picard}
     alert_delay_s: 2
 
 One :meth:`InsGnssNavigation.update` per navigation step: the INS units advance (truth ⊕ their
-errors), each filter predicts over the step, the baro reading and any delivered GNSS fix are
-used (innovation-gated, Joseph form), the INS block of each estimate is fed back to its unit at
-every GNSS update, and the output is unit 0's corrected solution with the filter's position
-covariance (``pos_cov_enu_m2``) and ANP. Logged columns (``NavSolution.errors``): ``anp_m``
-(95 % horizontal radius of P, m), ``nav_mode`` (:data:`~.monitor.NAV_MODES`), ``ins_used`` (bit
-mask of the units the output uses), ``nse_{east,north,up}_m`` (output - truth, truth side),
-``att_err_{roll,pitch,heading}_deg`` (output - truth) and ``sigma_heading_deg`` (filter). Events
-(``events``: GNSS groups rejected by the gate / accepted again) go to ``summary.json``.
+errors), each filter predicts over the step, any delivered GNSS fix is used (innovation-gated,
+delayed-measurement correction, Joseph form) and the INS block of each estimate is fed back to
+its unit, then the baro reading; with two or three units the two-stage identification of seed
+001 (:mod:`.fdi`) runs, and the output is the mean of the units in use (unit 0 alone for one
+unit) with the filters' position covariance (``pos_cov_enu_m2``) and ANP. Logged columns
+(``NavSolution.errors``): ``anp_m`` (95 % horizontal radius of P, m), ``nav_mode``
+(:data:`~.monitor.NAV_MODES`), ``ins_used`` (bit mask of the units in use),
+``nse_{east,north,up}_m`` (output - truth, truth side), ``att_err_{roll,pitch,heading}_deg``
+(output - truth), ``sigma_heading_deg`` (filter) and, with identification,
+``nse_vote_{east,north}_m`` (the majority-voting baseline) and ``fdi_nu`` (ν12 + 2 ν13 + 4 ν23).
+Events (``events``: faults injected, gate rejections, detection, isolation, exclusion,
+reconfiguration) go to ``summary.json``; faults come from scenario events (:meth:`inject`).
 
-Seeds: ``navigation.seed`` or the run seed → :func:`~.ins_bank.derive_seeds` → one stream per INS
-unit, the GNSS receiver and the baro.
+Seeds: ``navigation.seed`` or the run seed → :func:`~.ins_bank.derive_seeds` → one stream each
+for the GNSS receiver, the baro and every INS unit (in that order: adding a unit changes no other
+realisation).
 """
 
 from __future__ import annotations
@@ -40,7 +45,10 @@ from fms_testbed.core.earth import radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.navigation.ins_bank import InsBank, derive_seeds
-from fms_testbed.navigation.ins_filter import FilterTuning, GroupResult, InsGnssFilter
+from fms_testbed.navigation.faults import check_fault, inject
+from fms_testbed.navigation.fdi import SensorComparator, TwoStageFdi, channel_sigmas
+from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter,
+                                               _unmodelled_variances, enu_difference_m)
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
 from fms_testbed.sensors.baro import BaroAltimeter, BaroSpec
 from fms_testbed.sensors.gnss import GnssReceiver, GnssSpec, Interval, OutlierBurst, Ramp
@@ -88,6 +96,19 @@ def corrected(sol: NavSolution, dx9: np.ndarray) -> tuple[float, float, float, n
             sol.pitch_rad - float(d_pitch), (sol.heading_rad - float(d_head)) % (2 * math.pi))
 
 
+def _mean_solution(sols: list[tuple]) -> tuple:
+    """Mean of corrected solutions (lat, lon, alt, V, roll, pitch, heading); circular mean of
+    heading."""
+    if len(sols) == 1:
+        return sols[0]
+    a = list(zip(*sols))
+    hdg = math.atan2(sum(math.sin(h) for h in a[6]), sum(math.cos(h) for h in a[6]))
+    n = len(sols)
+    return (sum(a[0]) / n, sum(a[1]) / n, sum(a[2]) / n, sum(a[3]) / n, sum(a[4]) / n,
+            sum(a[5]) / n,
+            hdg % (2 * math.pi))
+
+
 class InsGnssNavigation:
     """INS/GNSS navigation source; see the module docstring for the scenario keys.
 
@@ -95,20 +116,24 @@ class InsGnssNavigation:
     ----------
     bank : the INS units;  receiver : the GNSS receiver;  baro : the baro (or None)
     filters : one filter per unit;  alert_delay_s : RNP-alert persistence, s
+    fdi : the two-stage identification over the units (None: one unit, or no monitoring)
     """
 
     def __init__(self, bank: InsBank, receiver: GnssReceiver, baro: BaroAltimeter | None,
-                 filters: list[InsGnssFilter], alert_delay_s: float = DEFAULT_ALERT_DELAY_S):
+                 filters: list[InsGnssFilter], alert_delay_s: float = DEFAULT_ALERT_DELAY_S,
+                 fdi: TwoStageFdi | None = None):
         self.bank, self.receiver, self.baro, self.filters = bank, receiver, baro, filters
         self.alert_delay_s = float(alert_delay_s)
+        self.fdi = fdi
+        self.comparator: SensorComparator | None = None     # built at the second step (dt)
         self.events: list[dict] = []
         self._prev_truth: AircraftState | None = None
         self._prev_ins: list[NavSolution] = []
         self._buffer: list[list[NavSolution]] = [[] for _ in filters]
-        self._gate_open = {"gnss_pos": True, "gnss_vel": True}
+        self._gate_open = [{"gnss_pos": True, "gnss_vel": True, "baro": True} for _ in filters]
         self._last_fix_used_s = -math.inf
-        self.last_groups: list[GroupResult] = []
-        self.nis_log: list[tuple[float, str, float, int]] = []   # (t_s, group, NIS, dim)
+        self._prev_sensor_t: float | None = None
+        self.nis_log: list[tuple[float, str, float, int]] = []   # unit 0: (t_s, group, NIS, dim)
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "InsGnssNavigation":
@@ -125,41 +150,53 @@ class InsGnssNavigation:
             raise ConfigError(msg.replace("navigation: field '", "field 'navigation.", 1)) from None
         imu = load_imu(b.imu)
         sd = b.seed if b.seed is not None else (0 if seed is None else int(seed))
-        seeds = derive_seeds(sd, b.n_ins + 2)
+        seeds = derive_seeds(sd, b.n_ins + 2)        # [GNSS, baro, INS 1, INS 2, ...]
         g, br = gnss_spec(b.gnss), baro_spec(b.baro)
         tuning = FilterTuning(b.filter.gate_sigma, b.filter.unmodelled_tau_s, b.filter.method)
-        bank = InsBank([imu] * b.n_ins, seeds[:b.n_ins], method=b.filter.method)
+        bank = InsBank([imu] * b.n_ins, seeds[2:], method=b.filter.method)
         filters = [InsGnssFilter(imu, g, br, tuning) for _ in range(b.n_ins)]
-        baro = BaroAltimeter(br, seeds[-1]) if br is not None else None
-        src = cls(bank, GnssReceiver(g, seeds[-2]), baro, filters,
-                  DEFAULT_ALERT_DELAY_S if b.alert_delay_s is None else b.alert_delay_s)
+        baro = BaroAltimeter(br, seeds[1]) if br is not None else None
+        fdi = TwoStageFdi(b.n_ins) if b.n_ins > 1 else None
+        src = cls(bank, GnssReceiver(g, seeds[0]), baro, filters,
+                  DEFAULT_ALERT_DELAY_S if b.alert_delay_s is None else b.alert_delay_s, fdi)
         src.seed = sd
         return src
 
-    # -- one navigation step -------------------------------------------------------------
+    # -- faults ----------------------------------------------------------------------------
+    def check_fault(self, fault: dict) -> None:
+        """Raise ConfigError when a scenario fault names a unit this source does not have."""
+        check_fault(fault, len(self.bank), self.baro is not None)
+
+    def inject(self, fault: dict, t_s: float) -> None:
+        """Inject a scenario fault at ``t_s`` (s) on the truth side
+        (:mod:`fms_testbed.navigation.faults`); logs a ``fault_injected`` event."""
+        self.events.append(inject(self, fault, t_s))
+
+    # -- one navigation step ---------------------------------------------------------------
     def _ins_at(self, i: int, t_s: float) -> NavSolution | None:
         for sol in reversed(self._buffer[i]):
             if abs(sol.t_s - t_s) <= 1e-6:
                 return sol
         return None
 
-    def _gate_events(self, t_s: float, groups: list[GroupResult]) -> None:
+    def _gate_events(self, i: int, t_s: float, groups: list[GroupResult]) -> None:
         for g in groups:
-            if g.name not in self._gate_open:
-                continue
-            was = self._gate_open[g.name]
+            sensor = "baro" if g.name == "baro" else "gnss"
+            unit = sensor if len(self.filters) == 1 else f"{sensor}@ins{i + 1}"
+            was = self._gate_open[i][g.name]
             if was and not g.used:
-                self.events.append({"t_s": round(t_s, 3), "unit": "gnss", "kind": "detected",
+                r = np.max(np.abs(g.innovation) / np.sqrt(np.diag(g.S)))
+                self.events.append({"t_s": round(t_s, 3), "unit": unit, "kind": "detected",
                                     "stage": "innovation_gate",
-                                    "reason": f"{g.name} rejected: max |ν|/σ "
-                                              f"{np.max(np.abs(g.innovation) / np.sqrt(np.diag(g.S))):.1f}"})
+                                    "reason": f"{g.name} rejected: max |ν|/σ {r:.1f}"})
             elif not was and g.used:
-                self.events.append({"t_s": round(t_s, 3), "unit": "gnss", "kind": "reconfigured",
+                self.events.append({"t_s": round(t_s, 3), "unit": unit, "kind": "reconfigured",
                                     "stage": "innovation_gate", "reason": f"{g.name} accepted again"})
-            self._gate_open[g.name] = g.used
+            self._gate_open[i][g.name] = g.used
 
     def update(self, truth: AircraftState) -> NavSolution:
-        """Advance to ``truth.t_s``: INS, prediction, baro, GNSS, feedback; return the output."""
+        """Advance to ``truth.t_s``: INS, prediction, GNSS (feedback), baro, identification;
+        return the output."""
         ins = self.bank.update(truth)
         t = truth.t_s
         prev = self._prev_truth
@@ -172,45 +209,86 @@ class InsGnssNavigation:
             buf.append(ins[i])
             while buf and buf[0].t_s < t - _BUFFER_S:
                 buf.pop(0)
-        reading = self.baro.update(truth) if self.baro is not None else None
-        if reading is not None:
-            for i, f in enumerate(self.filters):
-                f.baro_update(reading, ins[i])
-        fixes = self.receiver.update(truth)
-        for fix in fixes:
-            groups = []
+        for fix in self.receiver.update(truth):
             for i, f in enumerate(self.filters):
                 at = self._ins_at(i, fix.t_s)
                 if at is None:
                     continue
-                g = f.gnss_update(fix, at)
-                if i == 0:
-                    groups = g
-                    for r in g:
+                groups = f.gnss_update(fix, at)
+                for r in groups:
+                    if i == 0:
                         self.nis_log.append((fix.t_s, r.name, r.nis, r.innovation.size))
-                if any(r.used for r in g):
+                    if self.fdi is not None:
+                        self.fdi.add_innovation(i, t, r.nis, r.innovation.size)
+                if any(r.used for r in groups):
                     self.bank.correct(i, f.take_feedback())
                     ins[i] = self.bank.output(i, truth)
                     self._buffer[i][-1] = ins[i]
-            if groups:
-                self._gate_events(t, groups)
-                self.last_groups = groups
-                if groups[0].used:
                     self._last_fix_used_s = fix.t_s
+                self._gate_events(i, t, groups)
+        reading = self.baro.update(truth) if self.baro is not None else None
+        if reading is not None:
+            for i, f in enumerate(self.filters):
+                self._gate_events(i, t, [f.baro_update(reading, ins[i])])
         self._prev_truth, self._prev_ins = truth, ins
         return self.solution(truth, ins)
 
+    def _sensor_pairs(self, truth: AircraftState) -> tuple:
+        """Sensor-level stage 1 on the units' raw IMU outputs over the last step."""
+        prev = self._prev_sensor_t
+        self._prev_sensor_t = truth.t_s
+        if prev is None or truth.t_s <= prev:
+            return (0, 0, 0)
+        dt = truth.t_s - prev
+        if self.comparator is None:
+            q = np.array([np.r_[u.imu.q_psd[3:6], u.imu.q_psd[6:9]] for u in self.bank.units])
+            sf = np.array([_unmodelled_variances(f.imu) for f in self.filters])
+            self.comparator = SensorComparator(len(self.bank), q, dt, sf, self.fdi.tuning)
+        return self.comparator.update(truth.t_s, self.bank.sensor_errors(truth, dt),
+                                      truth.f_body_mps2, (truth.p_rps, truth.q_rps, truth.r_rps))
+
+    def _comparison(self, sols: list[tuple]) -> list[np.ndarray]:
+        """Comparison vectors y_i (position ENU m from unit 0's, velocity, roll, pitch, heading)."""
+        lat0, lon0, h0 = sols[0][0], sols[0][1], sols[0][2]
+        out = []
+        for s in sols:
+            y = np.empty(9)
+            y[:3] = enu_difference_m(s[0], s[1], s[2], lat0, lon0, h0)
+            y[3:6] = s[3]
+            y[6], y[7], y[8] = s[4], s[5], s[6]
+            out.append(y)
+        return out
+
     def solution(self, truth: AircraftState, ins: list[NavSolution]) -> NavSolution:
-        """Unit 0's corrected output, its covariance, ANP and the logged columns."""
-        f = self.filters[0]
-        lat, lon, alt, v, roll, pitch, hdg = corrected(ins[0], f.x[:9])
-        P = f.P
+        """The output: the mean of the units in use (unit 0 alone without identification), the
+        mean of their covariances, ANP, and the logged columns."""
+        sols = [corrected(ins[i], f.x[:9]) for i, f in enumerate(self.filters)]
+        used = list(range(len(sols)))
+        extra: dict[str, float] = {}
+        if self.fdi is not None:
+            y = self._comparison(sols)
+            sig = [channel_sigmas(f.P) for f in self.filters]
+            self.events += self.fdi.update(truth.t_s, y, sig, self._sensor_pairs(truth))
+            used = [i for i, u in enumerate(self.fdi.state.used) if u]
+            vote = _mean_solution([sols[i] for i in self.fdi.vote(y, sig)])
+            rm, rn = radii_m(truth.lat_rad)
+            extra = {"nse_vote_east_m": (vote[1] - truth.lon_rad) * (rn + truth.alt_m)
+                     * math.cos(truth.lat_rad),
+                     "nse_vote_north_m": (vote[0] - truth.lat_rad) * (rm + truth.alt_m),
+                     "fdi_nu": float(self.fdi.nu[0] + 2 * self.fdi.nu[1] + 4 * self.fdi.nu[2])}
+        valid = bool(used)
+        pick = used if valid else [int(np.argmin([np.trace(f.P[:3, :3]) for f in self.filters]))]
+        lat, lon, alt, v, roll, pitch, hdg = _mean_solution([sols[i] for i in pick])
+        P = (self.filters[pick[0]].P if len(pick) == 1
+             else sum(self.filters[i].P for i in pick) / len(pick))
         anp = horizontal_radius(P[0, 0], P[1, 1], P[0, 1])
         rm, rn = radii_m(truth.lat_rad)
-        mode = 0 if truth.t_s - self._last_fix_used_s <= 2.0 * self.receiver.period_s + \
-            self.receiver.spec.latency_s + 1e-6 else 1
+        coast = truth.t_s - self._last_fix_used_s > 2.0 * self.receiver.period_s + \
+            self.receiver.spec.latency_s + 1e-6
+        mode = 2 if not valid else (1 if coast else 0)
         errors = {
-            "anp_m": anp, "nav_mode": float(mode), "ins_used": 1.0,
+            "anp_m": anp, "nav_mode": float(mode),
+            "ins_used": float(sum(1 << i for i in used)),
             "nse_east_m": (lon - truth.lon_rad) * (rn + truth.alt_m) * math.cos(truth.lat_rad),
             "nse_north_m": (lat - truth.lat_rad) * (rm + truth.alt_m),
             "nse_up_m": alt - truth.alt_m,
@@ -219,9 +297,10 @@ class InsGnssNavigation:
             "att_err_heading_deg": math.degrees(math.remainder(hdg - truth.heading_rad,
                                                                2 * math.pi)),
             "sigma_heading_deg": math.degrees(math.sqrt(max(P[8, 8], 0.0))),
+            **extra,
         }
         return NavSolution(truth.t_s, lat, lon, alt, v, roll, pitch, hdg, errors,
-                           pos_cov_enu_m2=P[:3, :3].copy())
+                           pos_cov_enu_m2=P[:3, :3].copy(), valid=valid)
 
 
 __all__ = ["InsGnssNavigation", "baro_spec", "corrected", "gnss_spec"]

@@ -17,6 +17,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import pandas as pd
 
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.units import NM_M
@@ -112,5 +113,46 @@ def rnp_alerts(t_s: np.ndarray, anp_m: np.ndarray, rnp_m: np.ndarray,
     return AlertTrace(alert, events, tta)
 
 
-__all__ = ["AlertTrace", "DEFAULT_ALERT_DELAY_S", "NAV_MODES", "TIME_TO_ALERT_S", "rnp_alerts",
+def monitor_flight(df: pd.DataFrame, source, rnp_m: float | None
+                   ) -> tuple[pd.DataFrame, dict | None]:
+    """The flight's navigation monitoring: the RNP alert over its timeseries and the source's
+    events, for ``summary.json``'s ``navigation`` block.
+
+    Parameters
+    ----------
+    df : the timeseries; ``anp_m`` (from the source) and, for a procedure flight, ``rnp_m`` (the
+        leg's RNP, from guidance)
+    source : the navigation source (its ``events`` list and ``alert_delay_s`` when it has them)
+    rnp_m : RNP for a flight without a procedure, m (None: no RNP, no alert)
+
+    Returns
+    -------
+    (df with an ``rnp_alert`` column 0/1 when ANP was logged, the ``navigation`` block: ``events``
+    sorted by time and ``rnp_alert`` {raised, first_t_s, time_to_alert_s, delay_s}; None when the
+    source logs neither ANP nor events)
+    """
+    events = [dict(e) for e in getattr(source, "events", None) or []]
+    if "anp_m" not in df and not events:
+        return df, None
+    block: dict = {}
+    if "anp_m" in df:
+        delay = float(getattr(source, "alert_delay_s", DEFAULT_ALERT_DELAY_S))
+        if "rnp_m" in df:
+            rnp = df["rnp_m"].to_numpy(float)
+        else:
+            rnp = np.full(len(df), np.nan if rnp_m is None else float(rnp_m))
+        trace = rnp_alerts(df["t_s"].to_numpy(), df["anp_m"].to_numpy(float), rnp, delay)
+        df = df.assign(rnp_alert=trace.alert.astype(float))
+        events += trace.events
+        raised = [e for e in trace.events if not e["reason"].startswith("cleared")]
+        anp = df["anp_m"].to_numpy(float)
+        block["rnp_alert"] = {
+            "raised": bool(raised), "first_t_s": raised[0]["t_s"] if raised else None,
+            "time_to_alert_s": [round(x, 2) for x in trace.time_to_alert_s], "delay_s": delay,
+            "anp_max_m": round(float(np.nanmax(anp)), 2) if np.isfinite(anp).any() else None}
+    block["events"] = sorted(events, key=lambda e: e["t_s"])
+    return df, block
+
+
+__all__ = ["AlertTrace", "monitor_flight", "DEFAULT_ALERT_DELAY_S", "NAV_MODES", "TIME_TO_ALERT_S", "rnp_alerts",
            "time_to_alert_limit_s"]

@@ -19,6 +19,7 @@ from fms_testbed.evaluation.flight_errors import error_columns, flight_errors
 from fms_testbed.evaluation.outcome import DEFAULT_ENROUTE_RNP_NM, decide
 from fms_testbed.loop.flight import Flight
 from fms_testbed.loop.procedure import PreparedProcedure, prepare_procedure
+from fms_testbed.navigation.monitor import monitor_flight
 from fms_testbed.run.results import Results, Summary
 
 _PROC_TYPE = {"D": "SID", "E": "STAR", "F": "APPROACH"}
@@ -119,6 +120,9 @@ def results_of(flight: Flight) -> Results:
         scn = flight.scn
         rnp_nm = scn.rnp_nm if scn.rnp_nm is not None else (
             DEFAULT_ENROUTE_RNP_NM if scn.navigation_spec["source"] != "truth" else None)
+    df, nav_block = monitor_flight(df, flight.navigation, None if rnp_nm is None else rnp_nm * NM_M)
+    if nav_block is not None:
+        summary["navigation"] = nav_block
     decide(summary, df, flight.cfg, rnp_nm)
     return Results(df=df, summary=summary, scenario=flight.scn, procedure=proc,
                    flown_paths=rebuilt)

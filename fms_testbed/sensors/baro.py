@@ -30,7 +30,7 @@ class BaroSpec:
     markov_sigma_m: float = 5.0
     markov_tau_s: float = 1800.0
     white_sigma_m: float = 0.5
-    rate_hz: float = 10.0
+    rate_hz: float = 1.0
     failed_from_s: float = math.inf
 
     def __post_init__(self):

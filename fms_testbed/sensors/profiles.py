@@ -2,8 +2,8 @@
 segments (turn rate, climb angle, acceleration) integrated into a kinematically consistent true
 trajectory, without the flight simulator.
 
-Each :class:`Segment` holds for ``duration_s``: turn rate ψ' (coordinated, roll
-φ = atan(V ψ'/g)), flight-path angle γ (pitch = γ + ``alpha_rad``, a constant angle of attack) and
+Each :class:`Segment` holds for ``duration_s``: turn rate ψ' (the target of a coordinated turn,
+roll φ = atan(V ψ'/g); the heading follows the lagging roll, ψ' = g tan φ / V), flight-path angle γ (pitch = γ + ``alpha_rad``, a constant angle of attack) and
 longitudinal acceleration V'. Kinematics (flat-Earth attitude rates, ellipsoidal position)::
 
     V_ENU = V (cos γ sin ψ, cos γ cos ψ, sin γ),   a_ENU = dV_ENU/dt
@@ -72,7 +72,7 @@ def fly_profile(segments: list[Segment], dt_s: float = 0.1, lat_deg: float = 47.
         if k > 0:
             roll += a * (math.atan(V * wz / G0_MPS2) - roll)
             gam += a * (math.radians(s.gamma_deg) - gam)
-            psi += wz * dt_s
+            psi += G0_MPS2 * math.tan(roll) / V * dt_s        # coordinated with the roll
             V += s.accel_mps2 * dt_s
         v_enu[k] = V * np.array([math.cos(gam) * math.sin(psi), math.cos(gam) * math.cos(psi),
                                  math.sin(gam)])

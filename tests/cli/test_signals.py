@@ -13,10 +13,18 @@ from pathlib import Path
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "sins-stim300.yaml"
 
 
+def _long_scenario(tmp_path) -> Path:
+    """The shipped SINS flight lengthened to 6 h, so it is surely still flying when signalled."""
+    p = tmp_path / "long.yaml"
+    p.write_text(SCENARIO.read_text().replace("duration_s: 600", "duration_s: 21600"))
+    assert "duration_s: 21600" in p.read_text()
+    return p
+
+
 def _start(tmp_path):
     env = {**os.environ, "TMPDIR": str(tmp_path / "tmp")}
     (tmp_path / "tmp").mkdir()
-    p = subprocess.Popen([sys.executable, "-m", "fms_testbed", "run", str(SCENARIO),
+    p = subprocess.Popen([sys.executable, "-m", "fms_testbed", "run", str(_long_scenario(tmp_path)),
                           "--out", str(tmp_path / "out"), "--no-plots"],
                          stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     deadline = time.time() + 60

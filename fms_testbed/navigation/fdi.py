@@ -1,0 +1,299 @@
+"""Two-stage fault identification over redundant INS units (seed 001) and the majority-voting
+baseline.
+
+Stage 1 compares the units pairwise twice: at sensor level (:class:`SensorComparator`, seed
+001's "duplicate same-type sources": a step in the difference of two units' raw accelerometer or
+gyro outputs) and at output level (below). Each unit i gives a comparison vector y_i (position E, N, U m relative to a common point,
+velocity E, N, U m/s, roll, pitch, heading rad — its filter-corrected output) and per-channel
+σ_i from its filter's covariance.
+
+Stage 1 (fast, pairwise): ν_ij = 1 when some channel of y_i - y_j exceeds
+ε_N = k_pair √(σ_i² + σ_j²) for ``persist_s``; for three units the majority table names the
+failed unit::
+
+    ν12 ν13 ν23 → (1 1 0) unit 1,  (1 0 1) unit 2,  (0 1 1) unit 3,  (0 0 0) none
+
+Stage 2 (the estimator): a candidate is confirmed when its own filter's GNSS innovations fail a
+windowed χ² test (sum of NIS over ``window_s`` against its 1 - ``alpha`` quantile), or when it
+disagrees with the mean of the other units beyond k_est √(σ_i² + σ_others²) (the prediction
+check). A confirmed unit is excluded and the output is reconfigured on the others. When stage 1
+cannot name a unit (two units left, or every pair disagreeing) stage 2 alone decides, if exactly
+one unit fails it.
+
+Majority voting (the baseline, Zaitseva's foil): the mean of the units the majority table does
+not flag at this instant — no persistence, no estimator check, no memory; a unit that stays
+inside the pairwise thresholds is averaged in however wrong its sensors are.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.stats import chi2
+
+MAJORITY = {(1, 1, 0): 0, (1, 0, 1): 1, (0, 1, 1): 2}
+"""Seed 001's table for three units: (ν12, ν13, ν23) → index of the failed unit."""
+
+PAIRS = ((0, 1), (0, 2), (1, 2))
+
+
+@dataclass(frozen=True)
+class FdiTuning:
+    """Thresholds of the two stages.
+
+    k_pair : stage-1 threshold in σ of each channel difference
+    persist_s : a pair must disagree this long before ν_ij = 1, s
+    k_est : stage-2 prediction threshold in σ
+    window_s : stage-2 innovation window, s
+    alpha : stage-2 false-alarm probability per test of the innovation window
+    isolate_s : a unit named by the majority table this long is excluded without an estimator
+        confirmation (a persistent 2-of-3 vote), s
+    k_sensor : sensor-level step threshold in σ of the window-mean difference
+    accel_window_s, gyro_window_s : short windows of the sensor-level step test, s
+    reference_s : the reference window before the short one, s
+    """
+
+    k_pair: float = 6.0
+    persist_s: float = 1.0
+    k_est: float = 6.0
+    window_s: float = 10.0
+    alpha: float = 1e-6
+    isolate_s: float = 3.0
+    k_sensor: float = 6.0
+    accel_window_s: float = 1.0
+    gyro_window_s: float = 10.0
+    reference_s: float = 60.0
+
+
+@dataclass
+class FdiState:
+    """Run-time state: which units are in use, pair persistence timers, recent NIS."""
+
+    used: list[bool]
+    since: dict = field(default_factory=dict)          # pair → first time it disagreed, s
+    nis: list = field(default_factory=list)            # per unit: [(t_s, nis, dim)]
+
+
+def channel_sigmas(P: np.ndarray) -> np.ndarray:
+    """σ of the 9 comparison channels from a filter covariance: position (3), velocity (3) and
+    roll, pitch, heading (ε components as small angles; roll/pitch take the larger tilt σ)."""
+    d = np.sqrt(np.maximum(P.diagonal()[:9], 0.0))
+    d[6] = d[7] = max(d[6], d[7])
+    return d
+
+
+def _diff(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    d = a - b
+    d[8] = math.remainder(d[8], 2 * math.pi)
+    return d
+
+
+class TwoStageFdi:
+    """Seed 001's two-stage identification for N = 2 or 3 units.
+
+    Parameters
+    ----------
+    n_units : number of INS units;  tuning : thresholds
+    """
+
+    def __init__(self, n_units: int, tuning: FdiTuning = FdiTuning()):
+        self.n, self.tuning = n_units, tuning
+        self.state = FdiState([True] * n_units, nis=[[] for _ in range(n_units)])
+        self.nu = (0, 0, 0)
+        self._suspect: tuple[int, float] | None = None        # (unit, since t_s)
+
+    def add_innovation(self, i: int, t_s: float, nis: float, dim: int) -> None:
+        """Record unit i's GNSS innovation statistic (NIS of a group of dimension ``dim``)."""
+        self.state.nis[i].append((t_s, nis, dim))
+
+    def _innovation_fails(self, i: int, t_s: float) -> bool:
+        buf = self.state.nis[i]
+        while buf and buf[0][0] < t_s - self.tuning.window_s:
+            buf.pop(0)
+        if not buf:
+            return False
+        total, dof = sum(b[1] for b in buf), sum(b[2] for b in buf)
+        return total > chi2.isf(self.tuning.alpha, dof)
+
+    def pairwise(self, t_s: float, y: list[np.ndarray], sig: list[np.ndarray]) -> tuple:
+        """Stage 1: (ν12, ν13, ν23) with persistence (pairs with a unit out of use read 0)."""
+        out = []
+        for a, b in PAIRS:
+            if b >= self.n or not (self.state.used[a] and self.state.used[b]):
+                out.append(0)
+                continue
+            bad = bool((np.abs(_diff(y[a], y[b]))
+                        > self.tuning.k_pair * np.sqrt(sig[a] ** 2 + sig[b] ** 2)).any())
+            if bad:
+                t0 = self.state.since.setdefault((a, b), t_s)
+                out.append(int(t_s - t0 >= self.tuning.persist_s - 1e-9))
+            else:
+                self.state.since.pop((a, b), None)
+                out.append(0)
+        return tuple(out)
+
+    def _prediction_fails(self, i: int, y, sig) -> bool:
+        others = [j for j in range(self.n) if j != i and self.state.used[j]]
+        if not others:
+            return False
+        ym = sum(y[j] for j in others) / len(others)
+        sm2 = sum(sig[j] ** 2 for j in others) / len(others)
+        return bool((np.abs(_diff(y[i], ym)) > self.tuning.k_est * np.sqrt(sig[i] ** 2 + sm2)).any())
+
+    def update(self, t_s: float, y: list[np.ndarray], sig: list[np.ndarray],
+               nu_sensor: tuple = (0, 0, 0)) -> list[dict]:
+        """Run both stages at ``t_s`` (s) on the output comparison (``y``, ``sig``) and the
+        sensor-level pair verdicts ``nu_sensor``; return the events (detected, isolated,
+        excluded, reconfigured) and update :attr:`state.used`."""
+        events: list[dict] = []
+        nu_out = self.pairwise(t_s, y, sig)
+        nu = tuple(int(a or (b and self._pair_live(k))) for k, (a, b) in
+                   enumerate(zip(nu_out, nu_sensor)))
+        if any(nu) and not any(self.nu):
+            where = "outputs" if any(nu_out) else "sensors"
+            events.append({"t_s": round(t_s, 3), "unit": "ins", "kind": "detected",
+                           "stage": "pairwise", "reason": f"(ν12, ν13, ν23) = {nu} ({where})"})
+        self.nu = nu
+        live = [i for i in range(self.n) if self.state.used[i]]
+        suspect = MAJORITY.get(nu) if len(live) == 3 else None
+        if suspect is None:
+            self._suspect = None
+        elif self._suspect is None or self._suspect[0] != suspect:
+            self._suspect = (suspect, t_s)
+        if suspect is not None:
+            events.append({"t_s": round(t_s, 3), "unit": f"ins{suspect + 1}", "kind": "isolated",
+                           "stage": "pairwise", "reason": f"majority table {nu}"})
+            if self._innovation_fails(suspect, t_s) or self._prediction_fails(suspect, y, sig):
+                events += self._exclude(suspect, t_s, "estimator check failed")
+            elif t_s - self._suspect[1] >= self.tuning.isolate_s - 1e-9:
+                events += self._exclude(suspect, t_s, f"named by the majority table for "
+                                                      f"{self.tuning.isolate_s:g} s")
+        elif any(nu) or len(live) < 3:
+            fails = [i for i in live if self._innovation_fails(i, t_s)]
+            if len(fails) == 1 and len(live) > 1:
+                events += self._exclude(fails[0], t_s, "innovation test failed alone")
+        # keep only what changed: 'isolated' once per unit
+        return [e for e in events if e["kind"] != "isolated" or self._new_isolation(e)]
+
+    def _pair_live(self, k: int) -> bool:
+        a, b = PAIRS[k]
+        return b < self.n and self.state.used[a] and self.state.used[b]
+
+    def _new_isolation(self, e: dict) -> bool:
+        key = ("iso", e["unit"])
+        if key in self.state.since:
+            return False
+        self.state.since[key] = e["t_s"]
+        return True
+
+    def _exclude(self, i: int, t_s: float, why: str) -> list[dict]:
+        self.state.used[i] = False
+        left = [f"ins{j + 1}" for j in range(self.n) if self.state.used[j]]
+        return [{"t_s": round(t_s, 3), "unit": f"ins{i + 1}", "kind": "excluded",
+                 "stage": "estimator", "reason": why},
+                {"t_s": round(t_s, 3), "unit": "fms", "kind": "reconfigured",
+                 "stage": "estimator", "reason": "output from " + (", ".join(left) or "none")}]
+
+    def vote(self, y: list[np.ndarray], sig: list[np.ndarray]) -> list[int]:
+        """Majority voting: the units the majority table of this instant's output comparison
+        (all units, no persistence, no sensor level, no estimator) does not flag."""
+        if self.n != 3:
+            return list(range(self.n))
+        nu = tuple(int((np.abs(_diff(y[a], y[b]))
+                        > self.tuning.k_pair * np.sqrt(sig[a] ** 2 + sig[b] ** 2)).any())
+                   for a, b in PAIRS)
+        bad = MAJORITY.get(nu)
+        return [i for i in range(self.n) if i != bad]
+
+
+class _Ring:
+    """Running sum over the last ``n`` samples of arrays of one shape."""
+
+    def __init__(self, n: int, shape: tuple):
+        self.buf = np.zeros((n,) + shape)
+        self.sum = np.zeros(shape)
+        self.i = self.count = 0
+
+    def push(self, v: np.ndarray) -> None:
+        n = self.buf.shape[0]
+        if self.count == n:
+            self.sum -= self.buf[self.i]
+        else:
+            self.count += 1
+        self.buf[self.i] = v
+        self.sum += v
+        self.i = (self.i + 1) % n
+
+
+class SensorComparator:
+    """Stage 1 at sensor level: a step in the difference of two units' raw IMU outputs.
+
+    For each pair and channel (3 accelerometers, 3 gyros) the mean difference over a short window
+    (``accel_window_s`` / ``gyro_window_s``) is compared with its mean over the ``reference_s``
+    before: Δ = mean_short - mean_ref, σ_Δ² = σ_sample² (1/N_short + 1/N_ref) + σ_k² |Δu|², with
+    σ_sample² the two units' white-noise variances per sample (VRW/ARW densities over the sample
+    interval) and the last term the declared scale-factor/misalignment variance of the pair
+    (σ_k², dimensionless) times the change of the measured specific force or rate between the
+    windows (a manoeuvre changes the difference of two healthy units by that much).
+    ν_ij = 1 when some |Δ| > k_sensor σ_Δ (tested once both windows are full). Windows are
+    counted in samples of the interval ``dt_s`` (the navigation step).
+
+    Parameters
+    ----------
+    n_units : 2 or 3;  q_white : (n, 6) white-noise densities (accel (m/s²)²·s, gyro rad²/s)
+    dt_s : sample interval, s;  sf_var : (n, 2) declared scale-factor + 2 × misalignment
+        variance (accelerometer, gyro) per unit;  tuning : thresholds and windows
+    """
+
+    def __init__(self, n_units: int, q_white: np.ndarray, dt_s: float, sf_var: np.ndarray,
+                 tuning: FdiTuning = FdiTuning()):
+        self.n, self.tuning, self.dt_s = n_units, tuning, dt_s
+        self.pairs = [p for p in PAIRS if p[1] < n_units]
+        ia = [p[0] for p in self.pairs]
+        ib = [p[1] for p in self.pairs]
+        self.ia, self.ib = ia, ib
+        q = np.asarray(q_white, float)
+        sf = np.asarray(sf_var, float)
+        self.var = (q[ia] + q[ib]) / dt_s                              # (pairs, 6)
+        self.sf = np.repeat(sf[ia] + sf[ib], 3, axis=1)                # (pairs, 6)
+        self.n_short, self.n_long = [], []
+        self.d_short, self.d_long, self.u_short, self.u_long = [], [], [], []
+        for w in (tuning.accel_window_s, tuning.gyro_window_s):        # group 0 accel, 1 gyro
+            ns = max(1, int(round(w / dt_s)))
+            nl = ns + max(1, int(round(tuning.reference_s / dt_s)))
+            self.n_short.append(ns)
+            self.n_long.append(nl)
+            self.d_short.append(_Ring(ns, (len(self.pairs), 3)))
+            self.d_long.append(_Ring(nl, (len(self.pairs), 3)))
+            self.u_short.append(_Ring(ns, (3,)))
+            self.u_long.append(_Ring(nl, (3,)))
+        self.last_z = np.zeros((len(self.pairs), 6))
+
+    def update(self, t_s: float, errs: np.ndarray, f_mps2, w_rps) -> tuple:
+        """Add the units' raw-output errors (n, 6) at ``t_s`` (s) with the measured specific
+        force (3,) m/s² and rate (3,) rad/s; return (ν12, ν13, ν23)."""
+        d = errs[self.ia] - errs[self.ib]
+        bad = np.zeros(len(self.pairs), bool)
+        for g, u in enumerate((np.asarray(f_mps2, float), np.asarray(w_rps, float))):
+            cols = slice(3 * g, 3 * g + 3)
+            ds, dl, us, ul = self.d_short[g], self.d_long[g], self.u_short[g], self.u_long[g]
+            ds.push(d[:, cols])
+            dl.push(d[:, cols])
+            us.push(u)
+            ul.push(u)
+            if dl.count < self.n_long[g]:
+                continue
+            ns, nr = self.n_short[g], self.n_long[g] - self.n_short[g]
+            delta = ds.sum / ns - (dl.sum - ds.sum) / nr
+            du = us.sum / ns - (ul.sum - us.sum) / nr
+            var = self.var[:, cols] * (1.0 / ns + 1.0 / nr) + self.sf[:, cols] * float(du @ du)
+            z = delta / np.sqrt(var)
+            self.last_z[:, cols] = z
+            bad |= (np.abs(z) > self.tuning.k_sensor).any(axis=1)
+        out = dict(zip(self.pairs, bad.astype(int).tolist()))
+        return tuple(out.get(p, 0) for p in PAIRS)
+
+
+__all__ = ["FdiTuning", "MAJORITY", "SensorComparator", "TwoStageFdi", "channel_sigmas"]
