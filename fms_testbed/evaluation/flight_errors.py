@@ -23,9 +23,10 @@ Statistics are the 95th percentile of the absolute value and the maximum, over t
 over **straight flight** (on a line segment at least :data:`STRAIGHT_MARGIN_M` from the nearest
 arc, so roll-in/roll-out transients count as turns), and per leg. RNP containment: TSE95 ≤ the
 leg's RNP value (record, else the scenario's ``rnp_nm``, else 1 NM for SID/STAR and 0.3 NM for
-approaches). Constraint compliance: at the sample nearest each constrained fix (or at the end of
-an altitude-terminated leg) the true altitude must be inside the coded window within
-:data:`ALT_TOL_FT` and the CAS inside the coded speed limit within :data:`SPEED_TOL_KT`.
+approaches). Constraint compliance: at the sample nearest each constrained fix (for a fly-by
+fix, nearest the middle of its fly-by arc, where the path passes it; for a leg that ends at a
+condition — altitude, DME, radial, intercept, distance — where it ended) the true altitude must
+be inside the coded window within :data:`ALT_TOL_FT` and the CAS inside the coded speed limit within :data:`SPEED_TOL_KT`.
 """
 
 from __future__ import annotations
@@ -109,6 +110,7 @@ def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
 def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
     """Altitude and speed compliance at each constrained fix (module docstring)."""
     built = {lg.index: lg for lg in fp.path.legs}
+    passing = _passing_points(fp.path)
     out = []
     leg_col = df["leg_index"].to_numpy()
     for k, rec in enumerate(fp.seq.legs):
@@ -120,7 +122,10 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
                "alt_desc": rec.alt_desc}
         bl = built.get(k)
         term = bl.termination if bl is not None else None
-        if term is not None and term.kind == "altitude" and not term.fix_ident:
+        if term is not None and (term.kind == "altitude" or not term.fix_ident and term.kind
+                                 in ("dme", "radial", "intercept", "manual", "distance")):
+            # a leg that ends where a condition is met (an HA at its altitude over its fix):
+            # checked where it ended, not where it first passed the fix
             sel = np.flatnonzero(leg_col == k)
             if sel.size:
                 i = int(sel[-1])
@@ -146,13 +151,17 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
                 row.update(ok=False, why="fix never approached")
                 out.append(row)
                 continue
+            # a fly-by fix is passed where its fly-by arc is nearest to it (the arc's middle),
+            # up to R (1/cos(Ω/2) − 1) away: the check is against that planned point
+            plat, plon = passing.get(k, (term.lat_deg, term.lon_deg))
             d = _dist_m(df["lat_deg"].to_numpy()[sel], df["lon_deg"].to_numpy()[sel],
-                        term.lat_deg, term.lon_deg)
+                        plat, plon)
             j = int(np.argmin(d))
             i = int(sel[j])
-            row["where"] = f"{d[j]:.0f} m from the fix"
+            what = "the fix" if k not in passing else "the fly-by point abeam the fix"
+            row["where"] = f"{d[j]:.0f} m from {what}"
             if d[j] > FIX_PASS_MAX_M:
-                row.update(ok=False, why=f"fix passed {d[j] / NM_M:.2f} NM away")
+                row.update(ok=False, why=f"{what} passed {d[j] / NM_M:.2f} NM away")
                 out.append(row)
                 continue
         alt_ft = float(df["alt_m"].iloc[i]) / FT_M
@@ -184,6 +193,16 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
             row["why"] = ", ".join(msgs)
         out.append(row)
     return out
+
+
+def _passing_points(path) -> dict[int, tuple[float, float]]:
+    """Leg index → (lat_deg, lon_deg) of the middle of the fly-by arc the leg ends in (the
+    planned point abeam its fix), for legs of ``path`` that end in one."""
+    last: dict[int, object] = {}
+    for sg in path.segments:
+        last[sg.leg_index] = sg
+    return {k: sg.geom.point_at(0.5 * sg.geom.length_m())
+            for k, sg in last.items() if sg.role == "flyby"}
 
 
 def sequencing(guidance, n_legs: int) -> dict:

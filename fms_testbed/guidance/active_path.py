@@ -2,12 +2,10 @@
 
 The built path (:class:`~fms_testbed.path.plan.FlyablePath`) becomes the flown-for path:
 
-* a 'connector' the builder put across a discontinuity (after vectors, VM/FM) that starts with
-  a track change is flown as a direct-to — straight on for the roll-in anticipation, a turn at
-  the planned radius, a line to the connector's end — as an FMS does once a discontinuity is
-  cleared (:func:`smooth_connectors`);
 * segments too short to fly are dropped (bridges under :data:`MIN_CONNECTOR_M`, others under
-  :data:`MIN_SEGMENT_M`): the lateral law absorbs a gap that small;
+  :data:`MIN_SEGMENT_M`): the lateral law absorbs a gap that small (:func:`smooth_connectors`);
+  a bridge over a discontinuity (after vectors, VM/FM) is already built by the builder as it is
+  flown — a direct-to, with the fly-by at its end rounded like any other corner;
 * after an in-flight rebuild, a straight run-in from the aircraft to the rebuilt path's start is
   put first (role 'leg' of the first rebuilt leg, so a heading leg keeps its heading; no PDE).
 
@@ -21,14 +19,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field, replace
 
-from fms_testbed.core.geodesy import direct, wrap180
 from fms_testbed.core.segments import Line
-from fms_testbed.core.units import G0_MPS2
 from fms_testbed.guidance.geometry import LocalPiece, local_pieces
-from fms_testbed.guidance.lateral import LateralGains, anticipation_m
 from fms_testbed.guidance.pde import path_pde_m
-from fms_testbed.guidance.vertical import climb_targets, profile_nodes_at_fixes
-from fms_testbed.legs.construct import direct_to_arc
+from fms_testbed.guidance.vertical import climb_targets
 from fms_testbed.path.plan import FlyablePath
 
 MIN_SEGMENT_M = 1.0
@@ -36,11 +30,6 @@ MIN_SEGMENT_M = 1.0
 MIN_CONNECTOR_M = 50.0
 """Connector segments (the builder's bridges over gaps) shorter than this are not flown: their
 course is meaningless and the lateral law absorbs a gap this small, m."""
-CONNECTOR_BANK_DEG = 20.0
-"""Bank of the direct-to turn that replaces a connector with a track change (the builder's
-planned bank), deg."""
-CONNECTOR_TURN_MIN_DEG = 2.0
-"""A connector is flown as a direct-to when it starts with a track change above this, deg."""
 
 
 @dataclass
@@ -51,7 +40,8 @@ class ActivePath:
     seg_cum_m: path distance at each segment's start, m; pde_m: each segment's PDE, m (NaN where
     undefined); flat_m: (straight run before, after) each segment, m (0 on arcs); prof_s /
     prof_h: the vertical profile's node distances (m, on this path) and altitudes (m);
-    climb_tgt: climb target per node (m, None outside climbs); s_base_m: path distance of this
+    climb_tgt: climb target per node (m, None outside climbs); windows: coded window per node;
+    s_base_m: path distance of this
     path's start along the whole flight, m; last_piece_of_leg: leg index → its last piece.
     """
 
@@ -66,38 +56,28 @@ class ActivePath:
     climb_tgt: list[float | None]
     s_base_m: float
     last_piece_of_leg: dict[int, int] = field(default_factory=dict)
+    windows: list[tuple[float | None, float | None]] = field(default_factory=list)
+    """Per profile node, the coded altitude window (lo, hi), m (None: unbounded)."""
+    piece_legs: list[int] = field(default_factory=list)
+    """Per piece, its whole-procedure leg index."""
 
 
-def smooth_connectors(segs, tas_mps: float, bank_deg: float = CONNECTOR_BANK_DEG) -> list:
-    """The path as flown (module docstring): connectors with a track change flown as a
-    direct-to, segments too short to fly dropped, other segments unchanged.
+def smooth_connectors(segs) -> list:
+    """The path as flown (module docstring): segments too short to fly dropped, the others
+    unchanged — the builder already built every bridge over a discontinuity as it is flown
+    (a direct-to with its turns, or a gap closed in the geometry:
+    :meth:`fms_testbed.legs.builder.LegBuilder.connect`), so guidance flies exactly the
+    built path the map, the profile and the monitor see.
 
     Parameters
     ----------
     segs : the built path's segments
-    tas_mps : planned speed of the direct-to turns, m/s
-    bank_deg : their bank, deg (radius R = V²/(g tan γ))
     """
-    r = tas_mps * tas_mps / (G0_MPS2 * math.tan(math.radians(bank_deg)))
-    lead_m = anticipation_m(tas_mps, math.radians(bank_deg), LateralGains())
     out = []
     for sg in segs:
         short = MIN_CONNECTOR_M if sg.role == "connector" else MIN_SEGMENT_M
         if sg.geom.length_m() < short and len(segs) > 1:
             continue  # a tiny bridge between legs: nothing to fly (the law absorbs the gap)
-        if sg.role == "connector" and out and isinstance(sg.geom, Line):
-            trk = out[-1].geom.end_course_deg
-            if abs(wrap180(sg.geom.start_course_deg - trk)) > CONNECTOR_TURN_MIN_DEG:
-                lat0, lon0 = sg.geom.start
-                tlat, tlon = sg.geom.end
-                # run straight on for the roll-in anticipation, then turn direct to the end
-                lat, lon, _ = direct(lat0, lon0, trk, lead_m)
-                arc, ok = direct_to_arc(lat, lon, trk, tlat, tlon, None, r)
-                if ok and arc is not None:
-                    out.append(replace(sg, geom=Line(lat0, lon0, lat, lon), role="connector"))
-                    out.append(replace(sg, geom=arc, role="turn"))
-                    out.append(replace(sg, geom=Line(*arc.end, tlat, tlon)))
-                    continue
         out.append(sg)
     return out
 
@@ -129,11 +109,11 @@ def activate(fp: FlyablePath, s_base_m: float, tas_mps: float,
     ----------
     fp : the built procedure (or the rest of it, rebuilt in flight)
     s_base_m : path distance flown before this path starts, m
-    tas_mps : planned speed for the connectors' direct-to turns, m/s
+    tas_mps : planned speed, m/s (kept for callers; the builder plans the turns)
     lead_from : (lat_deg, lon_deg) of the aircraft when the path was rebuilt in flight: a
         straight run-in from there to the path's start is flown first
     """
-    segs = smooth_connectors(list(fp.path.segments), tas_mps)
+    segs = smooth_connectors(list(fp.path.segments))
     pde = path_pde_m(segs, fp.path.legs)
     lead_m = 0.0
     if lead_from is not None and segs:
@@ -154,6 +134,11 @@ def activate(fp: FlyablePath, s_base_m: float, tas_mps: float,
     last = {}
     for i, p in enumerate(pieces):
         last[segs[p.seg_index].leg_index] = i
+    wins: list[tuple[float | None, float | None]] = [(None, None)] * len(prof.along_m)
+    for w in prof.windows:
+        if w.leg_index + 1 < len(wins):
+            wins[w.leg_index + 1] = (w.lo_m, w.hi_m)
     return ActivePath(fp, segs, pieces, cum, pde, _straight_runs_m(geoms),
-                      [x + lead_m for x in profile_nodes_at_fixes(fp.path, prof)],
-                      [float(x) for x in prof.alt_m], climb_targets(prof), s_base_m, last)
+                      [float(x) + lead_m for x in prof.along_m],
+                      [float(x) for x in prof.alt_m], climb_targets(prof), s_base_m, last,
+                      wins, [fp.leg_offset + segs[p.seg_index].leg_index for p in pieces])

@@ -37,7 +37,8 @@ from fms_testbed.guidance.sequencing import OVERRUN_MAX_M, ConditionWatch, hold_
 from fms_testbed.guidance.speed_plan import SpeedPlan
 from fms_testbed.guidance.steering import steer_bank_rad
 from fms_testbed.guidance.step_log import log_row
-from fms_testbed.guidance.vertical import altitude_command_m, altitude_lead_s, leg_speed_limits
+from fms_testbed.guidance.vertical import (altitude_command_m, altitude_lead_s,
+                                          planned_limits)
 from fms_testbed.legs.model import BuiltLeg, PathSegment
 from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.plan import FlyablePath
@@ -115,7 +116,9 @@ class ProcedureGuidance:
         self.top_m = max([top] + los)
         self.t2_s2 = cfg.coupled_law.T_H_s ** 2 if cfg.coupled_law is not None else 0.0
         self.approach = fp.path.proc_type == "F"
-        self.speed = SpeedPlan(leg_speed_limits(fp.seq.legs), fp.path.proc_type in ("E", "F"),
+        self.speed = SpeedPlan(planned_limits(fp.seq.legs, fp.path.proc_type,
+                                              cfg.limits.cas_min_mps),
+                               fp.path.proc_type in ("E", "F"),
                                cfg.limits.climb_tas_mps, cfg.limits.cas_min_mps,
                                cfg.limits.climb_tas_mps)
         self.watch = ConditionWatch()
@@ -149,9 +152,10 @@ class ProcedureGuidance:
             s_path = self._s_path_m(w)
             alt_cmd = altitude_command_m(self.act.prof_s, self.act.prof_h, self.act.climb_tgt,
                                          s_path, w.gs_mps, self.lead_s, self.t2_s2, self.top_m,
-                                         self.approach)
+                                         self.approach, self.act.windows)
             tas_cmd = self.speed.update(nav.t_s, nav.alt_m, w.leg, self.act.pieces, self.i,
-                                        w.along_m, w.gs_mps, self.gains.bank_max_deg)
+                                        w.along_m, w.gs_mps, self.gains.bank_max_deg,
+                                        self.act.piece_legs)
             return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=tas_cmd,
                                   log=self._log_due(w, truth, s_path))
         return GuidanceOutput(done=True)

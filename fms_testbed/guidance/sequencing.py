@@ -6,8 +6,8 @@
   radial) ends when its condition is actually met (:class:`ConditionWatch`) — earlier than
   planned, or later: its last line is then flown on beyond the planned end, up to
   :data:`OVERRUN_MAX_M`.
-* A hold to an altitude (HA) is left over its fix at the end of the first circuit completed
-  with the altitude reached (:func:`hold_exit_reached`), instead of every circuit planned.
+* A hold to an altitude (HA) is left over its fix at the end of the first circuit (after the
+  entry) completed with the altitude reached (:func:`hold_exit_reached`), instead of every circuit planned.
 * A DF whose fix is already behind the aircraft when the leg before it ends counts as passed
   (:func:`direct_fix_passed`): a direct-to would loop back.
 
@@ -78,8 +78,9 @@ class ConditionWatch:
 
 
 def hold_exit_reached(p: LocalPiece, seg: PathSegment, t: Termination, alt_m: float) -> bool:
-    """HA (hold to altitude): True when the piece just completed ends over the hold fix (a
-    circuit is complete) and the altitude is reached within :data:`ALT_CAPTURE_M`.
+    """HA (hold to altitude): True when the piece just completed ends over the hold fix and
+    completes a circuit (not the entry, role 'turn': at least one circuit is flown) and the
+    altitude is reached within :data:`ALT_CAPTURE_M`.
 
     Parameters
     ----------
@@ -88,6 +89,8 @@ def hold_exit_reached(p: LocalPiece, seg: PathSegment, t: Termination, alt_m: fl
     """
     if t.alt_m is None or t.lat_deg is None or alt_m < t.alt_m - ALT_CAPTURE_M:
         return False
+    if seg.role == "turn":
+        return False  # the way to the hold and its entry end over the fix too: no circuit yet
     if p.s0_m + p.length_m < seg.geom.length_m() - 1.0:
         return False  # not the last chunk of its segment
     lat, lon = seg.geom.end

@@ -5,7 +5,9 @@ every arc within the deceleration distance ahead can be flown :data:`ARC_BANK_MA
 the bank limit (:func:`arc_speed_cap_mps`, the monitor's V,γ correction applied in flight), then
 moved into the CAS band the leg's coded limit allows (:func:`~.vertical.cas_band`); in descent
 (STAR/approach) an 'at' or 'at or below' limit, once entered, holds for the rest of the
-procedure. The target is refreshed every :data:`SPEED_UPDATE_S` and on entering a leg.
+procedure; the 'at' / 'at or below' limit of a fix ahead is flown from the deceleration
+distance before it (:meth:`SpeedPlan.limit_ahead_cap_mps`). The target is refreshed every
+:data:`SPEED_UPDATE_S` and on entering a leg.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from dataclasses import dataclass
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.guidance.geometry import LocalPiece
-from fms_testbed.guidance.vertical import SpeedLimit, cas_band, tas_target_mps
+from fms_testbed.guidance.vertical import SPEED_MARGIN_MPS, SpeedLimit, cas_band, tas_target_mps
 
 ARC_BANK_MARGIN_DEG = 3.0
 """Arcs are flown at a speed that needs at most the bank limit minus this, deg."""
@@ -87,15 +89,49 @@ class SpeedPlan:
         """Recompute the target at the next step (a new leg is flown)."""
         self.next_t_s = -1.0
 
+    def limit_ahead_cap_mps(self, alt_m: float, leg: int, pieces: list[LocalPiece], i: int,
+                            along_m: float, v_mps: float, piece_legs: list[int]) -> float:
+        """Highest TAS that still lets the aircraft slow to the 'at' / 'at or below' speed
+        limit of a fix ahead (the end of a later leg) by the time it gets there, m/s (inf when
+        none is in reach): the limit's TAS once the fix is within the deceleration distance
+        (V² − v²) / (2 a) + DECEL_EXTRA_S V, a = DECEL_MPS2 — the deceleration is planned
+        before the fix, not from the start of its leg."""
+        cap = math.inf
+        dist = -along_m
+        for j in range(i, len(pieces)):
+            dist += pieces[j].length_m
+            k = piece_legs[j]
+            last = j + 1 >= len(pieces) or piece_legs[j + 1] != k
+            if k <= leg or not last or k >= len(self.limits):
+                if dist > LOOKAHEAD_M:
+                    break
+                continue
+            lim = self.limits[k]
+            if lim is not None and lim.desc in ("", "@", "-"):
+                v_lim = cas_to_tas_scalar(lim.cas_mps - (SPEED_MARGIN_MPS if lim.desc == "-"
+                                                         else 0.0), alt_m)
+                need = max(v_mps * v_mps - v_lim * v_lim, 0.0) / (2 * DECEL_MPS2) \
+                    + DECEL_EXTRA_S * v_mps
+                if dist <= need:
+                    cap = min(cap, v_lim)
+            if dist > LOOKAHEAD_M:
+                break
+        return cap
+
     def update(self, t_s: float, alt_m: float, leg: int, pieces: list[LocalPiece], i: int,
-               along_m: float, gs_mps: float, bank_max_deg: float) -> float:
+               along_m: float, gs_mps: float, bank_max_deg: float,
+               piece_legs: list[int] | None = None) -> float:
         """The TAS target at time ``t_s`` (s), altitude (m), on leg ``leg`` (whole-procedure
-        index), piece ``i`` at ``along_m`` (m), ground speed (m/s), m/s."""
+        index), piece ``i`` at ``along_m`` (m), ground speed (m/s), m/s; ``piece_legs``: the
+        whole-procedure leg of each piece (speed limits of fixes ahead planned before them)."""
         if t_s >= self.next_t_s:
             lim = self.limits[leg] if leg < len(self.limits) else None
             lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
             plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m),
                        arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg))
+            if piece_legs is not None:
+                plan = min(plan, self.limit_ahead_cap_mps(alt_m, leg, pieces, i, along_m,
+                                                          self.tas_cmd_mps, piece_legs))
             self.tas_cmd_mps = tas_target_mps(plan, alt_m, lo, hi, self.cas_min_mps)
             self.next_t_s = t_s + SPEED_UPDATE_S
         return self.tas_cmd_mps

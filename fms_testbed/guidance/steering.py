@@ -94,8 +94,15 @@ def steer_bank_rad(seg: PathSegment, p: LocalPiece, along_m: float, xtk_m: float
     """
     kappa = feedforward_curvature_1pm(p, along_m, nxt, gs_mps, gains)
     if flies_heading(seg, p) and kappa == 0.0:
-        # a heading leg (V*): fly the coded heading — the built line's direction — and let
-        # the wind drift the track; the leg still ends at its condition/planned distance
-        return heading_hold_bank_rad(desired_track_rad, heading_rad, heading_kp,
+        # a heading leg (V*): hold the coded heading (the built line is the ground track it
+        # gives in the planned wind) and let the actual wind drift the track; the leg still
+        # ends at its condition/planned distance
+        # the heading is held relative to the line's local direction (the planned drift,
+        # heading − track, kept): on a long heading leg a constant true heading would leave
+        # the geodesic as its azimuth turns (1 km over 150 km)
+        drift = 0.0 if seg.heading_deg is None else math.radians(
+            ((seg.heading_deg - seg.geom.start_course_deg + 180.0) % 360.0) - 180.0)
+        hdg = desired_track_rad + drift
+        return heading_hold_bank_rad(hdg, heading_rad, heading_kp,
                                      math.radians(gains.bank_max_deg))
     return bank_command_rad(xtk_m, wrap_pi(track_rad - desired_track_rad), gs_mps, kappa, gains)

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.core.units import KT_MPS
+from fms_testbed.legs.model import approach_cas_caps
 
 MIN_CAS_FACTOR = 1.15
 """The TAS target never gives a CAS below this multiple of the aircraft's minimum clean CAS
@@ -50,6 +51,20 @@ def leg_speed_limits(legs) -> list[SpeedLimit | None]:
     """Speed limit of each leg record (``LegRecord.speed_limit_mps``/``speed_desc``), or None."""
     return [SpeedLimit(r.speed_limit_mps, r.speed_desc) if r.speed_limit_mps else None
             for r in legs]
+
+
+def planned_limits(legs, proc_type: str, cas_min_mps: float) -> list[SpeedLimit | None]:
+    """The speed limit guidance flies on each leg: the coded one, merged with the planned
+    approach speed (:func:`fms_testbed.legs.model.approach_cas_caps`) as an 'at or below'
+    limit where that is lower."""
+    out = leg_speed_limits(legs)
+    for k, cap in enumerate(approach_cas_caps(legs, proc_type, cas_min_mps)):
+        lim = out[k]
+        if cap is None:
+            continue
+        if lim is None or (lim.desc == "-" and lim.cas_mps > cap):
+            out[k] = SpeedLimit(cap, "-")
+    return out
 
 
 def cas_band(limit: SpeedLimit | None, carried_max_cas_mps: float | None
@@ -160,32 +175,18 @@ def climb_targets(prof) -> list[float | None]:
     return out
 
 
-def profile_nodes_at_fixes(path, prof) -> list[float]:
-    """Profile node distances (m) with each fly-by fix's node moved from the end of its fly-by
-    arc (where the planned profile puts a leg's end) back to the arc's middle, abeam the fix,
-    where the aircraft passes the fix and its altitude constraint is checked."""
-    s = [float(x) for x in prof.along_m]
-    last: dict[int, object] = {}
-    for sg in path.segments:
-        last[sg.leg_index] = sg
-    for j in range(1, len(s)):
-        sg = last.get(path.legs[j - 1].index) if j - 1 < len(path.legs) else None
-        if sg is not None and sg.role == "flyby":
-            s[j] -= 0.5 * sg.geom.length_m()
-    for j in range(1, len(s)):  # keep the nodes ordered
-        s[j] = max(s[j], s[j - 1])
-    return s
-
-
 def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list[float | None],
                        s_path_m: float, gs_mps: float, lead_s: float, t2_s2: float,
-                       top_m: float, approach: bool) -> float:
+                       top_m: float, approach: bool,
+                       windows: list[tuple[float | None, float | None]] | None = None
+                       ) -> float:
     """Altitude command at path distance ``s_path_m``, m.
 
     Along the blended planned profile (:func:`blended_profile`, blend ±``gs BLEND_S``) the
     command inverts the coupled law's altitude dynamics,
     ``H_cmd = h + 2 ξ_H T_H V dh/ds + T_H² V² d²h/ds²``; in a climb phase it is instead the
-    climb target of the node ahead (:func:`climb_targets`), never above ``top_m``.
+    climb target of the node ahead (:func:`climb_targets`: capped by every 'at or below'
+    constraint ahead), never above ``top_m``.
 
     Parameters
     ----------
@@ -194,10 +195,21 @@ def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list
     s_path_m : distance along the active path, m; gs_mps : ground speed, m/s
     lead_s : read-ahead time 2 ξ_H T_H, s (:func:`altitude_lead_s`); t2_s2 : T_H², s²
     top_m : the flight's climb top, m; approach : the last slope continues to the runway
+    windows : coded (lo, hi) window per node, m: outside climbs the blended profile stays
+        above the lower bound of the node ahead until it is passed (the blend of a
+        level-to-descent knee at an 'at or above' fix would otherwise cut below it)
     """
     h, dh, ddh = blended_profile(prof_s, prof_h, s_path_m, gs_mps * BLEND_S, approach)
-    alt_cmd = h + lead_s * gs_mps * dh + t2_s2 * gs_mps * gs_mps * ddh
     jn = bisect.bisect_right(prof_s, s_path_m)
-    if 0 < jn < len(prof_s) and climb_tgt[jn] is not None:  # climb: at the law's rate
-        alt_cmd = min(max(alt_cmd, climb_tgt[jn]), top_m)
+    if windows is not None and 0 < jn < len(windows) and climb_tgt[jn] is None:
+        # the blend of a knee at an 'at or above' (or 'at') fix ahead never cuts below it
+        lo = windows[jn][0]
+        if lo is not None and h < lo:
+            h, dh, ddh = lo, 0.0, 0.0
+    alt_cmd = h + lead_s * gs_mps * dh + t2_s2 * gs_mps * gs_mps * ddh
+    if 0 < jn < len(prof_s) and climb_tgt[jn] is not None:
+        # climb: to the target of the node ahead at the law's rate — never above it, so an
+        # 'at or below' cap holds until its fix is passed (the profile's read-ahead and blend
+        # would lift it up to 20 s early: issue 12, class F)
+        alt_cmd = min(climb_tgt[jn], top_m)
     return alt_cmd

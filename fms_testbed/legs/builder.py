@@ -12,12 +12,23 @@ import math
 from dataclasses import dataclass, replace
 
 from fms_testbed.core.geodesy import direct, inverse, wrap180, wrap360
-from fms_testbed.core.segments import Arc, Line
+from fms_testbed.core.segments import Arc, Line, turn_angle_deg
 from fms_testbed.core.units import NM_M
 from fms_testbed.legs.construct import _foot, direct_to_arc, ray_geodesic_intersection, turn_to_course
 from fms_testbed.procedures.legrecord import LegRecord
 from fms_testbed.legs.model import BuildParams, Finding, FlightState, PathSegment, Performance
 from fms_testbed.procedures.records import Fix
+
+CLOSE_S = 3.0
+"""A gap the aircraft covers in less than this at the planned speed (its roll-in to a 20° bank
+at 5°/s plus the bank loop's lag) is closed in the geometry, never flown as a direct-to, s."""
+DIRECT_XTK_M = 50.0
+"""A course into a fix whose line passes within this of the present position is flown as the
+straight to the fix (courses referenced to an old station declination differ from the fixes'
+bearing by up to ~5° in the FAA data; beyond this offset the coded course is intercepted), m."""
+PARALLEL_TOL_M = 30.0
+"""A turn from over a fix that ends closer than this to the coded course line out of the fix
+is left parallel to it; beyond, the line is rejoined with a 45° intercept, m."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -47,6 +58,14 @@ class ResolvedLeg:
         return wrap360(bearing_deg + (0.0 if self.rec.course_true else self.magvar_deg))
 
 
+def intercept_angle_deg(offset_m: float, radius_m: float) -> float:
+    """Intercept angle for joining a course line ``offset_m`` away with two fly-by turns of
+    radius R: 45°, or less for a small offset — the S-turn whose turns exactly fill the
+    intercept, y = 4 R sin²(α/2) → α = 2 asin √(y / 4R), deg."""
+    q = min(max(offset_m, 0.0) / (4.0 * radius_m), 1.0)
+    return max(min(45.0, math.degrees(2.0 * math.asin(math.sqrt(q)))), 1.0)
+
+
 class LegBuilder:
     """Mutable builder for one procedure transition (one instance per build).
 
@@ -73,6 +92,8 @@ class LegBuilder:
         self.climbing = True
         self.gradient = 0.05
         self._corner_pending = False
+        self._upstream_depth = 0
+        self.joined = True
 
     # ------------------------------------------------------------------ context
     @property
@@ -84,6 +105,12 @@ class LegBuilder:
     def next_leg(self) -> ResolvedLeg | None:
         """The leg after the current one, if any."""
         return self.legs[self.i + 1] if self.i + 1 < len(self.legs) else None
+
+    @property
+    def wind_mps(self) -> float:
+        """The planned wind speed, m/s: turns whose tracks are not known yet (a leg's turns, a
+        hold's 180° turns) are planned for TAS + wind, the most ground speed they can see."""
+        return self.params.wind_speed_mps
 
     def finding(self, category: str, message: str, branch: str = "") -> None:
         """Record a finding against the current leg."""
@@ -101,7 +128,8 @@ class LegBuilder:
         pt, ident = self._tag()
         bank = 0.0
         if isinstance(geom, Arc):
-            bank = math.degrees(math.atan(self.speed_mps ** 2 / (geom.radius_m * self.g)))
+            bank = math.degrees(math.atan((self.speed_mps + self.wind_mps) ** 2
+                                          / (geom.radius_m * self.g)))
         if self._corner_pending:
             self.corners.add(len(self.segments))
         self._corner_pending = False
@@ -162,8 +190,9 @@ class LegBuilder:
         """True when the turn onto ``course_deg`` at the present fix may be flown fly-by."""
         if state.track_deg is None or not state.flyby:
             return False
-        if self.segments and isinstance(self.segments[-1].geom, Arc):
-            return False  # corners are rounded between two lines only: turn after the arc
+        if self.segments and isinstance(self.segments[-1].geom, Arc) and \
+                self.segments[-1].role != "leg":
+            return False  # a turn's end is no corner: the next turn starts after it
         short = wrap180(course_deg - state.track_deg)
         if abs(short) > self.params.flyby_max_deg:
             return False
@@ -212,30 +241,36 @@ class LegBuilder:
                     direction: str | None, flyby_end: bool) -> FlightState:
         """Join the course line into ``fix`` (course ``course_deg`` at the fix), then fly it.
 
-        On the line already: straight to the fix. Otherwise turn to a 45° intercept heading,
-        fly to the line (role 'turn') and turn onto it (fly-by); if the intercept would fall
-        beyond the fix, fly direct to the fix instead (recorded as a finding).
+        Within :data:`DIRECT_XTK_M` of the line: straight to the fix. Otherwise turn to an
+        intercept heading α off the course — 45°, or for a small offset y the S-turn angle
+        α = 2 asin √(y / 4R) whose two fly-by turns just fit (:func:`intercept_angle_deg`) —
+        fly to the line (role 'turn') and turn onto it (fly-by). When the intercept would fall
+        beyond the fix (or leave no room for the turn onto the course), the line is joined
+        upstream instead (:meth:`_join_upstream`): so the leg's straight always lies on its
+        coded course.
         """
         along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
                                  state.lon_deg)
+        toward = state.track_deg is None or abs(wrap180(state.track_deg - fcrs)) < 10.0
+        if along < 0 and abs(xtk) <= DIRECT_XTK_M:
+            if toward:   # on the course line already (within the tolerance): to the fix
+                return self.direct_to(state, fix, direction, flyby_end)
+            # on the line, heading elsewhere (the end of an intercept): turn onto it here
+            here = Fix(ident="", region="", section="", lat_deg=state.lat_deg,
+                       lon_deg=state.lon_deg)
+            n0 = len(self.segments)
+            st = self.join_from_fix(state, here, fcrs, direction, max_along_m=-along)
+            if self.joined:
+                if len(self.segments) > n0:
+                    self.as_transition(n0)
+                return self.line_to(st, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
+            if abs(wrap180(state.track_deg - fcrs)) < 90.0:
+                return self._direct_no_room(state, fix, direction, flyby_end)
         n0 = len(self.segments)
-        trk = state.track_deg
-        if along < 0 and math.degrees(math.atan2(abs(xtk), -along)) < 5.0:
-            # within 5° of the course line seen from the fix (courses referenced to old station
-            # declinations differ from the fixes' bearing by up to ~5° in the FAA data):
-            # fly straight to the fix
-            return self.direct_to(state, fix, direction, flyby_end)
-        aligned = trk is None or abs(wrap180(trk - fcrs)) < 2.0
-        if abs(xtk) < 30.0 and aligned and along < 0:
-            if trk is not None and abs(wrap180(fcrs - trk)) >= 0.5:
-                state = self.start_course(state, fcrs, direction)
-            return self.line_to(state, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
-        if abs(xtk) < 30.0 and along < 0:
-            state = self.start_course(state, fcrs, direction)
-            return self.line_to(state, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
-        state0 = state
+        state0, dir0, corner0 = state, direction, self._corner_pending
+        alpha = intercept_angle_deg(abs(xtk), self.radius_m)
         for _ in range(2):
-            heading = wrap360(fcrs - math.copysign(45.0, xtk))
+            heading = wrap360(fcrs - math.copysign(alpha, xtk))
             state = self.start_course(state, heading, direction)
             direction = None
             along, xtk2, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
@@ -246,40 +281,200 @@ class LegBuilder:
             xtk = xtk2
         hit = ray_geodesic_intersection(state.lat_deg, state.lon_deg, state.track_deg,
                                         fix.lat_deg, fix.lon_deg, course_deg)
-        lead = self.radius_m * math.tan(math.radians(22.5))
-        if hit is None or hit[1] > -lead:
-            if abs(xtk) > 30.0:
-                self.finding("info", f"course into {fix.ident} joined too late for a 45° "
-                             "intercept; flown direct to the fix")
-            return self.direct_to(state, fix, None, flyby_end)
-        if hit[0] < lead:
-            # too close to the line for the 45° capture: turn onto the course now and let a
-            # direct-to absorb the small offset
-            if len(self.segments) == n0:      # nothing flown yet: drop the intercept heading
-                state, self._corner_pending = state0, False
-            arc = turn_to_course(state.lat_deg, state.lon_deg, state.track_deg, fcrs, None,
-                                 self.radius_m)
-            if arc is not None:
-                self._corner_pending = False
-                state = self.arc(state, arc)
-            return self.direct_to(state, fix, None, flyby_end)
-        # the 45° intercept is a transition onto the course line (no PDE); the course is the leg
+        lead = self.radius_m * math.tan(math.radians(alpha) / 2.0)
+        room = lead if len(self.segments) > n0 else 2.0 * lead
+        if hit is None or hit[1] > -lead or hit[0] < 0.99 * room:
+            del self.segments[n0:]
+            self._corner_pending = corner0
+            if self._upstream_depth > 0:
+                return self.direct_to(state0, fix, dir0, flyby_end)
+            return self._join_upstream(state0, fix, course_deg, dir0, flyby_end)
+        # the intercept is a transition onto the course line (no PDE); the course is the leg
         state = self.straight(state, state.track_deg, hit[0], role="turn")
         state = replace(state, flyby=True)
         self._corner_pending = True
         return self.line_to(state, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
 
+    def _join_upstream(self, state: FlightState, fix: Fix, course_deg: float,
+                       direction: str | None, flyby_end: bool) -> FlightState:
+        """Join the course into ``fix`` upstream of the fix, where no intercept reaches it in
+        time (the aircraft abeam or past the fix, or too close to it). When the aircraft heads
+        toward the fix (within 90° of the course) with less than two turn radii of course ahead
+        of it, or no upstream point fits, there is no room without a loop: it flies direct to
+        the fix (:meth:`_direct_no_room`).
+
+        Direct to a point P on the course D before the fix (role 'turn'), fly-by onto the
+        course there, then the course to the fix; D is 2, 3, 4.5 and 6.75 turn radii until the
+        fly-by at P (lead R tan(Ω/2), Ω the turn at P as built) fits both in the direct line
+        before P and in half of D. When it never fits (the aircraft would reach P heading away
+        from the fix), the course is reversed onto: direct to Q, two radii beside P on the
+        aircraft's side (P two radii upstream of the aircraft's abeam point), a 180° turn
+        toward the course there, then the course joined (:meth:`join_course`) from where the
+        turn ends."""
+        n0, corner0 = len(self.segments), self._corner_pending
+        along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
+                                 state.lon_deg)
+        away = state.track_deg is not None and abs(wrap180(state.track_deg - fcrs)) >= 90.0
+        if state.track_deg is not None:
+            # the fix abeam or behind: a direct-to would turn back anyway — reverse onto the
+            # course instead of arriving at the fix across it
+            brg = inverse(state.lat_deg, state.lon_deg, fix.lat_deg, fix.lon_deg)[1]
+            away = away or abs(wrap180(brg - state.track_deg)) > 90.0
+        if not away and -along < 2.0 * self.radius_m:
+            return self._direct_no_room(state, fix, direction, flyby_end)
+        for k in range(4):
+            del self.segments[n0:]
+            self._corner_pending = corner0
+            d_m = 2.0 * self.radius_m * 1.5 ** k
+            plat, plon, _ = direct(fix.lat_deg, fix.lon_deg, course_deg + 180.0, d_m)
+            target = Fix(ident="", region="", section="", lat_deg=plat, lon_deg=plon)
+            st = self.direct_to(state, target, direction, True)
+            last = self.segments[-1].geom if len(self.segments) > n0 else None
+            run = last.length_m() if isinstance(last, Line) else 0.0
+            into = last.end_course_deg if last is not None else st.track_deg
+            omega = abs(wrap180(course_deg - into))
+            if self.radius_m * math.tan(math.radians(min(omega, 179.0)) / 2.0) \
+                    <= min(run, 0.5 * d_m):
+                self.finding("info", f"course into {fix.ident} joined {d_m / NM_M:.1f} NM "
+                             "before the fix (no intercept before it from here)")
+                self.as_transition(n0)
+                st = replace(st, flyby=True)
+                self._corner_pending = True
+                return self.line_to(st, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
+        del self.segments[n0:]
+        self._corner_pending = corner0
+        if not away:
+            return self._direct_no_room(state, fix, direction, flyby_end)
+        side = 1.0 if xtk >= 0 else -1.0
+        # P beyond the aircraft when it flies away from the fix, so that Q lies ahead of it
+        d_m = 2.0 * self.radius_m + max(0.0, -along)
+        plat, plon, _ = direct(fix.lat_deg, fix.lon_deg, course_deg + 180.0, d_m)
+        qlat, qlon, _ = direct(plat, plon, course_deg + 90.0 * side, 2.0 * self.radius_m)
+        target = Fix(ident="", region="", section="", lat_deg=qlat, lon_deg=qlon)
+        st = self.direct_to(state, target, direction, False)
+        arc = turn_to_course(st.lat_deg, st.lon_deg, st.track_deg, course_deg,
+                             "R" if side > 0 else "L", self.radius_m)
+        if arc is not None:
+            st = self.arc(st, arc)
+        self.finding("info", f"course into {fix.ident} joined by a course reversal "
+                     f"{d_m / NM_M:.1f} NM before the fix")
+        self.as_transition(n0)
+        _, xtk2, _ = _foot(fix.lat_deg, fix.lon_deg, course_deg, st.lat_deg, st.lon_deg)
+        if abs(xtk2) <= DIRECT_XTK_M or self._upstream_depth > 0:
+            return self.direct_to(st, fix, None, flyby_end)
+        self._upstream_depth += 1
+        try:
+            return self.join_course(replace(st, flyby=False), fix, course_deg, None, flyby_end)
+        finally:
+            self._upstream_depth -= 1
+
+    def _direct_no_room(self, state: FlightState, fix: Fix, direction: str | None,
+                        flyby_end: bool) -> FlightState:
+        """Heading toward ``fix`` with no room to get onto its course without a loop (at the
+        planned radius: Danilin's class 1, the conditions): fly direct to it; a finding says
+        the coded course is not flown."""
+        self.finding("info", f"no room to join the course into {fix.ident} at the planned "
+                     f"radius {self.radius_m:.0f} m: flown direct to the fix")
+        return self.direct_to(state, fix, direction, flyby_end)
+
+    def join_from_fix(self, state: FlightState, fix: Fix, course_deg: float,
+                      direction: str | None, max_along_m: float = math.inf) -> FlightState:
+        """From over (or at the fly-by corner of) ``fix``, get onto the geodesic that leaves the
+        fix on ``course_deg`` (F* legs, the procedure turn's outbound leg).
+
+        A fly-by corner is cut as usual (the next straight starts on the line). A turn flown
+        from over the fix ends R(1 − cos Δ) beside the coded course; when that is more than
+        :data:`PARALLEL_TOL_M` the turn is continued by α past the course (45°, less — 35, 25,
+        15° — when the intercept would leave no room for its fly-by), the intercept flown to
+        the line (role 'turn') and the course joined with a fly-by: the leg's straight then lies
+        on its coded course line, not parallel to it.
+
+        ``max_along_m``: the intercept must fall (with the lead of its fly-by) within this
+        distance from the fix (a TF's length), m; when it cannot, the state is returned
+        unchanged with the intercept segments removed and ``self.joined`` False.
+
+        Returns the state on the line (track ``course_deg``) or, when it may be cut, at the fix.
+        """
+        self.joined = True
+        if state.track_deg is None:
+            return replace(state, track_deg=course_deg)
+        if self.can_cut(state, course_deg, direction):
+            return self.start_course(state, course_deg, direction)
+        sweep = turn_angle_deg(state.track_deg, course_deg, direction)
+        if abs(sweep) < 0.5 or abs(sweep) > 359.5:
+            return replace(state, track_deg=course_deg)
+        if self.radius_m * (1.0 - math.cos(math.radians(min(abs(sweep), 180.0)))) \
+                < PARALLEL_TOL_M:
+            return self.start_course(state, course_deg, direction)
+        n0 = len(self.segments)
+        turn = "R" if sweep > 0 else "L"
+        st = hit = None
+        for alpha in (45.0, 35.0, 25.0, 15.0):
+            del self.segments[n0:]
+            over = wrap360(course_deg + math.copysign(alpha, sweep))
+            arc = turn_to_course(state.lat_deg, state.lon_deg, state.track_deg, over, turn,
+                                 self.radius_m)
+            st = self.arc(state, arc) if arc is not None else replace(state, track_deg=over)
+            hit = ray_geodesic_intersection(st.lat_deg, st.lon_deg, st.track_deg, fix.lat_deg,
+                                            fix.lon_deg, course_deg)
+            lead = self.radius_m * math.tan(math.radians(alpha) / 2.0)
+            if hit is not None and hit[0] >= lead:
+                break
+        else:
+            # no room for the intercept: back to the plain turn onto the course
+            del self.segments[n0:]
+            return self.start_course(state, course_deg, direction)
+        if hit[1] + lead > max_along_m:
+            del self.segments[n0:]
+            self.joined = False
+            return state
+        st = self.straight(st, st.track_deg, hit[0], role="turn")
+        self._corner_pending = True
+        return replace(st, track_deg=course_deg, flyby=True)
+
     def connect(self, state: FlightState, lat: float, lon: float, why: str) -> FlightState:
-        """Bridge a gap (> 1 cm) with a connector line; a gap above 0.05 NM is also recorded
-        as a discontinuity finding."""
-        s, _, _ = inverse(state.lat_deg, state.lon_deg, lat, lon)
+        """Bridge a gap (> 1 cm) to a point; a gap above 0.05 NM is also recorded as a
+        discontinuity finding.
+
+        The bridge is built here, as flown, so that the corner at its end is rounded like any
+        other fly-by (the segments carry role 'connector': no PDE):
+
+        * a gap shorter than the turn anticipation L = R tan(Ω/2) of the turn toward it (Ω the
+          track change to its bearing, R the planned radius), and than the roll-in distance
+          V · :data:`CLOSE_S`, is closed in the geometry: the
+          last line moves its end onto the point when it does not end at a fix, else a short
+          straight bridge is flown through (never a direct-to with turns larger than the gap);
+        * a longer gap (vectors to the next fix, an intercept that never happens) is a
+          direct-to from the present track: a turn at the planned radius, then the line.
+        """
+        s, az, _ = inverse(state.lat_deg, state.lon_deg, lat, lon)
         if s <= 0.01:
             return replace(state, lat_deg=lat, lon_deg=lon)
         if s > 0.05 * NM_M:
             self.finding("discontinuity", f"{why}: gap of {s / NM_M:.2f} NM bridged")
-        seg = Line(state.lat_deg, state.lon_deg, lat, lon)
-        self.emit(seg, "connector")
-        return self.advance(state, s, lat_deg=lat, lon_deg=lon, track_deg=seg.end_course_deg)
+        omega = abs(wrap180(az - state.track_deg)) if state.track_deg is not None else 0.0
+        # the turn anticipation a direct-to onto the gap would need — the roll-in distance
+        # (V · CLOSE_S) bounds it: a larger gap is flown as a real direct-to
+        lead = min(self.radius_m * math.tan(math.radians(min(omega, 179.0)) / 2.0),
+                   self.speed_mps * CLOSE_S)
+        last = self.segments[-1] if self.segments else None
+        if s < lead and last is not None and isinstance(last.geom, Line) and \
+                not state.fix_ident and last.geom.length_m() > 4.0 * s:
+            moved = Line(last.geom.start_lat_deg, last.geom.start_lon_deg, lat, lon)
+            self.segments[-1] = replace(last, geom=moved)
+            return self.advance(state, s, lat_deg=lat, lon_deg=lon,
+                                track_deg=moved.end_course_deg)
+        if s < lead or state.track_deg is None:
+            seg = Line(state.lat_deg, state.lon_deg, lat, lon)
+            self.emit(seg, "connector")
+            return self.advance(state, s, lat_deg=lat, lon_deg=lon,
+                                track_deg=seg.end_course_deg)
+        n0 = len(self.segments)
+        target = Fix(ident="", region="", section="", lat_deg=lat, lon_deg=lon)
+        state = self.direct_to(replace(state, flyby=False), target, None, False)
+        for k in range(n0, len(self.segments)):
+            self.segments[k] = replace(self.segments[k], role="connector")
+        return replace(state, lat_deg=lat, lon_deg=lon)
 
     def fix_state(self, state: FlightState, fix: Fix) -> FlightState:
         """State placed at a fix with its fly-over/fly-by flag from the current record."""

@@ -162,6 +162,57 @@ def ray_circle_distance(plat: float, plon: float, pcrs: float, clat: float, clon
     return max(s, 0.0)
 
 
+def centre_through(p: tuple[float, float], f: tuple[float, float], centre: tuple[float, float]
+                   ) -> tuple[float, float, float]:
+    """The centre nearest to ``centre`` of the circle through the points ``p`` and ``f``.
+
+    An arc coded about a centre (RF centre fix, AF DME) whose two ends lie at slightly
+    different distances from it (the previous leg ends a few metres off the circle, an IF at
+    a range that differs from the end fix's) is closed in the geometry by this circle: it
+    starts exactly where the aircraft is and ends exactly at the fix. The centre lies on the
+    perpendicular bisector of the chord p–f, at the foot of the coded centre on it (planar
+    estimate in the azimuthal-equidistant plane about the coded centre), then refined on the
+    ellipsoid by secant steps along the bisector until the two geodesic distances agree to a
+    millimetre.
+
+    Parameters
+    ----------
+    p, f : start and end points (lat_deg, lon_deg)
+    centre : the coded centre (lat_deg, lon_deg)
+
+    Returns
+    -------
+    (lat_deg, lon_deg, radius_m) of the circle through both points.
+    """
+    fr = LocalFrame(*centre)
+    px, py = fr.to_xy(*p)
+    fx, fy = fr.to_xy(*f)
+    mx, my = 0.5 * (px + fx), 0.5 * (py + fy)
+    cx, cy = fx - px, fy - py
+    chord = math.hypot(cx, cy)
+    if chord < 1e-6:
+        r = inverse(*centre, *p)[0]
+        return centre[0], centre[1], r
+    nx, ny = -cy / chord, cx / chord
+    t = -(mx * nx + my * ny)
+
+    def diff(tt: float) -> tuple[float, tuple[float, float]]:
+        c = fr.to_latlon(mx + tt * nx, my + tt * ny)
+        return inverse(*c, *p)[0] - inverse(*c, *f)[0], c
+
+    d0, c0 = diff(t)
+    t1 = t + 1.0
+    for _ in range(8):
+        if abs(d0) < 1e-3:
+            break
+        d1, c1 = diff(t1)
+        if abs(d1 - d0) < 1e-12:
+            break
+        t, t1 = t1, t1 - d1 * (t1 - t) / (d1 - d0)
+        d0, c0 = d1, c1
+    return c0[0], c0[1], inverse(*c0, *p)[0]
+
+
 def gap_m(a: tuple[float, float], b: tuple[float, float]) -> float:
     """Geodesic distance between two (lat_deg, lon_deg) points, m."""
     return inverse(a[0], a[1], b[0], b[1])[0]

@@ -22,7 +22,8 @@ from fms_testbed.legs.base import (LEG_TYPES, Leg, LegError, altitude_of, course
 from fms_testbed.legs.builder import LegBuilder
 from fms_testbed.legs.coded import course_from
 from fms_testbed.legs.construct import ray_circle_distance, ray_geodesic_intersection
-from fms_testbed.legs.model import FlightState, Termination
+from fms_testbed.core.segments import Line
+from fms_testbed.legs.model import FlightState, Termination, drift_track_deg
 
 
 def _climb_to(b: LegBuilder, s: FlightState, course: float) -> tuple[FlightState, Termination]:
@@ -101,7 +102,8 @@ def from_fix(b: LegBuilder, s: FlightState, direction: str | None = "coded"
 
     The coded turn direction applies to the first turn of the leg: the turn toward the fix when
     the aircraft is elsewhere, else the turn onto the course at the fix. The way to the fix is
-    a transition onto the leg's coded path (role 'turn', no PDE)."""
+    a transition onto the leg's coded path (role 'turn', no PDE); a turn flown over the fix
+    rejoins the coded course line (:meth:`~.builder.LegBuilder.join_from_fix`)."""
     f, c = fix_of(b), course_of(b)
     d = b.turn_dir() if direction == "coded" else direction
     if s.track_deg is None:
@@ -112,20 +114,34 @@ def from_fix(b: LegBuilder, s: FlightState, direction: str | None = "coded"
         b.as_transition(n0)
         s = b.fix_state(s, f)
         d = None
-    return b.start_course(s, c, d), c
+    return b.join_from_fix(s, f, c, d), c
 
 
 # --------------------------------------------------------------------------- C*, V*
 class _CourseLeg(Leg):
-    """Course (C*) or heading (V*) from the present position to a condition."""
+    """Course (C*) or heading (V*) from the present position to a condition.
+
+    A heading leg is built along the ground track its coded heading gives in the planned wind
+    (:func:`~.model.drift_track_deg`: the drift is predicted, Danilin's current conditions), and
+    its straights carry the heading to hold (``PathSegment.heading_deg``)."""
 
     end = staticmethod(_climb_to)
 
     @classmethod
     def build(cls, b, s):
         c = course_of(b)
-        s = b.start_course(s, c, b.turn_dir())
-        return cls.end(b, s, c)
+        if not cls.heading_leg:
+            s = b.start_course(s, c, b.turn_dir())
+            return cls.end(b, s, c)
+        trk = drift_track_deg(c, b.speed_mps, b.params.wind_speed_mps, b.params.wind_from_deg)
+        n0 = len(b.segments)
+        s = b.start_course(s, trk, b.turn_dir())
+        s, term = cls.end(b, s, trk)
+        for k in range(n0, len(b.segments)):
+            sg = b.segments[k]
+            if sg.role == "leg" and isinstance(sg.geom, Line):
+                b.segments[k] = replace(sg, heading_deg=c)
+        return s, term
 
 
 class CA(_CourseLeg):

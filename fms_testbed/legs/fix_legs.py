@@ -8,6 +8,7 @@ have none (see :attr:`~.base.Leg.pde_reference`).
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 from fms_testbed.core.geodesy import direct, inverse, wrap180, wrap360
@@ -17,7 +18,9 @@ from fms_testbed.legs.base import (Leg, LegError, course_of, dme_position, fix_c
                                    fix_of, fix_termination, navaid_of)
 from fms_testbed.legs.builder import LegBuilder
 from fms_testbed.legs.coded import CodedCircle, course_into, track_between
+from fms_testbed.legs.construct import centre_through
 from fms_testbed.legs.model import FlightState
+from fms_testbed.procedures.records import Fix
 
 
 class IF(Leg):
@@ -30,7 +33,14 @@ class IF(Leg):
     @classmethod
     def build(cls, b, s):
         f = fix_of(b)
-        if s.track_deg is not None or b.segments:
+        prev = b.legs[b.i - 1] if b.i > 0 else None
+        nxt = b.next_leg
+        if prev is not None and prev.pt == "PI" and nxt is not None and nxt.pt == "CF" \
+                and nxt.course_true_deg is not None and s.track_deg is not None:
+            # the final's IF after a procedure turn lies on the inbound course the turn
+            # intercepts: join that course through the IF (no direct-to onto it)
+            s = b.join_course(s, f, nxt.course_true_deg, None, not b.leg.rec.fly_over)
+        elif s.track_deg is not None or b.segments:
             s = b.connect(s, f.lat_deg, f.lon_deg, f"IF {f.ident} away from the previous leg")
         return b.fix_state(s, f), fix_termination(f)
 
@@ -56,9 +66,15 @@ class TF(Leg):
             return b.fix_state(s, f), fix_termination(f)
         if b.can_cut(s, inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[1], b.turn_dir()):
             s = b.direct_to(s, f, b.turn_dir(), not b.leg.rec.fly_over)   # fly-by corner
-        else:  # over the previous fix (or after an arc): turn and rejoin the TF track
-            _, _, az2 = inverse(prev.lat_deg, prev.lon_deg, f.lat_deg, f.lon_deg)
-            s = b.join_course(s, f, az2, b.turn_dir(), not b.leg.rec.fly_over)
+        else:  # over the previous fix: turn there and rejoin the TF track out of it
+            length, az1, az2 = inverse(prev.lat_deg, prev.lon_deg, f.lat_deg, f.lon_deg)
+            n0 = len(b.segments)
+            s1 = b.join_from_fix(s, prev, az1, b.turn_dir(), max_along_m=length)
+            if b.joined:
+                b.as_transition(n0)
+                s = b.line_to(s1, f.lat_deg, f.lon_deg, f.ident, not b.leg.rec.fly_over)
+            else:   # the track is too short to rejoin after the turn: join it upstream of f
+                s = b.join_course(s, f, az2, b.turn_dir(), not b.leg.rec.fly_over)
         return b.fix_state(s, f), fix_termination(f)
 
     @classmethod
@@ -126,20 +142,80 @@ def _corner_onto(b: LegBuilder, s: FlightState, arc: Arc) -> None:
 
 def _arc_to_fix(b: LegBuilder, s: FlightState, clat: float, clon: float, f, why: str
                 ) -> FlightState:
-    """The arc about (clat, clon) from the radial of the present position to the fix, at the
-    fix's range, the coded way; a gap to the arc is bridged with a connector."""
+    """The arc about (clat, clon) from the radial of the present position to the fix, the coded
+    way.
+
+    The present position usually lies a little off the circle through the fix (an IF at a
+    range that differs from the end fix's, the previous fix a few metres off an RF's radius:
+    up to ~0.4 NM in the FAA data). A gap shorter than the turn anticipation a connector would
+    need (its ±90° turns: one planned turn radius) and than a quarter of the arc radius is
+    closed in the geometry: the arc is the circle through the present position and the fix
+    whose centre is nearest the coded one (:func:`~.construct.centre_through`), so it starts
+    where the aircraft is, ends at the fix and is never flown as a direct-to. A larger gap is
+    a discontinuity, bridged by :meth:`~.builder.LegBuilder.connect` to the arc at the fix's
+    range on the present radial."""
     d = b.turn_dir()
     if d is None:
         raise LegError(f"{b.leg.pt} leg without a turn direction (column 44)")
     r_end, rad_end, _ = inverse(clat, clon, f.lat_deg, f.lon_deg)
-    _, rad_start, _ = inverse(clat, clon, s.lat_deg, s.lon_deg)
-    start_pt = direct(clat, clon, rad_start, r_end)
-    s = b.connect(s, start_pt[0], start_pt[1], why)
+    r_now, rad_start, _ = inverse(clat, clon, s.lat_deg, s.lon_deg)
+    gap = abs(r_now - r_end)
+    if 0.01 < gap < min(b.radius_m, 0.25 * r_end):
+        clat, clon, r_end = centre_through(s.pos, (f.lat_deg, f.lon_deg), (clat, clon))
+        _, rad_end, _ = inverse(clat, clon, f.lat_deg, f.lon_deg)
+        _, rad_start, _ = inverse(clat, clon, s.lat_deg, s.lon_deg)
+    else:
+        start_pt = direct(clat, clon, rad_start, r_end)
+        s = b.connect(s, start_pt[0], start_pt[1], why)
     sweep = wrap360(rad_end - rad_start) if d == "R" else -wrap360(rad_start - rad_end)
     if abs(sweep) > 0.01:
         arc = Arc(clat, clon, r_end, rad_start, sweep)
+        if _too_sharp(b, s, arc):
+            return _join_arc_ahead(b, s, arc, f)
         _corner_onto(b, s, arc)
         s = b.arc(s, arc, role="leg")
+    return b.fix_state(replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
+
+
+ARC_JOIN_DEG = 60.0
+"""An arc entered at a corner too sharp for a fly-by is joined this far round it (at most 60 %
+of its sweep), deg: the chord from its start meets the arc there at half that angle."""
+
+
+def _too_sharp(b: LegBuilder, s: FlightState, arc: Arc) -> bool:
+    """True when the corner from the present track onto a coded arc (more than 20°) cannot be
+    rounded: the fly-by's lead R tan(Δ/2) exceeds the straight before it (or no straight)."""
+    if s.track_deg is None:
+        return False
+    delta = abs(wrap180(arc.start_course_deg - s.track_deg))
+    if delta <= 20.0:
+        return False
+    last = b.segments[-1].geom if b.segments else None
+    room = last.length_m() if isinstance(last, Line) and b.can_cut(s, arc.start_course_deg,
+                                                                      None) else 0.0
+    return b.radius_m * math.tan(math.radians(min(delta, 179.0)) / 2.0) > 0.9 * room
+
+
+def _join_arc_ahead(b: LegBuilder, s: FlightState, arc: Arc, f) -> FlightState:
+    """Enter a coded arc whose start corner is too sharp (class 1: the planned radius does not
+    fit): over its start, a direct-to (role 'turn') to the point Q :data:`ARC_JOIN_DEG` round
+    the arc, then a fly-by onto the arc there (the chord meets it at half that angle) and the
+    rest of the arc to the fix. A finding says so."""
+    theta = min(ARC_JOIN_DEG, 0.6 * abs(arc.sweep_deg))
+    rad_q = arc.start_radial_deg + math.copysign(theta, arc.sweep_deg)
+    qlat, qlon, _ = direct(arc.centre_lat_deg, arc.centre_lon_deg, rad_q, arc.radius_m)
+    b.finding("info", f"{b.leg.pt} entered {abs(wrap180(arc.start_course_deg - s.track_deg)):.0f}"
+              f"° off its tangent: too sharp for a fly-by at {b.radius_m:.0f} m; the arc is "
+              f"joined {theta:.0f}° round it")
+    n0 = len(b.segments)
+    target = Fix(ident="", region="", section="", lat_deg=qlat, lon_deg=qlon)
+    s = b.direct_to(replace(s, flyby=False), target, None, True)
+    b.as_transition(n0)
+    rest = Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, rad_q,
+               arc.sweep_deg - math.copysign(theta, arc.sweep_deg))
+    s = replace(s, flyby=True)
+    _corner_onto(b, s, rest)
+    s = b.arc(s, rest, role="leg")
     return b.fix_state(replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
 
 

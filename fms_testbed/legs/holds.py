@@ -12,16 +12,17 @@ no coded path.
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
-from fms_testbed.core.geodesy import inverse, wrap180, wrap360
+from fms_testbed.core.geodesy import LocalFrame, inverse, wrap180, wrap360
 from fms_testbed.core.units import FT_M, NM_M
 from fms_testbed.legs.base import Leg, altitude_of, course_of, fix_course, fix_of
 from fms_testbed.legs.builder import LegBuilder
 from fms_testbed.legs.coded import racetrack
-from fms_testbed.legs.construct import turn_to_course
+from fms_testbed.legs.construct import _foot, turn_to_course
 from fms_testbed.legs.course_legs import from_fix
-from fms_testbed.legs.model import FlightState, Termination
+from fms_testbed.legs.model import FlightState, Termination, turn_radius_m
 
 
 def timed_speed_mps(b: LegBuilder) -> float:
@@ -54,24 +55,97 @@ def _circuit(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: fl
     return b.direct_to(s, f, None, False)
 
 
+ALIGNED_DEG = 1.0
+"""An arrival this close to the inbound course needs no entry: the circuit starts at once."""
+
+
+def entry_kind(arrival_deg: float | None, inbound_deg: float, d: str) -> str:
+    """ICAO hold entry sector of an arrival track (deg true) for a hold on ``inbound_deg``
+    turning ``d``: 'none' (no track, or within :data:`ALIGNED_DEG` of the inbound course),
+    'direct' (track − inbound within −70°..+110° toward the holding side), 'teardrop' (the 70°
+    beyond) or 'parallel' (the other 110°)."""
+    if arrival_deg is None:
+        return "none"
+    rel = wrap180(arrival_deg - inbound_deg)
+    if abs(rel) <= ALIGNED_DEG:
+        return "none"
+    rel *= 1.0 if d == "R" else -1.0
+    if -70.0 <= rel <= 110.0:
+        return "direct"
+    return "teardrop" if rel > 110.0 else "parallel"
+
+
+def _hold_frame(f, inbound: float, lat: float, lon: float) -> tuple[float, float]:
+    """(lateral m, right of the inbound course; along m, along it) of a point, the fix at 0."""
+    x, y = LocalFrame(f.lat_deg, f.lon_deg).to_xy(lat, lon)
+    a = math.radians(inbound)
+    return x * math.cos(a) - y * math.sin(a), x * math.sin(a) + y * math.cos(a)
+
+
 def _entry(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: float
-           ) -> FlightState:
-    """Hold entry from the arrival track: direct entry when arriving within 90° of the inbound
-    course, else a teardrop (outbound 30° off the reciprocal toward the holding side), ending
-    over the fix on the inbound course."""
-    if s.track_deg is None or abs(wrap180(s.track_deg - inbound)) <= 90.0:
-        return s
-    sign = 1.0 if d == "R" else -1.0
-    tear = wrap360(inbound + 180.0 - 30.0 * sign)
-    arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, tear, None, b.radius_m)
+           ) -> tuple[FlightState, bool]:
+    """Hold entry from over the fix, ending over the fix on the inbound course.
+
+    The ICAO sector (:func:`entry_kind`) sets the side of the final turn σ — the holding side
+    for a direct or teardrop entry, the other side for a parallel one — and the first turn
+    (the holding direction for a direct entry, the shorter way otherwise). The outbound heading
+    is the reciprocal of the inbound course turned θ toward the σ side, θ chosen (bisection in
+    −60°..90°) so that after the first turn and ``leg_m`` of outbound leg the final turn of
+    radius R in the σ direction ends on the inbound course line:
+    ``R (1 + cos θ) − σ x₀ = L sin θ`` (x₀ the lateral offset where the outbound leg starts).
+    Then the inbound course is flown to the fix. So the first circuit, or the exit, starts on
+    the coded course. Returns (state over the fix on the inbound course, entry flown)."""
+    kind = entry_kind(s.track_deg, inbound, d)
+    if kind == "none":
+        return replace(s, track_deg=s.track_deg if s.track_deg is not None else inbound), False
+    h = 1.0 if d == "R" else -1.0
+    sigma = -h if kind == "parallel" else h
+    first = d if kind == "direct" else None
+    final = "R" if sigma > 0 else "L"
+    outbound = wrap360(inbound + 180.0)
+    n0 = len(b.segments)
+    r = b.radius_m
+
+    def head(theta: float) -> float:   # outbound heading turned θ toward the σ side
+        return wrap360(outbound - sigma * theta)
+
+    def first_turn(theta: float) -> tuple[FlightState, float]:
+        del b.segments[n0:]
+        arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, head(theta), first, r)
+        st = b.arc(s, arc, role="turn") if arc is not None else replace(s, track_deg=head(theta))
+        return st, _hold_frame(f, inbound, st.lat_deg, st.lon_deg)[0]
+
+    theta = 0.0
+    for _ in range(3):
+        st, x0 = first_turn(theta)
+
+        def miss(t: float) -> float:
+            rt = math.radians(t)
+            return r * (1.0 + math.cos(rt)) - sigma * x0 - leg_m * math.sin(rt)
+
+        lo, hi = -60.0, 90.0
+        if miss(lo) * miss(hi) > 0:
+            theta = lo if abs(miss(lo)) < abs(miss(hi)) else hi
+        else:
+            for _ in range(40):
+                mid = 0.5 * (lo + hi)
+                lo, hi = (mid, hi) if miss(lo) * miss(mid) > 0 else (lo, mid)
+            theta = 0.5 * (lo + hi)
+    st, x0 = first_turn(theta)
+    # the straight that puts the final turn's end on the inbound line (planar, exact heading)
+    psi = math.radians(wrap360(st.track_deg - inbound))
+    xs, _ = _hold_frame(f, inbound, st.lat_deg, st.lon_deg)
+    run = leg_m
+    if abs(math.sin(psi)) > 1e-3:
+        run = (sigma * r * (1.0 - math.cos(psi)) - xs) / math.sin(psi)
+        if not 0.0 <= run <= 3.0 * leg_m + 4.0 * r:
+            run = leg_m
+    st = b.straight(st, st.track_deg, run, role="turn")
+    arc = turn_to_course(st.lat_deg, st.lon_deg, st.track_deg, inbound, final, r)
     if arc is not None:
-        s = b.arc(s, arc, role="hold")
-    s = b.straight(s, s.track_deg, leg_m)
-    arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, inbound, d, b.radius_m)
-    if arc is not None:
-        s = b.arc(s, arc, role="hold")
-    s = b.direct_to(s, f, None, False)
-    return replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg)
+        st = b.arc(st, arc, role="turn")
+    st = b.join_course(st, f, inbound, None, False)
+    return replace(st, lat_deg=f.lat_deg, lon_deg=f.lon_deg, track_deg=inbound), True
 
 
 class _Hold(Leg):
@@ -85,8 +159,9 @@ class _Hold(Leg):
 
     @classmethod
     def _enter(cls, b, s):
-        """Get to the fix and through the entry; returns (state over the fix, fix, inbound
-        course deg, turn direction, leg length m)."""
+        """Get to the fix and through the entry (:func:`_entry`); returns (state over the fix
+        on the inbound course, fix, inbound course deg, turn direction, leg length m, whether
+        an entry was flown)."""
         f, c = fix_of(b), course_of(b)
         n0 = len(b.segments)
         if s.track_deg is None:
@@ -95,9 +170,9 @@ class _Hold(Leg):
             s = b.direct_to(s, f, None, False)
         s = replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg)
         d = b.turn_dir() or "R"
-        s = _entry(b, s, f, c, d, hold_leg_m(b, s.alt_m))
+        s, flown = _entry(b, s, f, c, d, hold_leg_m(b, s.alt_m))
         b.as_transition(n0)
-        return s, f, c, d, hold_leg_m(b, s.alt_m)
+        return s, f, c, d, hold_leg_m(b, s.alt_m), flown
 
     @classmethod
     def coded_path(cls, b, term):
@@ -114,21 +189,23 @@ class HM(_Hold):
 
     @classmethod
     def build(cls, b, s):
-        s, f, c, d, leg_m = cls._enter(b, s)
+        s, f, c, d, leg_m, _ = cls._enter(b, s)
         s = _circuit(b, s, f, c, d, leg_m)
         return b.fix_state(s, f), Termination("manual", f.lat_deg, f.lon_deg, fix_ident=f.ident,
                                               distance_m=leg_m)
 
 
 class HF(_Hold):
-    """Hold to fix: one circuit, leaving over the fix."""
+    """Hold to fix: the course reversal ends at the first crossing of the fix on the inbound
+    course after the entry (one circuit when the arrival needs no entry)."""
 
     code = "HF"
 
     @classmethod
     def build(cls, b, s):
-        s, f, c, d, leg_m = cls._enter(b, s)
-        s = _circuit(b, s, f, c, d, leg_m)
+        s, f, c, d, leg_m, flown = cls._enter(b, s)
+        if not flown:
+            s = _circuit(b, s, f, c, d, leg_m)
         return replace(b.fix_state(s, f), flyby=False), Termination(
             "circuit", f.lat_deg, f.lon_deg, fix_ident=f.ident, distance_m=leg_m)
 
@@ -143,7 +220,7 @@ class HA(_Hold):
 
     @classmethod
     def build(cls, b, s):
-        s, f, c, d, leg_m = cls._enter(b, s)
+        s, f, c, d, leg_m, _ = cls._enter(b, s)
         alt = altitude_of(b)
         n = 0
         while n < 1 or (s.alt_m < alt - 0.5 and b.climbing):
@@ -159,31 +236,120 @@ class HA(_Hold):
 
 
 class PI(Leg):
-    """Procedure turn (45°/180°): outbound from the fix, 45° turn the coded way, one minute,
-    180° turn the other way, and a 45° intercept of the inbound course (next leg).
+    """Procedure turn (45°/180°), as ARINC-424 codes it and charts draw it.
 
-    No coded path: only the outbound course and the distance limit are coded; the turn is
-    flown as the aircraft chooses within the protected area."""
+    The record's course (col. 71) is the course of the 45° leg, its turn direction (col. 44)
+    the direction of the 180° turn, and its distance (col. 75) the limit within which the
+    manoeuvre stays. Flown from over the fix: outbound on the reciprocal of the inbound course
+    (the next CF's course; without a CF, the coded course ∓ 45° away from the 180° turn's
+    side), the shorter 45° turn onto the coded course, the 45° leg, the 180° turn the coded way
+    onto its reciprocal, which intercepts the inbound course at 45° (the next leg). The 45° leg
+    thus lies on the side opposite the coded turn — the protected side of the chart's barb;
+    FlyByWire's ``PILeg`` and the MSFS SDK's ``ProcedureTurnVectorBuilder`` read the fields the
+    same way, and every PI of the FAA cycle 2301 codes its turn opposite its 45° side.
+
+    Sizes (planar, R the planned turn radius): the 45° leg is one minute at the timed-leg speed,
+    at least 2.2 R so the 180° turn ends on the outbound side of the inbound course with room for
+    the 45° intercept; the intercept lies 3.24 R + d₁ beyond the fix, d₁ the outbound straight,
+    which is one minute when the manoeuvre (farthest point |C₂| + R, C₂ the 180° turn's
+    centre at (d₁ + 1.41 R + 0.71 L₁, 0.71 L₁ − 0.41 R)) fits in the
+    coded limit, shorter when not, and long enough that the intercept falls at least
+    :data:`INBOUND_MIN_M` outside the next leg's fix. A manoeuvre that does not fit is flown at
+    the bank limit (monitor branch γ), else reported.
+
+    No coded path: the record codes a manoeuvre of the aircraft's choosing within the protected
+    area, not a track."""
 
     code = "PI"
     course_reversal = True
-    OUTBOUND_MIN_M = 4.3 * NM_M
+    INBOUND_MIN_M = 1.0 * NM_M
+    """The inbound course is joined at least this far outside the next leg's fix, m."""
+
+    @classmethod
+    def _outbound_deg(cls, b: LegBuilder, c: float, d: str) -> tuple[float, float | None]:
+        """(outbound course deg true, along-outbound distance of the next CF's fix from the PI
+        fix m, or None)."""
+        nxt = b.next_leg
+        k = b.i + 1
+        while nxt is not None and nxt.pt == "IF" and k + 1 < len(b.legs):
+            k += 1
+            nxt = b.legs[k]
+        if nxt is not None and nxt.pt == "CF" and nxt.course_true_deg is not None \
+                and abs(abs(wrap180(c - nxt.course_true_deg - 180.0)) - 45.0) < 20.0:
+            out = wrap360(nxt.course_true_deg + 180.0)
+            x_next = None
+            first = b.legs[b.i + 1].fix   # the first fix after the PI (an IF, or the CF's)
+            if first is not None and b.leg.fix is not None:
+                s_m, az, _ = inverse(b.leg.fix.lat_deg, b.leg.fix.lon_deg, first.lat_deg,
+                                     first.lon_deg)
+                x_next = s_m * math.cos(math.radians(az - out))
+            return out, x_next
+        # the 45° leg lies on the side away from the coded 180° turn
+        return wrap360(c + (45.0 if d == "R" else -45.0)), None
 
     @classmethod
     def build(cls, b, s):
-        s = replace(s, flyby=False)   # a course reversal starts over its fix
-        s, c = from_fix(b, s, None)   # the coded direction is the procedure turn's
+        f, c = fix_of(b), course_of(b)
         d = b.turn_dir() or "L"
-        sign = 1.0 if d == "R" else -1.0
+        out, x_next = cls._outbound_deg(b, c, d)
+        n0 = len(b.segments)
+        s = replace(s, flyby=False)   # a course reversal starts over its fix
+        if s.track_deg is None:
+            s = replace(b.fix_state(s, f), track_deg=out, flyby=False)
+        elif inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[0] > 1.0:
+            s = b.direct_to(s, f, None, False)
+            b.as_transition(n0)
+        s = replace(b.fix_state(s, f), flyby=False)
         limit = b.leg.rec.distance_m or 10 * NM_M
-        out_m = max(cls.OUTBOUND_MIN_M - 2.0 * b.radius_m, 0.25 * limit - b.radius_m, NM_M)
-        s = b.straight(s, c, out_m)
-        arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, c + 45.0 * sign, d, b.radius_m)
-        s = b.arc(s, arc)
-        s = b.straight(s, s.track_deg, 60.0 * timed_speed_mps(b))
-        other = "L" if d == "R" else "R"
-        arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg,
-                             wrap360(c + 45.0 * sign + 180.0), other, b.radius_m)
-        s = b.arc(s, arc)
+        timed = 60.0 * timed_speed_mps(b)
+        gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
+        for bank in (None, gmax):
+            if bank is not None:
+                b.radius_m = turn_radius_m(b.speed_mps + b.wind_mps, bank, b.g)
+            r = b.radius_m
+            leg45 = max(timed, 2.2 * r)
+            d_min = max(0.0, (x_next or 0.0) + cls.INBOUND_MIN_M + r * math.tan(
+                math.radians(22.5)) - 3.243 * r)
+            # farthest point: the far side of the 180° turn, |C₂| + R from the fix, with
+            # C₂ = (d₁ + 1.414 R + 0.707 L₁, 0.707 L₁ − 0.414 R) in (outbound, 45° side)
+            a_m, b_m = 1.414 * r + 0.707 * leg45, 0.707 * leg45 - 0.414 * r
+            reach = max(limit - r, 0.0) ** 2 - b_m * b_m
+            d_max = math.sqrt(reach) - a_m if reach > 0 else -math.inf
+            if d_min <= d_max:
+                break
+        fits = d_min <= d_max
+        if bank is not None and fits:
+            b.finding("correction", f"procedure turn at {f.ident} kept within "
+                      f"{limit / NM_M:.1f} NM at bank {gmax:.0f}° (radius {r:.0f} m)", "γ")
+        elif not fits:
+            b.finding("info", f"procedure turn at {f.ident} reaches "
+                      f"{(math.hypot(d_min + a_m, b_m) + r) / NM_M:.1f} NM from the fix at "
+                      f"the bank limit, beyond the coded {limit / NM_M:.1f} NM")
+        d1 = max(d_min, min(d_max, timed)) if fits else d_min
+        n1 = len(b.segments)
+        s = b.join_from_fix(s, f, out, None)
+        b.as_transition(n1)
+        # the outbound straight is measured from the fix: a turn onto the outbound course
+        # from over the fix already flew part of it
+        joined, _, _ = _foot(f.lat_deg, f.lon_deg, out, s.lat_deg, s.lon_deg)
+        if fits and joined > d_max:
+            b.finding("info", f"procedure turn at {f.ident}: joining the outbound course takes "
+                      f"{joined / NM_M:.1f} NM; the manoeuvre reaches beyond the coded "
+                      f"{limit / NM_M:.1f} NM")
+        run = max(d1 - max(joined, 0.0), 0.0)
+        if run < 1.0 and b._corner_pending and b.segments:
+            # no outbound straight left: turn from the intercept heading straight onto the 45°
+            # leg (one turn) instead of a fly-by onto the outbound course and another turn
+            b._corner_pending = False
+            s = replace(s, track_deg=b.segments[-1].geom.end_course_deg)
+        else:
+            s = b.straight(s, out, run)
+        arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, c, None, b.radius_m)
+        if arc is not None:
+            s = b.arc(s, arc, role="leg")
+        s = b.straight(s, c, leg45)
+        arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, wrap360(c + 180.0), d,
+                             b.radius_m)
+        s = b.arc(s, arc, role="leg")
         s = replace(s, flyby=False, fix_ident="")
         return s, Termination("intercept", s.lat_deg, s.lon_deg, next_leg=b.i + 1)

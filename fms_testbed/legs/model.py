@@ -38,6 +38,12 @@ class BuildParams:
     climb_min_gradient: float = 0.033
     descent_angle_deg: float = 3.0
     max_iterations: int = 5
+    wind_speed_mps: float = 0.0
+    wind_from_deg: float = 0.0
+    """The wind the path is planned for (Danilin 2017: the desired trajectory is built for the
+    current conditions): turns are planned for their ground speed, R = V_g²/(g tan γ), with
+    V_g the largest ground speed over the turn's tracks (:func:`max_tailwind_mps`); m/s and
+    deg true (the direction it blows from)."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -140,6 +146,9 @@ class PathSegment:
     bank_deg: float = 0.0
     lead_m: float = 0.0
     """Fly-by arcs: turn anticipation, the distance from the corner to where the turn starts, m."""
+    heading_deg: float | None = None
+    """Heading legs (V*): the coded heading to hold, deg true; the line is the ground track that
+    heading gives in the planned wind (drift predicted); None elsewhere."""
 
 
 @dataclass(frozen=True, slots=True)
@@ -150,6 +159,23 @@ class Finding:
     category: str     # 'correction' | 'impossible' | 'discontinuity' | 'loop' | 'no-intercept' | 'info'
     message: str
     branch: str = ""  # paper branch: 'R', 'V,γ', 'γ', 'V,Θ', 'V,γ,φ,λ'
+
+    @property
+    def danilin_class(self) -> int:
+        """Danilin's (2017) class of what forced the finding: 1 — the current conditions (speed,
+        bank, climb and descent performance, wind: the monitor's corrections and the
+        manoeuvres flown instead of a fly-by that does not fit); 2 — a leg combination the
+        geometry has to bridge (discontinuities, intercepts that never happen, courses joined
+        upstream); 3 — the coding itself (a path flown twice, a fix missing, a coded radius
+        the fixes contradict) — not correctable by the monitor, for the crew to judge."""
+        m = self.message
+        if self.category == "loop" or "not in the database" in m or "coded" in m and \
+                "fixes give" in m or "arc angle built" in m:
+            return 3
+        if self.category in ("discontinuity", "no-intercept") or "joined" in m and \
+                "course into" in m:
+            return 2
+        return 1
 
 
 @dataclass(frozen=True, slots=True)
@@ -208,3 +234,72 @@ def turn_radius_m(tas_mps: float, bank_deg: float, g_mps2: float) -> float:
     return tas_mps * tas_mps / (g_mps2 * math.tan(math.radians(bank_deg)))
 
 
+
+
+def max_tailwind_mps(wind_speed_mps: float, wind_from_deg: float, track_deg: float | None = None,
+                     sweep_deg: float | None = None) -> float:
+    """Largest wind component along the track over a turn, m/s (≥ 0): the full wind speed when
+    the turn's tracks (from ``track_deg`` through ``sweep_deg``, signed, + right) include the
+    direction the wind blows to, else the larger end component; the full speed when the turn
+    is not known (None), as for a hold's 180° turns.
+
+    Parameters
+    ----------
+    wind_speed_mps : wind speed, m/s; wind_from_deg : direction it blows from, deg true
+    track_deg : track at the turn's start, deg true; sweep_deg : the turn, deg
+    """
+    if wind_speed_mps <= 0.0:
+        return 0.0
+    if track_deg is None or sweep_deg is None or abs(sweep_deg) >= 180.0:
+        return wind_speed_mps
+    to = wind_from_deg + 180.0
+    rel = ((to - track_deg) % 360.0) if sweep_deg >= 0 else ((track_deg - to) % 360.0)
+    if rel <= abs(sweep_deg):
+        return wind_speed_mps
+    ends = (math.cos(math.radians(to - track_deg)),
+            math.cos(math.radians(to - track_deg - sweep_deg)))
+    return max(0.0, wind_speed_mps * max(ends))
+
+
+def drift_track_deg(heading_deg: float, tas_mps: float, wind_speed_mps: float,
+                    wind_from_deg: float) -> float:
+    """Ground track flown on a heading in a steady wind (the wind triangle), deg true:
+    V_g = V (sin ψ, cos ψ) + W (sin χ_w, cos χ_w), χ_w = wind_from + 180°.
+
+    Parameters
+    ----------
+    heading_deg : heading, deg true; tas_mps : true airspeed, m/s
+    wind_speed_mps : wind speed, m/s; wind_from_deg : direction it blows from, deg true
+    """
+    if wind_speed_mps <= 0.0:
+        return heading_deg % 360.0
+    h, to = math.radians(heading_deg), math.radians(wind_from_deg + 180.0)
+    gx = tas_mps * math.sin(h) + wind_speed_mps * math.sin(to)
+    gy = tas_mps * math.cos(h) + wind_speed_mps * math.cos(to)
+    return math.degrees(math.atan2(gx, gy)) % 360.0
+
+
+APPROACH_CAS_MPS = 210 * KT_MPS
+"""CAS an approach is planned at up to its final approach fix (the usual initial/intermediate
+approach speed), m/s."""
+FINAL_CAS_FACTOR = 1.15
+"""From the final approach fix on, an approach is planned at this multiple of the aircraft's
+minimum clean CAS (no flaps are modelled yet: the slowest clean speed the laws fly)."""
+
+
+def approach_cas_caps(records, proc_type: str, cas_min_mps: float) -> list[float | None]:
+    """Planned CAS cap per leg of a procedure, m/s (None: no cap): approaches (``proc_type``
+    'F') at :data:`APPROACH_CAS_MPS` up to and including the leg that ends at the final
+    approach fix (waypoint description col. 43 'F'), at :data:`FINAL_CAS_FACTOR` × the minimum
+    clean CAS after it; other procedures uncapped. The builder plans turn radii for these
+    speeds and guidance flies them (decelerating before the fix where they start)."""
+    out: list[float | None] = []
+    final = False
+    for r in records:
+        if proc_type != "F":
+            out.append(None)
+            continue
+        out.append(max(FINAL_CAS_FACTOR * cas_min_mps, 1.0) if final else APPROACH_CAS_MPS)
+        if r.desc[3:4] == "F":
+            final = True
+    return out

@@ -30,7 +30,8 @@ from fms_testbed.path.plan import FlyablePath, build_procedure, load_db
 from fms_testbed.config.yamlfile import read_mapping
 from fms_testbed.config.scenario import Scenario, parse_scenario
 from fms_testbed.sim.jsbsim_core import DT_S
-from fms_testbed.guidance.vertical import cas_band, leg_speed_limits, tas_target_mps
+from fms_testbed.core.atmosphere import cas_to_tas_scalar
+from fms_testbed.guidance.vertical import cas_band, planned_limits, tas_target_mps
 from fms_testbed.guidance.lateral import LateralGains, anticipation_m
 from fms_testbed.core.geodesy import direct
 
@@ -48,17 +49,24 @@ def runner_log_every(scn: Scenario) -> int:
 def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     """The scenario ``initial`` block for the start of a built path (module docstring)."""
     seg0 = fp.path.segments[0].geom
-    crs = seg0.start_course_deg
+    # the course of the first segment long enough to fly (a bridge of a few metres has none)
+    crs = next((sg.geom.start_course_deg for sg in fp.path.segments
+                if sg.geom.length_m() >= 50.0), seg0.start_course_deg)
     # start one roll-in anticipation before the path start on its initial course, so that a
     # turn beginning at the path start (a fly-by at the DER) is flown like any planned turn
     lead = anticipation_m(cfg.limits.climb_tas_mps, math.radians(20.0),
                           LateralGains.for_aircraft(cfg))
     lat, lon, _ = direct(seg0.start[0], seg0.start[1], crs + 180.0, lead)
     alt = fp.path.legs[0].start.alt_m
-    lo, hi = cas_band(leg_speed_limits(fp.seq.legs[:1])[0], None)
-    tas = tas_target_mps(cfg.limits.climb_tas_mps, alt, lo, hi, cfg.limits.cas_min_mps)
+    # the planned speed is a CAS (guidance flies it so): its TAS at the start altitude, in the
+    # first leg's band (coded limit, an approach's planned speed)
+    lo, hi = cas_band(planned_limits(fp.seq.legs, fp.path.proc_type,
+                                     cfg.limits.cas_min_mps)[0], None)
+    tas = tas_target_mps(cas_to_tas_scalar(cfg.limits.climb_tas_mps, alt), alt, lo, hi,
+                         cfg.limits.cas_min_mps)
+    hdg = fp.path.segments[0].heading_deg   # a heading leg: its heading (drift in the plan)
     return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,
-            "tas_mps": round(tas, 3), "heading_deg": crs % 360.0}
+            "tas_mps": round(tas, 3), "heading_deg": (crs if hdg is None else hdg) % 360.0}
 
 
 @dataclass
@@ -85,6 +93,21 @@ class PreparedProcedure:
         return g, law
 
 
+def planned_wind(raw_wind, source: str) -> tuple[float, float] | None:
+    """(speed m/s, from deg true) of a scenario's ``wind:`` block, for the path to be planned
+    in it (None: calm or no block)."""
+    if not raw_wind:
+        return None
+    from fms_testbed.config.scenario import Wind
+    from pydantic import ValidationError
+
+    try:
+        w = Wind.model_validate(raw_wind)
+    except ValidationError:
+        return None   # parse_scenario reports it with the file and field
+    return (w.speed_ms, w.from_deg)
+
+
 def prepare(raw: dict, source: str = "<scenario>", db=None
             ) -> tuple[Scenario, ProcedureSpec, FlyablePath, Any]:
     """Validate a scenario mapping that has a ``procedure:`` block and build the procedure.
@@ -107,7 +130,7 @@ def prepare(raw: dict, source: str = "<scenario>", db=None
     if db is None:
         base = Path(source).parent if source and not source.startswith("<") else None
         db = load_db(spec.db, base)
-    fp = build_procedure(db, spec, cfg)
+    fp = build_procedure(db, spec, cfg, wind=planned_wind(raw.get("wind"), source))
     raw.setdefault("initial", initial_from_path(fp, cfg))
     raw.setdefault("duration_s", min(6 * 3600.0, 1.6 * fp.path.length_m()
                                      / cfg.limits.climb_tas_mps + 120.0))

@@ -20,7 +20,7 @@ from fms_testbed.core.segments import Arc, project
 from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
 from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
-from fms_testbed.path.profile import plan_profile
+from fms_testbed.path.profile import plan_profile, sid_join_required_alt_m
 
 #: Tolerances: fly-over pass, gaps (the coded-arc radius tolerances are the leg classes'
 #: ``radius_tol_m``).
@@ -58,10 +58,16 @@ def leg_end_checks(path: ProcedurePath) -> list[FixCheck]:
         if k is None:
             end = (lg.end.lat_deg, lg.end.lon_deg)
         elif path.segments[k].role == "flyby":
+            # the fillet leaves the fix's corner on one side at the lead distance (on the
+            # straight, for a fillet between a coded arc and a line)
             arc = path.segments[k].geom
             allowed += path.segments[k].lead_m or \
                 arc.radius_m * math.tan(math.radians(abs(arc.sweep_deg)) / 2.0)
-            end = arc.start
+            t = lg.termination
+            out.append(FixCheck(lg.index, t.fix_ident, min(
+                inverse(*arc.start, t.lat_deg, t.lon_deg)[0],
+                inverse(*arc.end, t.lat_deg, t.lon_deg)[0]), allowed, lg.record.fly_over))
+            continue
         else:
             end = path.segments[k].geom.end
         t = lg.termination
@@ -110,8 +116,9 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                                    f"give {arc.radius_m / NM_M:.3f} NM: path follows the fixes",
                                    "R"))
         v = lg.speed_mps
+        w = params.wind_speed_mps   # the ground speed on an arc reaches TAS + wind (class 1)
         for _ in range(params.max_iterations):
-            g_req = math.degrees(math.atan(v * v / (arc.radius_m * g)))
+            g_req = math.degrees(math.atan((v + w) ** 2 / (arc.radius_m * g)))
             if g_req <= gplan + 1e-9:
                 break
             if g_req <= gmax:
@@ -119,7 +126,7 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                                    f"{arc.radius_m / NM_M:.2f} NM at {v / KT_MPS:.0f} kt: bank "
                                    f"{gplan:.0f} -> {g_req:.1f}°", "γ"))
                 break
-            v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax)))
+            v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax))) - w
             if v_reg >= perf.tas_min_mps:
                 out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
                                    f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT_MPS:.0f} -> "
@@ -149,15 +156,23 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
         else:
             out.append(Finding(-1, "impossible", f"aircraft climb gradient "
                                f"{100 * theta_perf:.1f}% below the 3.3% minimum"))
-    prof = plan_profile(path, theta_perf, start_alt_m, params.descent_angle_deg)
+    g_desc = perf.descent_rate_max_mps / perf.tas_plan_mps
+    prof = plan_profile(path, theta_perf, start_alt_m, params.descent_angle_deg,
+                        descent_gradient_max=g_desc, descent_rate_mps=perf.descent_rate_max_mps)
     if path.proc_type == "D" and path.start_kind != "runway" and prof.windows:
-        # the aircraft arrives from an earlier transition at an unknown altitude: assume it
-        # just makes the first climb constraint and check the rest
-        w = next((w for w in prof.windows if w.lo_m is not None), None)
-        if w is not None:
-            a0 = w.lo_m - theta_perf * prof.along_m[w.leg_index + 1]
-            if a0 > start_alt_m:
-                prof = plan_profile(path, theta_perf, a0, params.descent_angle_deg)
+        # joined at a fix away from the runway: the planned start must make every climb
+        # constraint ahead at the aircraft's gradient; a start below that is flagged and the
+        # rest checked from the altitude it needs
+        a0 = sid_join_required_alt_m(path, theta_perf)
+        if a0 is not None and a0 > start_alt_m + 50 * FT_M:
+            name = path.legs[0].record.fix.ident if path.legs[0].record.fix else "the start"
+            out.append(Finding(0, "correction", f"SID joined at {name} at "
+                               f"{start_alt_m / FT_M:.0f} ft cannot make its climb constraints "
+                               f"at {100 * theta_perf:.1f}%: joined at {a0 / FT_M:.0f} ft",
+                               "V,Θ"))
+            prof = plan_profile(path, theta_perf, a0, params.descent_angle_deg,
+                                descent_gradient_max=g_desc,
+                                descent_rate_mps=perf.descent_rate_max_mps)
     for w in prof.windows:
         k = w.leg_index + 1
         if not prof.climb[k] or w.lo_m is None or prof.alt_m[k] >= w.lo_m - 1.0:

@@ -8,7 +8,9 @@ A flyable procedure is the concatenation of the database's transitions, in flyin
 * approach: approach transition (route type ``A``) → final approach, cut at the missed-approach
   point (an approach ends at the runway/MAP: the flight stops there)
 
-The ``IF`` that starts a later part is dropped when it repeats the fix the previous part ends at.
+The ``IF`` that starts a later part is dropped when it repeats the fix the previous part ends at;
+after a transition that ends in a hold at a fix the next part reaches later, the next part is
+joined at that fix.
 The path itself comes from the issue-4 builder (``arinc424.segmentation.build_sequence``) and
 monitor (``arinc424.monitor.check_path``); :func:`rebuild_from` builds the rest of a procedure
 from the aircraft's actual state when a conditional leg ends in flight.
@@ -108,6 +110,16 @@ def merge_parts(parts: list):
         if nxt and LEG_TYPES[nxt[0].path_term].initial and legs and legs[-1].fix is not None \
                 and nxt[0].fix is not None and nxt[0].fix.ident == legs[-1].fix.ident:
             nxt = nxt[1:]
+        elif nxt and LEG_TYPES[nxt[0].path_term].initial and legs and legs[-1].fix is not None \
+                and LEG_TYPES[legs[-1].path_term].hold:
+            # a transition ending in a hold (HF course reversal) at a fix the next part
+            # reaches later (its IF lies outbound of it): join the next part at that fix
+            # instead of flying back out to its IF
+            at = legs[-1].fix.ident
+            j = next((k for k, lg in enumerate(nxt) if k > 0 and lg.fix is not None
+                      and lg.fix.ident == at), None)
+            if j is not None:
+                nxt = nxt[j + 1:]
         legs += nxt
     if parts[0].proc_type == "F":
         cut = next((i for i, lg in enumerate(legs) if lg.missed_approach_start), len(legs))
@@ -119,8 +131,9 @@ def merge_parts(parts: list):
 
 
 PLAN_CLIMB_FRACTION = 0.75
-"""The plan climbs at this fraction of the aircraft's sustained climb rate (margin for the
-law to catch up after turns and speed changes)."""
+"""The plan climbs (and, where it must descend steeply, descends) at this fraction of the
+aircraft's sustained climb (descent) rate: margin for the law to catch up after turns and
+speed changes."""
 
 
 def plan_climb_rate_mps(cfg) -> float:
@@ -144,16 +157,23 @@ class FlyablePath:
     leg_offset: int
     rnp_m: tuple[float, ...]
     degraded: tuple[str, ...] = ()
+    params: object = None
+    """The :class:`~fms_testbed.legs.model.BuildParams` it was built with (the planned wind):
+    an in-flight rebuild uses the same."""
 
 
-def _perf_params(cfg, spec: ProcedureSpec):
+def _perf_params(cfg, spec: ProcedureSpec, wind: tuple[float, float] | None = None):
+    """Performance and build settings for aircraft ``cfg``; ``wind`` (speed m/s, from deg
+    true): the wind the path is planned for."""
     from fms_testbed.legs.model import BuildParams, Performance
 
     perf = Performance.from_aircraft(cfg)
     grad = spec.climb_gradient or plan_climb_rate_mps(cfg) / perf.tas_plan_mps
     perf = replace(perf, climb_gradient_max=min(grad, perf.climb_gradient_max))
+    w_mps, w_from = wind if wind is not None else (0.0, 0.0)
     params = BuildParams(manual_leg_m=spec.manual_leg_nm * NM_M,
-                         bank_limit_deg=min(25.0, cfg.limits.bank_max_deg))
+                         bank_limit_deg=min(25.0, cfg.limits.bank_max_deg),
+                         wind_speed_mps=float(w_mps), wind_from_deg=float(w_from))
     return perf, params
 
 
@@ -174,13 +194,18 @@ def _finish(path, seq, spec, cfg, perf, params, offset: int) -> FlyablePath:
     if checked.legs:
         grad = perf.climb_gradient_at(perf.tas_plan_mps)
         prof = plan_profile(checked, grad, checked.legs[0].start.alt_m,
-                            climb_top_m=spec.climb_top_ft * FT_M)
+                            params.descent_angle_deg, climb_top_m=spec.climb_top_ft * FT_M,
+                            descent_gradient_max=perf.descent_rate_max_mps / perf.tas_plan_mps,
+                            descent_rate_mps=PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
+                            wind=(params.wind_speed_mps, params.wind_from_deg))
         checked = replace(checked, profile=prof)
     return FlyablePath(checked, seq, offset, _rnp(seq, spec, 0))
 
 
-def build_procedure(db, spec: ProcedureSpec, cfg) -> FlyablePath:
-    """Select, merge, build and check the procedure a spec names, for aircraft ``cfg``.
+def build_procedure(db, spec: ProcedureSpec, cfg,
+                    wind: tuple[float, float] | None = None) -> FlyablePath:
+    """Select, merge, build and check the procedure a spec names, for aircraft ``cfg`` and the
+    planned ``wind`` (speed m/s, from deg true; None: calm).
 
     Raises
     ------
@@ -198,17 +223,16 @@ def build_procedure(db, spec: ProcedureSpec, cfg) -> FlyablePath:
         raise UserError(refusal(seq.name, seq.defects))
     if not seq.legs:
         raise UserError(f"{seq.name}: no leg left to fly (every record rejected)")
-    perf, params = _perf_params(cfg, spec)
+    perf, params = _perf_params(cfg, spec, wind)
     path = build_sequence(db, seq, perf, params)
     start_alt = spec.start_alt_ft * FT_M if spec.start_alt_ft is not None else None
     if start_alt is None and seq.proc_type == "D" and path.start_kind != "runway" and path.legs:
-        # a SID that starts at a fix (the runway part is vectors): arrive there at its
-        # 'at or above' altitude, not at runway height
-        from fms_testbed.path.profile import window
-        r0 = seq.legs[0]
-        lo, _ = window(r0.alt_desc, r0.alt1_m, r0.alt2_m)
-        if lo is not None and lo > path.legs[0].start.alt_m:
-            start_alt = lo
+        # a SID that starts at a fix (the runway part is vectors): arrive there high enough
+        # for its climb constraints at the planned gradient (the monitor assumes the same)
+        from fms_testbed.path.profile import sid_join_required_alt_m
+        need = sid_join_required_alt_m(path, perf.climb_gradient_at(perf.tas_plan_mps))
+        if need is not None and need > path.legs[0].start.alt_m:
+            start_alt = need
     if start_alt is not None and path.legs:
         from fms_testbed.legs.model import FlightState
         st = path.legs[0].start
@@ -221,7 +245,7 @@ def build_procedure(db, spec: ProcedureSpec, cfg) -> FlyablePath:
         why = "; ".join(f.message for f in fp.path.findings if f.category == "impossible")
         raise UserError(f"{seq.name}: the monitor finds the procedure impossible to fly: "
                         f"{why or 'no path segments'}")
-    return replace(fp, degraded=tuple(str(d) for d in seq.defects))
+    return replace(fp, degraded=tuple(str(d) for d in seq.defects), params=params)
 
 
 def rebuild_from(db, whole: FlyablePath, spec: ProcedureSpec, cfg, next_leg: int,
@@ -240,9 +264,11 @@ def rebuild_from(db, whole: FlyablePath, spec: ProcedureSpec, cfg, next_leg: int
         return None
     seq = replace(whole.seq, legs=legs)
     perf, params = _perf_params(cfg, spec)
+    if whole.params is not None:
+        params = whole.params
     start = FlightState(lat_deg, lon_deg, track_deg, alt_m)
     path = build_sequence(db, seq, perf, params, start=start)
     if not path.segments or path.status == "impossible":
         return None
     fp = _finish(path, seq, spec, cfg, perf, params, next_leg)
-    return replace(fp, rnp_m=whole.rnp_m[next_leg:], degraded=whole.degraded)
+    return replace(fp, rnp_m=whole.rnp_m[next_leg:], degraded=whole.degraded, params=params)

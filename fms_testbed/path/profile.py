@@ -75,23 +75,59 @@ def window(desc: str, alt1_m: float | None, alt2_m: float | None
 
 
 def leg_end_distances(path: ProcedurePath) -> np.ndarray:
-    """Distance along the path (m) at the end of each built leg."""
+    """Distance along the path (m) where each built leg ends — abeam its fix: a leg that ends
+    in a fly-by arc ends at the arc's middle, where the aircraft passes the fix and its
+    altitude constraint is checked, not where the arc ends (one geometry for the profile, the
+    monitor's gradients and guidance)."""
     ends = np.zeros(len(path.legs))
     s = 0.0
     per_leg: dict[int, float] = {}
     for seg in path.segments:
         s += seg.geom.length_m()
-        per_leg[seg.leg_index] = s
+        per_leg[seg.leg_index] = s - (0.5 * seg.geom.length_m() if seg.role == "flyby" else 0.0)
     last = 0.0
     for k, lg in enumerate(path.legs):
-        last = per_leg.get(lg.index, last)
+        last = max(per_leg.get(lg.index, last), last)
         ends[k] = last
     return ends
 
 
+DESCENT_CAP_MARGIN_M = 150 * FT_M
+"""Largest margin below an 'at or below' / 'between' top a descent is planned to, m."""
+
+
+def descent_cap_margin_m(lo_m: float | None, hi_m: float) -> float:
+    """Margin below a window's top a descent aims at, m: a quarter of a 'between' window (at
+    most :data:`DESCENT_CAP_MARGIN_M`), the whole margin under an 'at or below', none for an
+    'at' (its top is its bottom)."""
+    if lo_m is None:
+        return DESCENT_CAP_MARGIN_M
+    return min(0.25 * max(hi_m - lo_m, 0.0), DESCENT_CAP_MARGIN_M)
+
+
+def sid_join_required_alt_m(path: ProcedurePath, climb_gradient: float) -> float | None:
+    """Lowest altitude at which a SID joined at its first fix (not from the runway) must be
+    there to make every 'at or above' climb constraint at ``climb_gradient``: the largest
+    lo − gradient × distance over its windows, capped by the lowest 'at or below' one, m (None
+    when nothing is coded)."""
+    ends = leg_end_distances(path)
+    need, cap = None, math.inf
+    for k, lg in enumerate(path.legs):
+        r = lg.record
+        lo, hi = window(r.alt_desc, r.alt1_m, r.alt2_m)
+        if hi is not None:
+            cap = min(cap, hi)
+        if lo is not None:
+            a = lo - climb_gradient * ends[k]
+            need = a if need is None else max(need, a)
+    return None if need is None else min(need, cap)
+
+
 def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
-                 descent_angle_deg: float = 3.0, climb_top_m: float | None = None
-                 ) -> VerticalProfile:
+                 descent_angle_deg: float = 3.0, climb_top_m: float | None = None,
+                 descent_gradient_max: float | None = None,
+                 descent_rate_mps: float | None = None,
+                 wind: tuple[float, float] | None = None) -> VerticalProfile:
     """Plan the vertical profile of a built path.
 
     Parameters
@@ -104,7 +140,24 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
         None: the highest climb constraint ahead, else the coded transition altitude, else
         18,000 ft (the database check). A flight passes its own climb top so that the planned
         profile and the flown climb level at the same altitude.
+    descent_gradient_max : steepest descent the aircraft can fly (drop over run; its descent
+        rate over its planned speed); None: 2.5 × tan(descent_angle_deg)
+    descent_rate_mps : when given, the steepest descent of each leg is this rate over the
+        leg's planned ground speed (``BuiltLeg.speed_mps`` plus the ``wind`` component along
+        the leg's track), m/s
+    wind : (speed m/s, from deg true) the path is planned for; None: calm
+
+    Notes
+    -----
+    Descent: planned backwards from the last constrained node at the coded vertical angle
+    (else ``descent_angle_deg``), clamped into every window and under the start and highest
+    coded altitude — so the final approach lies on its coded path angle to the runway. Where
+    the path starts above that geometric path, the aircraft descends from its start at up to
+    ``descent_gradient_max`` until it meets it (it does not stay high and dive at the end).
     """
+    g_desc = descent_gradient_max if descent_gradient_max is not None else \
+        2.5 * math.tan(math.radians(descent_angle_deg))
+
     n = len(path.legs)
     ends = leg_end_distances(path)
     windows = []
@@ -143,17 +196,25 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
             h = alt[k + 1] + math.tan(math.radians(ang)) * (along[k + 1] - along[k])
             h = min(h, ceiling)
             if hi_at[k] is not None:
-                h = min(h, hi_at[k])
+                # a descent capped by a window's top aims a margin inside it: the aircraft
+                # tracks a descending path a little high (:func:`descent_cap_margin_m`)
+                h = min(h, hi_at[k] - descent_cap_margin_m(lo_at[k], hi_at[k]))
             if lo_at[k] is not None:
                 h = max(h, lo_at[k])
-            alt[k] = h if k > 0 else min(h, max(start_alt_m, alt[1]))
-        # forward pass: no steeper than the planned angle where the windows allow staying high
+            alt[k] = h if k > 0 else start_alt_m
+        # forward pass: from a start above the geometric path, descend no steeper than the
+        # aircraft can until the path is met
         for k in range(1, last + 1):
-            ang = descent_angle_deg
-            vpa = path.legs[k - 1].record.vpa_deg
-            if vpa:
-                ang = abs(vpa)
-            floor = alt[k - 1] - math.tan(math.radians(ang)) * (along[k] - along[k - 1])
+            lg = path.legs[k - 1]
+            v = lg.speed_mps
+            if v and wind is not None and lg.end.track_deg is not None:
+                # a tailwind makes the same descent rate a shallower path (class 1: wind)
+                v = max(v + wind[0] * math.cos(math.radians(wind[1] + 180.0
+                                                             - lg.end.track_deg)), 0.3 * v)
+            # the descent rate over the leg's planned ground speed (fast and high in a STAR,
+            # the same rate is a shallower path), else the given gradient
+            g_k = descent_rate_mps / v if descent_rate_mps and v else g_desc
+            floor = alt[k - 1] - g_k * (along[k] - along[k - 1])
             if floor > alt[k]:
                 alt[k] = floor if hi_at[k] is None else min(floor, max(hi_at[k], alt[k]))
         # a descent phase never climbs: after the last constraint (e.g. a STAR ending in vectors)

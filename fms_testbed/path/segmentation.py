@@ -18,15 +18,17 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
-from fms_testbed.core.geodesy import LocalFrame, direct, gravity_mps2, inverse, wrap180, wrap360
+from fms_testbed.core.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
+from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
 from fms_testbed.legs.model import (BuildParams, BuiltLeg, Finding, FlightState, Performance, PathSegment,
+                    approach_cas_caps, max_tailwind_mps,
                     ProcedurePath, isa_tas_mps, turn_radius_m)
 
 
@@ -53,7 +55,19 @@ def resolve_legs(db: Database, seq: Sequence) -> tuple[list[ResolvedLeg], list[F
     return out, findings
 
 
+def runway_part(transition: str) -> str:
+    """The runway element of a (merged) transition name: 'RW18C' of 'RW18C+AUDII' (a SID flown
+    from its runway transition through the common route to an en-route transition), '' when
+    it has none."""
+    return next((t for t in transition.split("+") if t.startswith("RW")), "")
+
+
 def _runway(db: Database, airport: str, transition: str):
+    """The runway threshold record (PG) of the runway part of ``transition`` (``RWxxB``: the
+    first of its L/R/C runways), or None."""
+    transition = runway_part(transition)
+    if not transition:
+        return None
     cands = db.terminal.get((airport, transition), [])
     for f in cands:
         if f.section == "PG":
@@ -66,24 +80,48 @@ def _runway(db: Database, airport: str, transition: str):
     return None
 
 
-def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightState:
+SID_JOIN_CAP_M = 18000 * FT_M
+"""A SID joined at a fix away from the runway is never planned above this, m."""
+
+
+def sid_join_alt_m(db: Database, seq: Sequence, fix, elev_m: float,
+                   perf: Performance | None) -> float:
+    """Altitude at which a SID joined at ``fix`` (not from its runway: the runway part is
+    vectors or was not asked for) is planned to be there: 35 ft above the field plus a climb at
+    the aircraft's gradient over the distance from the airport to the fix, capped by every 'at
+    or below' constraint of the transition and by :data:`SID_JOIN_CAP_M`, m — not the field
+    elevation (issue 12, class H: a start thousands of feet below the climb windows)."""
+    alt = elev_m + 35 * FT_M
+    apt = db.airports.get(seq.airport)
+    if perf is not None and apt is not None and fix is not None:
+        d = inverse(apt.lat_deg, apt.lon_deg, fix.lat_deg, fix.lon_deg)[0]
+        alt += perf.climb_gradient_at(perf.tas_plan_mps) * d
+    caps = [r.alt1_m for r in seq.legs if r.alt1_m is not None and r.alt_desc in ("-", "Y")]
+    return min([alt, SID_JOIN_CAP_M] + caps)
+
+
+def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
+                perf: Performance | None = None) -> FlightState:
     """Planned start: a SID runway transition starts at the departure end of the runway
-    (threshold + length along the runway's true bearing, 35 ft above the threshold); other
-    transitions start at their first fix (STAR/approach altitude: the first coded altitude, else
-    airport elevation + 10,000 ft / 3,000 ft); a SID without either starts over the airport."""
+    (threshold + length along the runway's true bearing, 35 ft above the threshold); a SID
+    joined at its first fix starts there at :func:`sid_join_alt_m`; other transitions start at
+    their first fix (STAR/approach altitude: the first coded altitude, else airport elevation
+    + 10,000 ft / 3,000 ft); a SID without either starts over the airport."""
     apt = db.airports.get(seq.airport)
     elev = (apt.elev_m if apt and apt.elev_m is not None else 0.0)
     first = legs[0]
     if seq.proc_type == "D":
-        rwy = _runway(db, seq.airport, seq.transition) if seq.transition.startswith("RW") else None
+        rwy = _runway(db, seq.airport, seq.transition)
         if rwy is not None and not LEG_TYPES[first.pt].initial:
             brg = wrap360((rwy.bearing_deg or 0.0) + (apt.magvar_deg if apt else 0.0))
             lat, lon, az = direct(rwy.lat_deg, rwy.lon_deg, brg, rwy.length_m or 0.0)
             alt = (rwy.elev_m if rwy.elev_m is not None else elev) + 35 * FT_M
             return FlightState(lat, lon, wrap360(az), alt)
-        alt = elev + 35 * FT_M
+        alt = sid_join_alt_m(db, seq, first.fix, elev, perf)
     else:
-        alt = next((lg.rec.alt1_m for lg in legs if lg.rec.alt1_m is not None), None)
+        # the first coded altitude; of an 'between' window its middle (the top of it can
+        # leave the next windows out of reach of the descent)
+        alt = next((_descent_target(lg) for lg in legs if lg.rec.alt1_m is not None), None)
         if alt is None:
             alt = elev + (10000 if seq.proc_type == "E" else 3000) * FT_M
     if first.fix is not None:
@@ -94,12 +132,15 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg]) -> FlightS
     raise LegError(f"{seq.name}: no runway, fix or airport to start from")
 
 
-def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float) -> float:
-    """Planned TAS: the aircraft's planned speed (flown as a CAS: its TAS at ``alt_m``) capped by
-    an 'at or below' speed limit, raised to
+def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float,
+                      cas_cap_mps: float | None = None) -> float:
+    """Planned TAS: the aircraft's planned speed (flown as a CAS: its TAS at ``alt_m``; no more
+    than ``cas_cap_mps``, an approach's planned speed: :func:`~fms_testbed.legs.model.
+    approach_cas_caps`) capped by an 'at or below' speed limit, raised to
     an 'at or above' one, and equal to an 'at' one — the speed guidance will fly there, so turn
     radii are planned for it (limits are IAS, turned to TAS in the ISA), m/s."""
-    v = isa_tas_mps(perf.tas_plan_mps, alt_m)  # the planned speed is flown as a CAS
+    v = isa_tas_mps(perf.tas_plan_mps if cas_cap_mps is None else
+                    min(perf.tas_plan_mps, cas_cap_mps), alt_m)  # flown as a CAS
     lim = leg.rec.speed_limit_mps
     if lim is None:
         return v
@@ -137,7 +178,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     if any(f.category == "impossible" for f in findings):
         return path
     try:
-        state = start or start_state(db, seq, legs)
+        state = start or start_state(db, seq, legs, perf)
         kind = "given" if start else _start_kind(db, seq, legs, state)
     except LegError as exc:
         return replace(path, findings=path.findings + (Finding(-1, "impossible", str(exc)),))
@@ -149,16 +190,17 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     b.climbing = seq.proc_type == "D"
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
     built: list[BuiltLeg] = []
+    caps = approach_cas_caps([lg.rec for lg in legs], seq.proc_type, perf.tas_min_mps)
     for i, leg in enumerate(legs):
         b.i = i
         if leg.rec.missed_approach_start:
             b.climbing = True
         speed_in = b.speed_mps if i else None
-        b.speed_mps = planned_speed_mps(perf, leg, state.alt_m)
+        b.speed_mps = planned_speed_mps(perf, leg, state.alt_m, caps[i])
         b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
         # a turn at the start of the leg is entered at the previous leg's speed: plan its radius
         # for the faster of the two
-        b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0), bank, g)
+        b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank, g)
         start_st = state
         leg_cls = LEG_TYPES[leg.pt]
         try:
@@ -180,7 +222,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
     if st.track_deg is not None and seq.proc_type == "D" and not LEG_TYPES[legs[0].pt].initial \
-            and seq.transition.startswith("RW") and _runway(db, seq.airport, seq.transition):
+            and _runway(db, seq.airport, seq.transition):
         return "runway"
     return "fix" if legs[0].fix is not None else "airport"
 
@@ -213,6 +255,11 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
                 and isinstance(out[-1].geom, Line):
             out.extend(_line_arc_fillet(b, out, seg, perf, params, bank_deg))
             continue
+        if k in b.corners and out and isinstance(seg.geom, Line) \
+                and isinstance(out[-1].geom, Arc):
+            avail = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
+            out.extend(_arc_line_fillet(b, out, seg, perf, params, bank_deg, avail))
+            continue
         if k not in b.corners or not out or not isinstance(seg.geom, Line) \
                 or not isinstance(out[-1].geom, Line):
             out.append(seg)
@@ -225,7 +272,10 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         # the aircraft enters the turn at the inbound speed and leaves it at the outbound one:
         # plan the radius for the faster, which the bank limit must cover
         v = max(a.speed_mps, seg.speed_mps)
-        r = turn_radius_m(v, bank_deg, b.g)
+        # planned for the largest ground speed over the turn's tracks (class 1: the wind)
+        w = max_tailwind_mps(params.wind_speed_mps, params.wind_from_deg,
+                             a.geom.end_course_deg, omega)
+        r = turn_radius_m(v + w, bank_deg, b.g)
         t = math.tan(math.radians(abs(omega)) / 2.0)
         avail_a = a.geom.length_m()  # already trimmed by the previous corner, if any
         avail_c = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
@@ -236,23 +286,25 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
             r_geom = l_avail / t
             b.i = a.leg_index
             if r_geom <= 1.0:
-                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v, gmax, b.g), depth))
+                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g), depth))
                 continue
-            g_reg = math.degrees(math.atan(v * v / (r_geom * b.g)))
+            g_reg = math.degrees(math.atan((v + w) ** 2 / (r_geom * b.g)))
             if g_reg <= gmax:
                 b.finding("correction", f"fly-by at {fix}: radius {r:.0f} -> {r_geom:.0f} m, "
                           f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°)", "R")
                 r, bank = r_geom, g_reg
             else:
-                v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax)))
+                v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax))) - w
                 if v_reg >= perf.tas_min_mps:
                     b.finding("correction", f"fly-by at {fix}: speed {v / KT_MPS:.0f} -> "
                               f"{v_reg / KT_MPS:.0f} kt, bank {gmax:.0f}°, radius "
                               f"{r_geom:.0f} m (turn {omega:+.0f}°)", "V,γ")
                     r, bank, v = r_geom, gmax, v_reg
                 else:
-                    out.extend(_flyover(b, a, seg, omega, turn_radius_m(
-                        perf.tas_min_mps, gmax, b.g), depth))
+                    # flown over at the bank limit and the speed flown there: slowing down
+                    # needs distance the corner does not have
+                    out.extend(_flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g),
+                                        depth))
                     continue
         lead = r * t
         la = a.geom.length_m()
@@ -267,7 +319,7 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
                                lead))
         t2 = seg.geom.point_at(lead)
         # end the arc exactly where the next line resumes
-        fixed = _retarget_arc(arc, t2)
+        fixed = retarget_arc(arc, t2)
         out[-1] = replace(out[-1], geom=fixed)
         rest = Line(*fixed.end, seg.geom.end_lat_deg, seg.geom.end_lon_deg)
         if rest.length_m() >= 0.01:
@@ -278,73 +330,30 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
 def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
                      perf: Performance, params: BuildParams, bank_deg: float
                      ) -> list[PathSegment]:
-    """Fly-by from a line onto a coded arc (CI/VI onto a DME arc, a non-tangent RF entry).
-
-    The fillet of radius r = V²/(g tan γ) is tangent to the line and to the arc (internally when
-    both turn the same way, |F − C| = R − r; externally otherwise, |F − C| = R + r), solved in a
-    local plane about the junction; γ is raised to the monitor's limit when the planned radius
-    does not fit. Returns the segments that replace ``seg`` (``out[-1]`` is trimmed in place);
-    when no fillet fits the sharp corner is kept (the monitor then reports the track jump).
-    """
+    """Fly-by from a line onto a coded arc (CI/VI onto a DME arc, a non-tangent RF entry)
+    (:func:`~.fillets.line_arc_fillet`); γ is raised to the monitor's limit when the planned
+    radius does not fit. Returns the segments that replace ``seg`` (``out[-1]`` is trimmed in
+    place); when no fillet fits the sharp corner is kept (the monitor then reports the track
+    jump)."""
     a = out[-1]
-    arc = seg.geom
-    omega = wrap180(arc.start_course_deg - a.geom.end_course_deg)
-    if abs(omega) < 0.5:
-        return [seg]
-    sgn = 1.0 if omega > 0 else -1.0
-    same = (arc.sweep_deg > 0) == (omega > 0)
-    fr = LocalFrame(*arc.start)
-    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
-    u = math.radians(a.geom.end_course_deg)
-    ux, uy = math.sin(u), math.cos(u)
-    nx, ny = sgn * uy, -sgn * ux          # unit normal toward the turn side
     v = min(a.speed_mps, seg.speed_mps)
+    w = b.wind_mps
     gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for bank in (bank_deg, gmax):
-        r = turn_radius_m(v, bank, b.g)
-        d = arc.radius_m - r if same else arc.radius_m + r
-        if d <= 0:
+        r = turn_radius_m(v + w, bank, b.g)
+        f = line_arc_fillet(a.geom, seg.geom, r)
+        if f is None:
             continue
-        # F = -L u + r n, |F - C| = d  ->  L² + 2 L (u·(C - r n)) + |C - r n|² - d² = 0 ... in -L
-        px, py = r * nx - cx, r * ny - cy
-        bq = -(px * ux + py * uy)
-        cq = px * px + py * py - d * d
-        disc = bq * bq - cq
-        if disc < 0:
-            continue
-        roots = sorted(x for x in (-bq - math.sqrt(disc), -bq + math.sqrt(disc)) if x >= 0)
-        if not roots or roots[0] > a.geom.length_m():
-            continue
-        lead = roots[0]
-        fx, fy = -lead * ux + r * nx, -lead * uy + r * ny
-        # the contact point lies on the ray from C through F (planar radial from C) ...
-        radial_t2 = math.degrees(math.atan2(fx - cx, fy - cy))
-        # ... and from here on the geometry is exact: the contact point on the coded arc and a
-        # fillet started on the line, ended on the radial through the contact point
-        t2 = direct(arc.centre_lat_deg, arc.centre_lon_deg, _geo_radial(fr, arc, radial_t2),
-                    arc.radius_m)[:2]
-        la = a.geom.length_m()
-        t1 = a.geom.point_at(la - lead)
-        fillet = _retarget_arc(turn_arc(t1[0], t1[1], a.geom.course_at(la - lead), omega, r),
-                               t2)
-        _, r2, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, *fillet.end)
-        used = (r2 - arc.start_radial_deg) % 360.0 if arc.sweep_deg > 0 else \
-            (arc.start_radial_deg - r2) % 360.0
-        if used >= abs(arc.sweep_deg) or used > 180.0:
-            continue
-        rest = Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, r2,
-                   arc.sweep_deg - math.copysign(used, arc.sweep_deg))
-        new_a = Line(a.geom.start_lat_deg, a.geom.start_lon_deg, *fillet.start)
-        out[-1] = replace(a, geom=new_a)
-        if new_a.length_m() < 0.01:
+        if f.line is None:
             out.pop()
-        g_used = math.degrees(math.atan(v * v / (r * b.g)))
-        res = [PathSegment(fillet, a.leg_index, a.path_term, a.fix_ident, "flyby", v, g_used,
-                           lead)]
-        gap = inverse(*fillet.end, *rest.start)[0]
-        if gap > 0.01:
-            res.append(replace(seg, geom=Line(*fillet.end, *rest.start), role="connector"))
-        res.append(replace(seg, geom=rest))
+        else:
+            out[-1] = replace(a, geom=f.line)
+        g_used = math.degrees(math.atan((v + w) ** 2 / (r * b.g)))
+        res = [PathSegment(f.fillet, a.leg_index, a.path_term, a.fix_ident, "flyby", v, g_used,
+                           f.lead_m)]
+        if f.gap is not None:
+            res.append(replace(seg, geom=f.gap, role="connector"))
+        res.append(replace(seg, geom=f.arc))
         if bank > bank_deg:
             b.i = seg.leg_index
             b.finding("correction", f"fly-by onto the {seg.path_term} arc: bank "
@@ -353,35 +362,45 @@ def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
     return [seg]
 
 
-def _geo_radial(fr: LocalFrame, arc: Arc, planar_radial_deg: float) -> float:
-    """Geodesic radial from the arc centre matching a radial measured in the local plane."""
-    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
-    a = math.radians(planar_radial_deg)
-    px, py = cx + arc.radius_m * math.sin(a), cy + arc.radius_m * math.cos(a)
-    lat, lon = fr.to_latlon(px, py)
-    return inverse(arc.centre_lat_deg, arc.centre_lon_deg, lat, lon)[1]
-
-
-def _retarget_arc(arc: Arc, pt: tuple[float, float]) -> Arc:
-    """The same arc ending on the radial through ``pt`` (small correction only)."""
-    _, az, _ = inverse(arc.centre_lat_deg, arc.centre_lon_deg, pt[0], pt[1])
-    if arc.sweep_deg >= 0:
-        sweep = wrap360(az - arc.start_radial_deg)
-        if sweep > 359.0:
-            sweep -= 360.0
-    else:
-        sweep = -wrap360(arc.start_radial_deg - az)
-        if sweep < -359.0:
-            sweep += 360.0
-    if abs(sweep - arc.sweep_deg) > 5.0:
-        return arc
-    return Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, arc.start_radial_deg, sweep)
+def _arc_line_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
+                     perf: Performance, params: BuildParams, bank_deg: float,
+                     avail_m: float) -> list[PathSegment]:
+    """Fly-by from the end of a coded arc (RF/AF end fix) onto the line that leaves it (the
+    CF, TF or DF after it) (:func:`~.fillets.arc_line_fillet`); γ is raised to the monitor's
+    limit when the planned radius does not fit in ``avail_m`` of the line. ``out[-1]`` (the
+    arc) is trimmed in place; returns what replaces ``seg``. When no fillet fits the corner is
+    flown over the fix: the line's leg rejoins its course (branch V,γ,φ,λ)."""
+    a = out[-1]
+    v = max(a.speed_mps, seg.speed_mps)
+    w = b.wind_mps
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    for bank in (bank_deg, gmax):
+        r = turn_radius_m(v + w, bank, b.g)
+        f = arc_line_fillet(a.geom, seg.geom, r, avail_m)
+        if f is None:
+            continue
+        out[-1] = replace(a, geom=f.arc)
+        if f.gap is not None:
+            out.append(replace(a, geom=f.gap, role="connector"))
+        g_used = math.degrees(math.atan((v + w) ** 2 / (r * b.g)))
+        res = [PathSegment(f.fillet, a.leg_index, a.path_term, a.fix_ident, "flyby", v, g_used,
+                           f.lead_m)]
+        if f.line is not None:
+            res.append(replace(seg, geom=f.line))
+        if bank > bank_deg:
+            b.i = a.leg_index
+            b.finding("correction", f"fly-by off the {a.path_term} arc at {a.fix_ident}: bank "
+                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ")
+        return res
+    omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
+    return _flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g))
 
 
 def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: float,
              depth: int = 0) -> list[PathSegment]:
     """Branch V,γ,φ,λ: the turn cannot be cut inside the fixes; fly over the corner, turn at
-    the lowest speed and maximum bank, then go direct to the end of the next line."""
+    the bank limit (radius ``r``, planned for the speed flown there: there is no room to slow
+    down) and rejoin the next line's course before its end."""
     at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
     b.finding("correction", f"fly-by at {at} (turn {omega:+.0f}°) "
               f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
@@ -391,14 +410,18 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     # rejoin the next line's own course before its end, so that the legs built after it (which
     # assumed that course) still start tangent to the path
     tmp = LegBuilder(b.legs, b.perf, b.params, b.g, b.prev_fixes)
-    tmp.i, tmp.speed_mps, tmp.radius_m = seg.leg_index, seg.speed_mps, r
+    gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
+    # the turn is flown at the speed that gives radius r at the bank limit
+    v_turn = min(seg.speed_mps,
+                 math.sqrt(r * b.g * math.tan(math.radians(gmax))) - b.wind_mps)
+    tmp.i, tmp.speed_mps, tmp.radius_m = seg.leg_index, v_turn, r
     tmp.climbing = False
     target = Fix(ident=seg.fix_ident, region="", section="", lat_deg=end[0], lon_deg=end[1])
     state = FlightState(lat, lon, a.geom.end_course_deg, 0.0, flyby=False)
     tmp.join_course(state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
     if depth == 0:
         segs = round_corners(tmp, b.perf, b.params, math.degrees(math.atan(
-            seg.speed_mps ** 2 / (r * b.g))), depth=1)
+            (v_turn + b.wind_mps) ** 2 / (r * b.g))), depth=1)
     else:
         segs = tmp.segments
     out = [replace(x, role="turn" if x.role == "leg" else x.role) for x in segs[:-1]]

@@ -20,6 +20,8 @@ from fms_testbed.viz.figure import subplots
 
 KMH = 1.0 / KMH_MPS
 """m/s → km/h."""
+BODE_FLOOR_DB = -120.0
+"""Magnitudes below this are drawn as absent (|W| < 1e-6: rounding noise of a zero entry)."""
 _LAW_STYLE = {"coupled": dict(color="C0", lw=1.8), "pi": dict(color="C3", lw=1.2),
               "tecs": dict(color="C2", lw=1.2), "ideal": dict(color="k", lw=1.0, ls="--")}
 _LAW_LABEL = {"coupled": "coupled law (JSBSim)", "pi": "baseline (a): PI autothrottle (JSBSim)",
@@ -67,8 +69,13 @@ def plot_comparison(runs: dict[str, pd.DataFrame], title: str) -> Figure:
     axes[3].set_ylabel("normal load factor n_y, g")
     axes[3].set_xlabel("time, s")
     e = np.concatenate([(d["alt_m"] - d["cmd_alt_m"]).to_numpy() for d in runs.values()])
-    if np.nanmax(np.abs(e)) > 50:       # a level change: zoom on the capture
-        axes[1].set_ylim(-120, 20) if np.nanmin(e) < 0 else axes[1].set_ylim(-20, 120)
+    e = e[np.isfinite(e)]
+    if e.size:
+        # the whole step and its capture (a 500 m step starts at -500 m), robust to one run
+        # diverging: the 0.1-99.9 % range of every run's error, with a margin
+        lo, hi = np.percentile(e, [0.1, 99.9])
+        pad = max(0.05 * (hi - lo), 5.0)
+        axes[1].set_ylim(min(lo, -10.0) - pad, max(hi, 10.0) + pad)
     for ax in axes:
         ax.grid(alpha=0.4)
         _events(ax, next(iter(runs.values())))
@@ -125,19 +132,24 @@ def plot_bode_coupling(omega_rps: np.ndarray, cases: dict[str, np.ndarray],
     fig, axes = subplots(2, 2, figsize=(11, 7), sharex=True)
     panels = [((0, 0), "V / V_cmd, dB", 0, 0, 1.0), ((0, 1), "V / H_cmd, dB re (km/h)/m", 0, 1, KMH),
               ((1, 0), "H / V_cmd, dB re m/(km/h)", 1, 0, 1 / KMH), ((1, 1), "H / H_cmd, dB", 1, 1, 1.0)]
-    floor = 1e-16
     notes: dict[tuple, list[str]] = {}
-    for label, W in cases.items():
+    for k, (label, W) in enumerate(cases.items()):
         for (r, c), _, i, j, scale in panels:
             mag = np.abs(W[i, j]) * scale
-            axes[r, c].semilogx(omega_rps, 20 * np.log10(np.maximum(mag, floor)), label=label)
-            if r != c and mag.max() < 1e-9:
+            db = 20 * np.log10(np.maximum(mag, 1e-300))
+            if mag.max() < 10 ** (BODE_FLOOR_DB / 20):
+                # numerical noise of an exactly-zero transfer (e.g. -320 dB): not drawn
                 notes.setdefault((r, c), []).append(
-                    f"{label}: max {mag.max():.1e} (numerically zero)")
+                    f"{label}: |W| ≤ {mag.max():.0e} — zero to rounding, not drawn")
+                axes[r, c].plot([], [], color=f"C{k}", label=label)
+                continue
+            axes[r, c].semilogx(omega_rps, np.where(db >= BODE_FLOOR_DB, db, np.nan),
+                                color=f"C{k}", label=label)
     for (r, c), lab, *_ in panels:
         axes[r, c].set_ylabel(lab)
         axes[r, c].grid(alpha=0.4, which="both")
-        axes[r, c].set_ylim(-330 if c != r else -60, 10)
+        axes[r, c].set_ylim(BODE_FLOOR_DB if c != r else -60, 10)
+        axes[r, c].set_xscale("log")
     for (r, c), txt in notes.items():
         axes[r, c].text(0.02, 0.04, "\n".join(txt), transform=axes[r, c].transAxes, fontsize=7,
                         va="bottom")

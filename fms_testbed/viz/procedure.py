@@ -26,10 +26,28 @@ def _sample(geom, step_m: float = 200.0):
     return [p[0] for p in pts], [p[1] for p in pts]
 
 
+def tse_headline(summary: dict) -> str:
+    """The figure that matters for a procedure flight, for a title: TSE95 and max TSE (the
+    true position's error from the path) and the RNP verdict; FTE after it (FTE alone hides a
+    navigation error: a flight 5 km off track with FTE95 4 m)."""
+    err = summary.get("errors", {})
+    tse = err.get("tse", {}).get("all", {})
+    fte = err.get("fte", {}).get("all", {})
+    rnp = summary.get("rnp", {})
+    verdict = ("RNP contained" if rnp.get("contained") else
+               f"NOT contained (legs {rnp.get('legs_not_contained')})") if rnp else "no RNP"
+
+    def m(v):
+        return "n/a" if v is None else f"{v:.0f} m" if v >= 10 else f"{v:.1f} m"
+    return (f"TSE95 {m(tse.get('p95_m'))}, max {m(tse.get('max_m'))} vs RNP "
+            f"{rnp.get('min_rnp_nm')} NM: {verdict} (FTE95 {m(fte.get('p95_m'))})")
+
+
 def plot_ground_track(df, summary, fp, flown_paths=()) -> Figure:
-    """Ground track (true, and navigation when it differs) over the designed path, NM from the
-    start; each leg is labelled '<n> <code> <fix>' at its middle; fixes marked; FTE95 in the
-    title."""
+    """Ground track (true, and navigation when it differs) over the path flown for — the built
+    path, whose bridges over discontinuities are the direct-tos flown, and the paths rebuilt in
+    flight — NM from the start; each leg is labelled '<n> <code> <fix>' at its middle; fixes
+    marked; TSE and the RNP verdict in the title (:func:`tse_headline`)."""
     path = fp.path
     s0 = path.segments[0].geom.start
 
@@ -42,7 +60,11 @@ def plot_ground_track(df, summary, fp, flown_paths=()) -> Figure:
         la, lo = _sample(seg.geom)
         x, y = xy_nm(la, lo)
         ax.plot(x, y, color=colors[seg.leg_index % 10], lw=3.0, alpha=0.45,
-                label="designed path (colour = leg)" if k == 0 else None)
+                ls="--" if seg.role == "connector" else "-",
+                label="path flown for (colour = leg)" if k == 0 else None)
+    if any(seg.role == "connector" for seg in path.segments):
+        ax.plot([], [], color="0.5", lw=3.0, alpha=0.45, ls="--",
+                label="direct-to over a discontinuity")
     for j, extra in enumerate(flown_paths):
         for k, seg in enumerate(extra.path.segments):
             la, lo = _sample(seg.geom)
@@ -74,11 +96,8 @@ def plot_ground_track(df, summary, fp, flown_paths=()) -> Figure:
     ax.set_ylabel("north of start, NM")
     ax.set_aspect("equal", adjustable="datalim")
     ax.grid(alpha=0.3)
-    err = summary.get("errors", {})
-    e = err.get("fte", {}).get("all", {})
-    tse = err.get("tse", {}).get("all", {}).get("p95_m")
-    ax.set_title(f"{path.name}: ground track ({summary.get('aircraft', '')}, "
-                 f"FTE95 {e.get('p95_m')} m, max {e.get('max_m')} m; TSE95 {tse} m)")
+    ax.set_title(f"{path.name} ({summary.get('aircraft', '')}): ground track\n"
+                 f"{tse_headline(summary)}", fontsize=10)
     ax.legend(loc="best", fontsize=8)
     fig.tight_layout()
     return fig
@@ -138,34 +157,56 @@ def plot_vertical(df, summary, fp) -> Figure:
 
 
 def plot_errors(df, summary, fp) -> Figure:
-    """FTE, TSE, NSE and PDE (m) along the path, leg boundaries labelled, RNP stated."""
-    fig, ax = subplots(figsize=(10, 5))
+    """The flight errors along the path, m, in three panels with their own axes: TSE (the true
+    position's cross-track from the path, ± RNP and ± 2 RNP drawn), FTE (the navigation
+    solution's cross-track from the path: what guidance flies), and the two distances that
+    are no cross-track — NSE (navigation vs truth) and PDE (built vs coded path). Leg
+    boundaries labelled; TSE and the RNP verdict in the title."""
+    fig, (ax_t, ax_f, ax_n) = subplots(3, 1, figsize=(10, 8), sharex=True,
+                                       gridspec_kw={"height_ratios": [2, 1.3, 1.3]})
     s_nm = df["along_m"].to_numpy() / NM_M
     fte = df["fte_m"] if "fte_m" in df else df["nav_xtk_m"]
     tse = df["tse_m"] if "tse_m" in df else df["xtk_m"]
-    ax.plot(s_nm, fte, lw=1.0, label="FTE (navigation vs path), m")
-    ax.plot(s_nm, tse, lw=1.0, label="TSE (truth vs path), m")
+    ax_t.plot(s_nm, tse, lw=1.0, color="crimson", label="TSE: true position's cross-track, m")
+    t = tse.to_numpy(dtype=float)
+    lim = max(1.3 * np.nanmax(np.abs(t)) if np.isfinite(t).any() else 0.0, 20.0)
+    if "rnp_m" in df and np.isfinite(df["rnp_m"]).any():
+        rnp = df["rnp_m"].to_numpy()
+        shown = np.nanmin(rnp) <= lim
+        for k, (lab, ls) in enumerate((("± RNP", "--"), ("± 2 RNP", ":"))):
+            for sgn in (1, -1):
+                ax_t.plot(s_nm, sgn * (k + 1) * rnp, color="k", lw=0.8, ls=ls,
+                          label=lab if sgn > 0 and shown else None)
+        if not shown:   # zoomed on the error: say where the RNP limit is
+            ax_t.plot([], [], color="k", lw=0.8, ls="--",
+                      label=f"± RNP = ± {np.nanmin(rnp):.0f} m (off this scale)")
+    ax_t.set_ylim(-lim, lim)
     if "heading_leg" in df and (df["heading_leg"] == 1).any():
-        ax.plot(s_nm, df["xtk_m"].where(df["heading_leg"] == 1), lw=0.8, color="gray",
-                label="heading legs: drift from the calm-air line (no defined path), m")
+        ax_t.plot(s_nm, df["xtk_m"].where(df["heading_leg"] == 1), lw=0.8, color="gray",
+                  label="heading legs: offset from the planned track (no defined path)")
+    ax_f.plot(s_nm, fte, lw=1.0, color="C0", label="FTE: navigation cross-track, m")
     if "nse_m" in df:
-        ax.plot(s_nm, df["nse_m"], lw=0.8, label="NSE (navigation vs truth), m")
+        ax_n.plot(s_nm, df["nse_m"], lw=1.0, color="C2", label="NSE: |navigation − truth|, m")
     if "pde_m" in df and np.isfinite(df["pde_m"]).any():
-        ax.plot(s_nm, df["pde_m"], lw=0.8, ls=":", label="PDE (built vs coded path), m")
+        ax_n.plot(s_nm, df["pde_m"], lw=1.0, ls=":", color="C4",
+                  label="PDE: |built − coded path|, m")
     legs = df["leg_index"].to_numpy()
     codes = df["leg_code"].to_numpy()
     starts = np.flatnonzero(np.r_[True, legs[1:] != legs[:-1]])
+    for ax in (ax_t, ax_f, ax_n):
+        for i in starts:
+            ax.axvline(s_nm[i], color="k", lw=0.5, alpha=0.3)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="lower right")
     for i in starts:
-        ax.axvline(s_nm[i], color="k", lw=0.5, alpha=0.4)
-        ax.annotate(f"{legs[i] + 1} {codes[i]}", (s_nm[i], 1.0), xycoords=("data", "axes fraction"),
-                    fontsize=7, rotation=90, va="top", ha="right")
-    rnp = summary.get("rnp", {})
-    ax.set_xlabel("distance along the path, NM")
-    ax.set_ylabel("error, m (cross-track: + right of path)")
-    ax.grid(alpha=0.3)
-    ax.set_title(f"{fp.path.name}: flight errors — TSE95 {rnp.get('tse95_m')} m vs RNP "
-                 f"{rnp.get('min_rnp_nm')} NM ({'contained' if rnp.get('contained') else 'NOT contained'})")
-    ax.legend(fontsize=8, loc="lower left")
+        ax_t.annotate(f"{legs[i] + 1} {codes[i]}", (s_nm[i], 1.0),
+                      xycoords=("data", "axes fraction"), fontsize=7, rotation=90, va="top",
+                      ha="right")
+    ax_t.set_ylabel("TSE, m (+ right of path)")
+    ax_f.set_ylabel("FTE, m (+ right)")
+    ax_n.set_ylabel("distance, m")
+    ax_n.set_xlabel("distance along the path, NM")
+    ax_t.set_title(f"{fp.path.name}: flight errors\n{tse_headline(summary)}", fontsize=10)
     fig.tight_layout()
     return fig
 

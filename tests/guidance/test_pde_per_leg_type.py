@@ -69,15 +69,19 @@ def test_tf_pde_is_zero_on_the_track_between_the_fixes(db, perf):
     assert max(scored(p, "TF")) < 0.01
 
 
-def test_cf_pde_is_the_offset_of_the_built_line_from_the_coded_course(tmp_path):
-    """A CF whose coded course is 3° off the bearing from the previous fix is flown straight to
-    the fix (within the builder's 5°): the line from WA is d·sin 3° off the coded course at WA."""
+def test_cf_whose_course_is_3_deg_off_the_fixes_bearing_is_intercepted_not_flown_direct(tmp_path):
+    """A CF whose coded course is 3° off the bearing from the previous fix (d·sin 3° ≈ 1.4 km
+    off at WA) is intercepted: the CF's own straight lies on the coded course (PDE below a
+    metre) and the way onto it is a transition (role 'turn'), instead of a direct line as far
+    off the coded course as the old "within 5°, fly direct" rule built."""
     w = world()
     d, az1, az2 = inverse(*w["WA"], *w["WB"])
     p = build(tmp_path, [app("IF", 10, fix="WA"),
                          app("CF", 20, fix="WB", course_deg=az2 + 3.0)],  # no variation here
               checked=False)
-    assert max(scored(p, "CF")) == pytest.approx(d * math.sin(math.radians(3.0)), rel=2e-3)
+    assert max(scored(p, "CF")) < 1.0
+    assert any(s.role == "turn" for s in p.segments if s.path_term == "CF")
+    assert d * math.sin(math.radians(3.0)) > 1000.0
 
 
 def test_cf_pde_on_a_real_intercepted_course_is_small(db, perf):
@@ -130,13 +134,16 @@ def test_fd_pde_is_zero_on_the_course_from_the_fix(tmp_path):
     assert max(scored(p, "FD")) < 0.01
 
 
-def test_course_from_the_fix_pde_shows_the_offset_after_a_turn_at_the_fix(db, perf):
-    """PAFA HRDNG3 RW20R: the FM turns 46° at HISKA and flies the course from the arc's end, a
-    turn-radius offset R (1 − cos 46°) from the coded course out of HISKA."""
+def test_course_from_the_fix_after_a_turn_at_the_fix_rejoins_the_coded_course(db, perf):
+    """PAFA HRDNG3 RW20R (issue 12): the FM turns ~46° over HISKA. Flown on from the end of
+    that turn its straight lay R (1 − cos Δ) ≈ 1.4 km beside the coded course out of HISKA; it
+    now rejoins the coded course line (intercept + fly-by), so its PDE is that of the course
+    line itself."""
     p = real(db, perf, "PAFA STAR HRDNG3 RW20R")
-    arc = next(s.geom for s in p.segments if s.path_term == "FM" and s.geom.kind == "arc")
-    expect = arc.radius_m * (1.0 - math.cos(math.radians(abs(arc.sweep_deg))))
-    assert max(scored(p, "FM")) == pytest.approx(expect, rel=0.01)
+    turn = next(s.geom for s in p.segments if s.path_term == "FM" and s.geom.kind == "arc")
+    offset_if_parallel = turn.radius_m * (1.0 - math.cos(math.radians(46.0)))
+    assert offset_if_parallel > 1000.0
+    assert max(scored(p, "FM")) < 30.0
 
 
 # --------------------------------------------------------------------------- holds
@@ -156,7 +163,7 @@ def test_hold_circuits_entered_on_the_inbound_course_lie_on_the_racetrack(tmp_pa
                                                                          extra):
     """TF WA -> WN runs due north along the meridian; the hold at WN has inbound course 000."""
     vals = scored(_hold(tmp_path, code, extra, "WN", 0.0), code)
-    assert len(vals) >= 4 and max(vals) < 0.01
+    assert len(vals) >= 4 and max(vals) < 0.05
 
 
 @pytest.mark.parametrize("code, extra", HOLDS)

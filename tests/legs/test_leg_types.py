@@ -62,8 +62,10 @@ def test_tf_fly_by_turn_uses_radius_and_lead_from_speed_and_bank(tmp_path):
     fb = arcs(p, "flyby")
     assert len(fb) == 1
     arc = fb[0].geom
-    # the planned speed is flown as a CAS: its TAS at the leg's planned altitude
-    v = isa_tas_mps(PERF.tas_plan_mps, p.legs[1].end.alt_m)
+    # the planned speed is flown as a CAS — an approach's at most 210 kt (issue 12) — : its
+    # TAS at the leg's planned altitude
+    from fms_testbed.legs.model import APPROACH_CAS_MPS
+    v = isa_tas_mps(min(PERF.tas_plan_mps, APPROACH_CAS_MPS), p.legs[1].end.alt_m)
     assert fb[0].speed_mps == pytest.approx(v, rel=1e-6)
     r_plan = turn_radius_m(v, PARAMS.bank_plan_deg, G)
     assert arc.radius_m == pytest.approx(r_plan, rel=1e-6)
@@ -79,11 +81,16 @@ def test_fly_over_fix_is_passed_then_rejoined(tmp_path):
     c = offset(*w["WB"], 150.0, 15.0)
     p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB", desc="EY  "),
                          app("TF", 30, fix="WC")], extra=[waypoint_record("WC", *c)])
-    assert not arcs(p, "flyby")
+    assert not [a for a in arcs(p, "flyby") if a.leg_index == 1]   # no fly-by at WB
     assert min(dist(s.geom.end, w["WB"]) for s in p.segments) < 0.5   # over the fix
     turn = arcs(p, "turn")[0]
     assert dist(turn.geom.start, w["WB"]) < 0.5 and turn.geom.sweep_deg > 0
     assert dist(end_of(p), c) < 0.5
+    # the track WB-WC is rejoined: the leg's own straight lies on it
+    last = p.segments[-1]
+    mid = last.geom.point_at(0.5 * last.geom.length_m())
+    _, az, _ = inverse(*w["WB"], *c)
+    assert last.role == "leg" and abs(_foot(*w["WB"], az, *mid)[1]) < 1.0
 
 
 def test_cf_intercepts_the_course_and_ends_on_it(tmp_path):
@@ -108,10 +115,13 @@ def test_df_turns_the_coded_way_even_beyond_180(tmp_path):
 
 def test_fa_ends_where_the_climb_reaches_the_altitude(tmp_path):
     p = build(tmp_path, [sid("IF", 10, fix="WB"),
-                         sid("FA", 20, fix="WB", course_deg=90.0, alt_desc="+", alt1_ft=3000)])
+                         sid("FA", 20, fix="WB", course_deg=90.0, alt_desc="+", alt1_ft=6000)])
     grad = PERF.climb_gradient_at(p.legs[1].speed_mps)
     assert p.legs[1].termination.kind == "altitude"
-    assert p.length_m() == pytest.approx((3000 - 35) * FT / grad, abs=1.0)
+    start_alt = p.legs[0].start.alt_m   # joined at WB: climbed from the field at the gradient
+    assert start_alt == pytest.approx(
+        35 * FT + PERF.climb_gradient_at(PERF.tas_plan_mps) * dist(APT, world()["WB"]), abs=0.5)
+    assert p.length_m() == pytest.approx((6000 * FT - start_alt) / grad, abs=1.0)
 
 
 def test_fc_flies_the_coded_distance(tmp_path):
@@ -183,7 +193,8 @@ def test_rf_follows_the_coded_centre_radius_and_direction_beyond_180(tmp_path):
     w = world()
     centre = offset(*w["WB"], 0.0, 2.0)   # WB is on a 2 NM circle about the centre
     c = offset(*centre, 340.0, 2.0)       # 200 deg clockwise from radial 180 -> 20 (340 ccw)
-    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
+    # arriving westbound: the clockwise arc starts tangent at WB (radial 180, track 270)
+    p = build(tmp_path, [app("IF", 10, fix="WE"), app("TF", 20, fix="WB"),
                          app("RF", 30, fix="WC", turn="R", arc_radius_nm=2.0, centre="CTR")],
               extra=[waypoint_record("WC", *c), waypoint_record("CTR", *centre)])
     rf = [s.geom for s in arcs(p) if s.path_term == "RF"][0]
@@ -254,14 +265,28 @@ def test_ha_holds_until_the_altitude_is_reached(tmp_path):
     assert p.legs[1].termination.kind == "altitude"
 
 
-def test_pi_turns_45_the_coded_way_then_180_the_other(tmp_path):
-    p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
-                         app("PI", 30, fix="WB", turn="R", course_deg=270.0, distance_nm=10.0),
+def test_pi_flies_outbound_then_45_to_the_coded_course_then_180_the_coded_way(tmp_path):
+    """ARINC-424 PI (issue 12, class B): col. 71 is the 45° leg's course, col. 44 the 180°
+    turn's direction. Inbound course 090 into WB, outbound 270, coded course 315 and turn L:
+    outbound on 270, a 45° right turn onto 315 (the 45° leg north of the inbound course, away
+    from the coded left turn: the chart's protected side), a 180° left turn onto 135, the 45°
+    intercept of the inbound course, the CF to WB — within the coded 10 NM."""
+    w = world()
+    p = build(tmp_path, [app("IF", 10, fix="WE"), app("TF", 20, fix="WB"),
+                         app("PI", 30, fix="WB", turn="L", course_deg=315.0, distance_nm=10.0),
                          app("CF", 40, fix="WB", course_deg=90.0)])
-    sweeps = [round(s.geom.sweep_deg) for s in p.segments
-              if s.leg_index == 2 and isinstance(s.geom, Arc)]
-    assert 45 in sweeps and -180 in sweeps
-    assert dist(end_of(p), world()["WB"]) < 0.5
+    pi = [s for s in p.segments if s.leg_index == 2]
+    sweeps = [round(s.geom.sweep_deg) for s in pi if isinstance(s.geom, Arc)]
+    assert sweeps == [45, -180]
+    leg45 = [s.geom for s in pi if s.geom.kind == "line"
+             and abs(s.geom.start_course_deg - 315.0) < 1.0]
+    assert leg45 and all(_foot(*w["WB"], 90.0, *g.end)[1] < -1000.0 for g in leg45)  # north
+    assert max(dist(s.geom.point_at(s.geom.length_m() * k / 4), w["WB"])
+               for s in pi for k in range(5)) < 10.0 * NM
+    assert p.legs[2].termination.kind == "intercept"
+    assert dist(end_of(p), w["WB"]) < 0.5
+    cf = [s.geom for s in p.segments if s.leg_index == 3 and s.role == "leg"][-1]
+    assert abs(_foot(*w["WB"], 90.0, *cf.point_at(0.5 * cf.length_m()))[1]) < 1.0
 
 
 def test_fix_leg_reached_from_elsewhere_turns_the_coded_way_to_its_fix(tmp_path):

@@ -59,7 +59,11 @@ def test_branch_V_gamma_slows_down_at_25_deg_bank(tmp_path):
 def test_branch_V_gamma_phi_lambda_flies_over_when_nothing_fits(tmp_path):
     p = _square_turn(tmp_path, 500.0)
     assert "V,γ,φ,λ" in branches(p) and p.status == "corrected"
-    assert not [s for s in p.segments if s.role == "flyby"]
+    # no fly-by at WB: the path passes over it (the rejoin of WB-WC may have its own fly-by)
+    assert not [s for s in p.segments if s.role == "flyby" and s.leg_index == 1]
+    from fms_testbed.core.geodesy import inverse
+    assert min(inverse(*s.geom.end, *world()["WB"])[0] for s in p.segments) < 1.0
+    assert all(s.bank_deg <= 25.0 + 1e-9 for s in p.segments)
 
 
 def _rf(tmp_path, radius_nm, coded_nm=None):

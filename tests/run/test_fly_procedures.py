@@ -112,18 +112,22 @@ def test_ca_leg_ends_when_the_altitude_is_reached_then_df_turns_from_there(db):
 
 
 def test_hold_entry_and_one_circuit_for_hf(db):
-    """KENV RNAV 26 via BVL: the approach transition ends in an HF course reversal (entry
-    plus one racetrack circuit); the flight leaves it over the fix and continues."""
+    """KENV RNAV 26 via BVL: the approach transition ends in an HF course reversal. ARINC-424
+    HF ends at the first crossing of the fix after the entry, so the entry (role 'turn') is the
+    course reversal; it ends over BVL on the inbound course, and the flight continues."""
     res, fp = flown(db, "KENV", "R26", transition="BVL")
     _completed(res)
     df = res.df
     assert "HF" in set(df["leg_code"])
     hf = df[df["leg_code"] == "HF"]
-    assert "hold" in set(hf["seg_role"])
-    # a racetrack: the track turns through at least 360° in the hold
+    # a course reversal: the track turns through at least 180° in the HF
     trk = np.unwrap(np.radians(hf["track_deg"].to_numpy()))
-    assert abs(math.degrees(trk[-1] - trk[0])) >= 300.0 or \
-        math.degrees(trk.max() - trk.min()) >= 300.0
+    assert math.degrees(trk.max() - trk.min()) >= 180.0
+    k = next(lg.index for lg in fp.path.legs if lg.path_term == "HF")
+    last = [sg for sg in fp.path.segments if sg.leg_index == k][-1]
+    from fms_testbed.path.segmentation import resolve_legs
+    inbound = resolve_legs(db, fp.seq)[0][k].course_true_deg
+    assert abs((last.geom.end_course_deg - inbound + 180.0) % 360.0 - 180.0) < 1.0
     assert hf["nav_xtk_m"].abs().max() <= 0.1 * NM
 
 
@@ -239,24 +243,22 @@ def test_pde_is_zero_on_tf_and_the_radius_difference_on_rf(db):
 
 
 def test_ha_hold_is_left_over_the_fix_once_the_altitude_is_reached(db):
-    """KENV ENV1 RW08 ends with HA at BVL (hold to 9000 ft): the aircraft climbs faster than the
-    plan's gradient, so it leaves the hold over BVL at the end of the first circuit completed
-    at the altitude instead of flying every planned circuit."""
+    """KENV ENV1 RW08 ends with HA at BVL (hold to 9000 ft): the aircraft reaches the altitude
+    during the entry, but an HA is left over its fix at the end of a circuit, not of the entry
+    (issue 12: it used to leave right after the entry, no circuit flown)."""
     from fms_testbed.evaluation.flight_errors import _dist_m
 
     res, fp = flown(db, "KENV", "ENV1", runway="08")
     _completed(res)
     ha = fp.path.legs[-1]
     assert ha.path_term == "HA"
-    ev = [e for e in res.summary["guidance_events"] if "HA altitude reached" in e.get("detail", "")]
-    assert len(ev) == 1
+    on_ha = res.df[res.df["leg_index"] == ha.index]
+    assert "turn" in set(on_ha["seg_role"]) and "hold" in set(on_ha["seg_role"])
     end = res.df.iloc[-1]
     assert end["alt_m"] >= ha.termination.alt_m - 50 * FT_M
     assert _dist_m(end["lat_deg"], end["lon_deg"], ha.termination.lat_deg,
                    ha.termination.lon_deg) < 300.0
-    planned_ha_m = sum(s.geom.length_m() for s in fp.path.segments if s.leg_index == ha.index)
-    flown_ha_m = res.df.loc[res.df["leg_index"] == ha.index, "along_m"].agg(np.ptp)
-    assert flown_ha_m < 0.8 * planned_ha_m
+    assert on_ha["nav_xtk_m"].abs().max() <= 0.1 * NM
 
 
 def test_heading_legs_are_left_out_of_the_path_error_statistics(db):
@@ -272,18 +274,30 @@ def test_heading_legs_are_left_out_of_the_path_error_statistics(db):
 
 def test_demo_sid_flies_with_a_finite_pde_on_its_cf_leg():
     """Issue 10: PDE on CF legs raised UnboundLocalError, hidden as NaN by a broad except.
-    DEEZZ5 RW31L (demo-sid.yaml): the VI intercepts the CF course into SKORR, so the CF's own
-    path lies on the coded course line — its PDE is finite and under a metre; the fly-by arc
-    that ends the leg is a transition (NaN)."""
+    DEEZZ5 RW31L (demo-sid.yaml), from the departure end of the runway (issue 12, class D):
+    the VI meets the CF course 971 m out, too close for the 77° fly-by at 230 kt, so the turn
+    is flown over the intercept and the CF flown direct to SKORR — its own path is the line
+    from there, whose PDE is finite and equals its offset from the coded course; the fly-by
+    arc that ends the leg is a transition (NaN)."""
     import fms_testbed
     from pathlib import Path
+    from fms_testbed.legs.construct import _foot
 
     scn = Path(__file__).resolve().parents[2] / "scenarios" / "demo-sid.yaml"
-    df = fms_testbed.run_scenario(scn, out_dir=None).df
+    res = fms_testbed.run_scenario(scn, out_dir=None, plots=False)
+    df = res.df
     cf = df[df["leg_code"] == "CF"]
     own = cf.loc[cf["seg_role"] == "leg", "pde_m"].to_numpy()
     assert own.size > 100 and np.isfinite(own).all()
-    assert 0.0 <= own.max() < 1.0
+    fp = res.procedure.path
+    line = next(s.geom for s in fp.path.segments if s.path_term == "CF" and s.role == "leg")
+    rec = next(lg for lg in fp.path.legs if lg.path_term == "CF")
+    from fms_testbed.path.segmentation import resolve_legs
+    crs = resolve_legs(res.procedure.db, fp.seq)[0][rec.index].course_true_deg
+    t = rec.termination
+    offset = max(abs(_foot(t.lat_deg, t.lon_deg, crs, *line.point_at(line.length_m() * k / 4))[1])
+                 for k in range(5))
+    assert own.max() == pytest.approx(offset, rel=1e-3, abs=0.5)
     assert cf.loc[cf["seg_role"] == "flyby", "pde_m"].isna().all()
 
 

@@ -1,0 +1,173 @@
+"""Issue 12, classes A-I flown closed loop (737, truth navigation): real procedures of the FAA
+cycle 2301 that failed before, and synthetic records where the cycle has no example.
+
+The CIFP is loaded once for the module and each procedure flown once (module cache); the
+module is skipped, with the reason, when the CIFP is not beside the repository. Goals are the
+issue's: FTE95 ≤ 150 m and max FTE ≤ 185 m, coded constraints within 50 ft / 5 kt.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fms_testbed.core.units import FT_M as FT
+from fms_testbed.core.units import NM_M as NM
+from fms_testbed.loop.procedure import prepare
+from fms_testbed.procedures.database import load_database
+from fms_testbed.procedures.synth import leg_record as L
+from fms_testbed.procedures.synth import offset, waypoint_record, write_file
+from fms_testbed.run import fly_procedure
+from tests.path.test_world import base_records, world
+
+CIFP = Path(__file__).resolve().parents[3] / "shared" / "data" / "cifp" / "FAACIFP18_230126"
+FTE95_GOAL_M = 150.0
+FTE_MAX_GOAL_M = 0.1 * NM
+
+
+@pytest.fixture(scope="module")
+def cifp():
+    if not CIFP.exists():
+        pytest.skip(f"the FAA CIFP is not at {CIFP}")
+    return load_database(CIFP)
+
+
+_CACHE: dict = {}
+
+
+def fly(db, airport, procedure, transition=None, runway=None, wind_kt=None, aircraft="737"):
+    key = (id(db), airport, procedure, transition, runway, wind_kt, aircraft)
+    if key not in _CACHE:
+        proc = {"airport": airport, "procedure": procedure}
+        if transition:
+            proc["transition"] = transition
+        if runway:
+            proc["runway"] = runway
+        raw = {"aircraft": aircraft, "procedure": proc}
+        if wind_kt:
+            raw["wind"] = {"from_deg": 270.0, "speed_kt": wind_kt}
+        scn, spec, fp, d = prepare(raw, db=db)
+        _CACHE[key] = (fly_procedure(scn, spec, fp, d, progress=False, plots=False), fp)
+    return _CACHE[key]
+
+
+def within_goals(res):
+    s = res.summary
+    assert s["sequencing"]["completed"], s["reason"]
+    e = s["errors"]["fte"]["all"]
+    assert e["p95_m"] <= FTE95_GOAL_M and e["max_m"] <= FTE_MAX_GOAL_M, e
+    return e
+
+
+def test_A_if_af_approach_flies_the_arc_not_90_deg_off_it(cifp):
+    """12J VOR/DME 30 via ITNEW (IF → AF): FTE95 3.0 km before (start 90° off the arc)."""
+    res, fp = fly(cifp, "12J", "D30", "ITNEW")
+    within_goals(res)
+    af = res.df[res.df["leg_code"] == "AF"]
+    assert len(af) > 100 and af["nav_xtk_m"].abs().max() < 30.0
+    assert res.summary["status"] == "ok", res.summary["reason"]
+
+
+def test_B_procedure_turn_ends_on_the_final_course(cifp):
+    """PAFA VOR 20R via CUN: the PI flown as coded joins the inbound CF on its course (before:
+    refused as impossible, and the PI ~11 km beside the final)."""
+    res, fp = fly(cifp, "PAFA", "S20R", "CUN")
+    within_goals(res)
+    assert res.summary["status"] == "ok", res.summary["reason"]
+    cf = res.df[(res.df["leg_code"] == "CF") & (res.df["seg_role"] == "leg")]
+    assert np.nanmax(cf["pde_m"].to_numpy()) < 50.0
+
+
+def test_C_rf_71_m_off_the_previous_fix_is_flown_without_a_direct_to(tmp_path):
+    """Synthetic: a 3 NM RF whose end fix is 71 m farther from the centre than the previous
+    fix (the cycle has none this large): closed in the geometry, the aircraft stays on the arc
+    (a connector ≥ 50 m used to be flown as a direct-to: 1.8 km outside the RF)."""
+    w = world()
+    centre = offset(*w["WB"], 0.0, 3.0)
+    c = offset(*centre, 90.0, 3.0 + 71.0 / NM)
+    d = offset(*c, 0.0, 8.0)
+
+    def app(pt, seq, **kw):
+        return L("XTST", "R09", pt, seq, proc_type="F", transition="", route_type="R", **kw)
+
+    legs = [app("IF", 10, fix="WA", alt_desc="+", alt1_ft=4000), app("TF", 20, fix="WB"),
+            app("RF", 30, fix="WC", turn="L", centre="CTR", arc_radius_nm=3.0),
+            app("TF", 40, fix="WD")]
+    f = write_file(tmp_path / "c.dat", base_records() + [
+        waypoint_record("WC", *c), waypoint_record("CTR", *centre), waypoint_record("WD", *d)]
+        + legs)
+    db = load_database(f)
+    res, fp = fly(db, "XTST", "R09")
+    e = within_goals(res)
+    rf = res.df[res.df["leg_code"] == "RF"]
+    assert len(rf) > 50 and rf["nav_xtk_m"].abs().max() < 30.0
+    assert not [s for s in fp.path.segments if s.role == "connector"]
+    assert e["max_m"] < 50.0
+
+
+def test_D_sid_with_runway_and_en_route_transition_starts_on_the_runway(cifp):
+    """KCLT KILNS4 RW18C + AUDII: the merged name 'RW18C+AUDII' found its runway: the flight
+    starts 35 ft above the threshold (before: at the VA's altitude)."""
+    res, fp = fly(cifp, "KCLT", "KILNS4", "AUDII", "18C")
+    within_goals(res)
+    rwy = cifp.terminal[("KCLT", "RW18C")][0]
+    assert res.df["alt_m"].iloc[0] == pytest.approx(rwy.elev_m + 35 * FT, abs=15.0)
+    assert res.summary["procedure"]["start"] == "runway"
+
+
+def test_E_direct_to_after_vectors_has_its_fly_by(cifp):
+    """KBCT MYZNR2 RW05: VM, then the direct-to JAVAA 17.7 NM away, then TF CONAS: no
+    overshoot at JAVAA (83-253 m before)."""
+    res, fp = fly(cifp, "KBCT", "MYZNR2", runway="05")
+    within_goals(res)
+    near = res.df[res.df["leg_index"].isin([2, 3])]
+    assert near["nav_xtk_m"].abs().max() < 30.0
+
+
+def test_F_at_or_below_cap_holds_until_its_fix_is_passed(cifp):
+    """KDEN BAYLR6 RW17L: BRKEM at or below 10,000 ft, then higher climbs: crossed 82 ft above
+    before (the climb command was lifted up to ~20 s before the fix)."""
+    res, fp = fly(cifp, "KDEN", "BAYLR6", runway="17L")
+    within_goals(res)
+    brkem = next(c for c in res.summary["constraints"] if c["fix"] == "BRKEM")
+    assert brkem["ok"] and brkem["alt_ft"] <= 10000 + 50
+
+
+def test_G_descent_meets_the_coded_final_path(cifp):
+    """PAFA VOR 20R via CUN: refused before (the planner stayed high: 16.2 %); now every coded
+    constraint is met, the MAP ILTAF within 50 ft on the coded 3.26° path."""
+    res, fp = fly(cifp, "PAFA", "S20R", "CUN")
+    assert res.summary["constraints_met"], [c for c in res.summary["constraints"]
+                                            if c.get("ok") is False]
+    iltaf = next(c for c in res.summary["constraints"] if c["fix"] == "ILTAF")
+    assert abs(iltaf["alt_ft"] - 748) <= 50
+
+
+def test_H_sid_joined_at_a_fix_flies_its_climb_constraints(cifp):
+    """3R9 AEROZ2 via SJT without a runway: the common route starts at AMUSE (+5,000 ft); the
+    flight starts there at a climb altitude, meets every constraint and reports ok."""
+    res, fp = fly(cifp, "3R9", "AEROZ2", "SJT")
+    within_goals(res)
+    assert res.summary["status"] == "ok", res.summary["reason"]
+    assert res.df["alt_m"].iloc[0] >= 5000 * FT - 50 * FT
+
+
+@pytest.mark.parametrize("wind_kt", [0, 30])
+def test_I_hold_to_altitude_stays_within_the_goal_in_wind(cifp, wind_kt):
+    """KENV ENV1 RW08 ends in an HA at BVL: its turns are planned for the ground speed and the
+    heading legs for their drift, so in a 30 kt wind the hold's max FTE stays within the goal
+    (293 m at the 25° bank limit before)."""
+    res, fp = fly(cifp, "KENV", "ENV1", runway="08", wind_kt=wind_kt or None)
+    e = within_goals(res)
+    ha = res.df[res.df["leg_code"] == "HA"]
+    assert ha["nav_xtk_m"].abs().max() < 50.0
+    assert res.df["bank_deg"].abs().max() < 25.5 if "bank_deg" in res.df else e
+
+
+def test_I_heading_legs_drift_is_predicted_in_wind(cifp):
+    """KBCT MYZNR2 RW05 in a 30 kt wind: the VA/VM headings drift; planned for the drift, the
+    direct-to after them starts where the aircraft is (FTE95 608 m before)."""
+    res, fp = fly(cifp, "KBCT", "MYZNR2", runway="05", wind_kt=30)
+    within_goals(res)
