@@ -198,25 +198,32 @@ def _too_sharp(b: LegBuilder, s: FlightState, arc: Arc) -> bool:
 
 def _join_arc_ahead(b: LegBuilder, s: FlightState, arc: Arc, f) -> FlightState:
     """Enter a coded arc whose start corner is too sharp (class 1: the planned radius does not
-    fit): over its start, a direct-to (role 'turn') to the point Q :data:`ARC_JOIN_DEG` round
-    the arc, then a fly-by onto the arc there (the chord meets it at half that angle) and the
-    rest of the arc to the fix. A finding says so."""
-    theta = min(ARC_JOIN_DEG, 0.6 * abs(arc.sweep_deg))
-    rad_q = arc.start_radial_deg + math.copysign(theta, arc.sweep_deg)
-    qlat, qlon, _ = direct(arc.centre_lat_deg, arc.centre_lon_deg, rad_q, arc.radius_m)
+    fit): over its start, a direct-to (role 'turn') to a point Q round the arc, then a fly-by
+    onto the arc there and the rest of the arc to the fix. Q is tried at
+    :data:`ARC_JOIN_DEG`, then 30° steps further round (at most 80 % of the sweep), until the
+    corner at Q, as the direct-to arrives there, fits its fly-by. A finding says so."""
+    n0 = len(b.segments)
+    theta, st, rest = 0.0, s, arc
+    for theta in (ARC_JOIN_DEG, 90.0, 120.0, 150.0):
+        theta = min(theta, 0.8 * abs(arc.sweep_deg))
+        del b.segments[n0:]
+        rad_q = arc.start_radial_deg + math.copysign(theta, arc.sweep_deg)
+        qlat, qlon, _ = direct(arc.centre_lat_deg, arc.centre_lon_deg, rad_q, arc.radius_m)
+        target = Fix(ident="", region="", section="", lat_deg=qlat, lon_deg=qlon)
+        st = b.direct_to(replace(s, flyby=False), target, None, True)
+        rest = Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, rad_q,
+                   arc.sweep_deg - math.copysign(theta, arc.sweep_deg))
+        if not _too_sharp(b, replace(st, flyby=True), rest) or \
+                theta >= 0.8 * abs(arc.sweep_deg):
+            break
     b.finding("info", f"{b.leg.pt} entered {abs(wrap180(arc.start_course_deg - s.track_deg)):.0f}"
               f"° off its tangent: too sharp for a fly-by at {b.radius_m:.0f} m; the arc is "
               f"joined {theta:.0f}° round it")
-    n0 = len(b.segments)
-    target = Fix(ident="", region="", section="", lat_deg=qlat, lon_deg=qlon)
-    s = b.direct_to(replace(s, flyby=False), target, None, True)
     b.as_transition(n0)
-    rest = Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, rad_q,
-               arc.sweep_deg - math.copysign(theta, arc.sweep_deg))
-    s = replace(s, flyby=True)
-    _corner_onto(b, s, rest)
-    s = b.arc(s, rest, role="leg")
-    return b.fix_state(replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
+    st = replace(st, flyby=True)
+    _corner_onto(b, st, rest)
+    st = b.arc(st, rest, role="leg")
+    return b.fix_state(replace(st, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
 
 
 class RF(Leg):

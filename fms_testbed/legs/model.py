@@ -280,26 +280,18 @@ def drift_track_deg(heading_deg: float, tas_mps: float, wind_speed_mps: float,
 
 
 APPROACH_CAS_MPS = 210 * KT_MPS
-"""CAS an approach is planned at up to its final approach fix (the usual initial/intermediate
-approach speed), m/s."""
-FINAL_CAS_FACTOR = 1.15
-"""From the final approach fix on, an approach is planned at this multiple of the aircraft's
-minimum clean CAS (no flaps are modelled yet: the slowest clean speed the laws fly)."""
+"""CAS an approach is planned at, at most (the usual initial/intermediate approach speed; no
+flaps are modelled yet, so the final is flown clean at it too), m/s."""
 
 
 def approach_cas_caps(records, proc_type: str, cas_min_mps: float) -> list[float | None]:
-    """Planned CAS cap per leg of a procedure, m/s (None: no cap): approaches (``proc_type``
-    'F') at :data:`APPROACH_CAS_MPS` up to and including the leg that ends at the final
-    approach fix (waypoint description col. 43 'F'), at :data:`FINAL_CAS_FACTOR` × the minimum
-    clean CAS after it; other procedures uncapped. The builder plans turn radii for these
-    speeds and guidance flies them (decelerating before the fix where they start)."""
-    out: list[float | None] = []
-    final = False
-    for r in records:
-        if proc_type != "F":
-            out.append(None)
-            continue
-        out.append(max(FINAL_CAS_FACTOR * cas_min_mps, 1.0) if final else APPROACH_CAS_MPS)
-        if r.desc[3:4] == "F":
-            final = True
-    return out
+    """Planned CAS cap per leg of a procedure, m/s (None: no cap): every leg of an approach
+    (``proc_type`` 'F') at :data:`APPROACH_CAS_MPS` (never below 1.15 × the minimum clean CAS
+    ``cas_min_mps``), other procedures uncapped. The builder plans turn radii for it and
+    guidance flies it (decelerating before the first fix where it applies). A slower final at
+    the approach speed needs the flap and gear model (not modelled): slowing clean to the
+    minimum clean speed on the glide path leaves the aircraft high and, for the Global 5000,
+    at its stall angle of attack (measured with the flight table)."""
+    if proc_type != "F":
+        return [None] * len(records)
+    return [max(APPROACH_CAS_MPS, 1.15 * cas_min_mps)] * len(records)

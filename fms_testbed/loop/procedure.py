@@ -34,6 +34,7 @@ from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.guidance.vertical import cas_band, planned_limits, tas_target_mps
 from fms_testbed.guidance.lateral import LateralGains, anticipation_m
 from fms_testbed.core.geodesy import direct
+from fms_testbed.core.units import G0_MPS2
 
 OUTER_RATE_HZ = 10.0
 """Rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS runs
@@ -130,10 +131,15 @@ def prepare(raw: dict, source: str = "<scenario>", db=None
     if db is None:
         base = Path(source).parent if source and not source.startswith("<") else None
         db = load_db(spec.db, base)
-    fp = build_procedure(db, spec, cfg, wind=planned_wind(raw.get("wind"), source))
+    wind = planned_wind(raw.get("wind"), source)
+    fp = build_procedure(db, spec, cfg, wind=wind)
     raw.setdefault("initial", initial_from_path(fp, cfg))
-    raw.setdefault("duration_s", min(6 * 3600.0, 1.6 * fp.path.length_m()
-                                     / cfg.limits.climb_tas_mps + 120.0))
+    v_min = max(cfg.limits.climb_tas_mps - (wind[0] if wind else 0.0),
+                0.5 * cfg.limits.climb_tas_mps)   # into the wind
+    # + two full turns: a path rebuilt in flight after a conditional leg may loop back
+    r_turn = cfg.limits.climb_tas_mps ** 2 / (G0_MPS2 * math.tan(math.radians(20.0)))
+    raw.setdefault("duration_s", min(6 * 3600.0, (1.6 * fp.path.length_m()
+                                                  + 4.0 * math.pi * r_turn) / v_min + 120.0))
     raw.setdefault("name", f"{spec.airport}-{spec.procedure}".lower())
     raw.setdefault("outer_rate_hz", OUTER_RATE_HZ)
     raw["procedure"] = spec.model_dump(exclude_none=True)

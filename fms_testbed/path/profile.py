@@ -105,6 +105,25 @@ def descent_cap_margin_m(lo_m: float | None, hi_m: float) -> float:
     return min(0.25 * max(hi_m - lo_m, 0.0), DESCENT_CAP_MARGIN_M)
 
 
+def arrival_join_alt_m(path: ProcedurePath, descent_angle_deg: float = 3.0) -> float | None:
+    """Highest altitude an arrival (STAR, approach) should start at: the descent path planned
+    back from its last constraint (the coded angles, else ``descent_angle_deg``, inside every
+    window) at its first fix, raised to that fix's own 'at or above', m (None: fewer than two
+    legs). Its first coded altitude may be an 'at or below' far above what the aircraft can
+    lose before the next fixes."""
+    if len(path.legs) < 2:
+        return None
+    st0 = path.legs[0].start.alt_m
+    prof = plan_profile(path, 0.0, st0, descent_angle_deg, descent_gradient_max=1e3)
+    vpa = path.legs[1].record.vpa_deg
+    ang = abs(vpa) if vpa else descent_angle_deg
+    back = float(prof.alt_m[2]) + math.tan(math.radians(ang)) * float(
+        prof.along_m[2] - prof.along_m[1])
+    r0 = path.legs[0].record
+    lo, _ = window(r0.alt_desc, r0.alt1_m, r0.alt2_m)
+    return max(back, lo) if lo is not None else back
+
+
 def sid_join_required_alt_m(path: ProcedurePath, climb_gradient: float) -> float | None:
     """Lowest altitude at which a SID joined at its first fix (not from the runway) must be
     there to make every 'at or above' climb constraint at ``climb_gradient``: the largest

@@ -24,6 +24,7 @@ from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
+from fms_testbed.path.profile import arrival_join_alt_m
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
@@ -180,6 +181,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     try:
         state = start or start_state(db, seq, legs, perf)
         kind = "given" if start else _start_kind(db, seq, legs, state)
+        state0 = state
     except LegError as exc:
         return replace(path, findings=path.findings + (Finding(-1, "impossible", str(exc)),))
     ref = legs[0].fix or db.airports.get(seq.airport)
@@ -216,8 +218,16 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     segs = round_corners(b, perf, params, bank)
     built = _attach_segments(built, segs)
     status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
-    return replace(path, legs=tuple(built), segments=tuple(segs),
-                   findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
+    out = replace(path, legs=tuple(built), segments=tuple(segs),
+                  findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
+    if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
+        # an arrival starts on the descent path planned back from its last constraint, not
+        # above it at its first coded altitude (an 'at or below' far above the next fixes)
+        alt = arrival_join_alt_m(out, params.descent_angle_deg)
+        if alt is not None and alt < state0.alt_m - 30.0:
+            again = build_sequence(db, seq, perf, params, start=replace(state0, alt_m=alt))
+            return replace(again, start_kind=kind)
+    return out
 
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
