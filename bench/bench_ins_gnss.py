@@ -11,12 +11,28 @@ prints NSE95 with GNSS, NSE max and ANP max in the outage, TSE95, FTE max and lo
 the times to the first detection and exclusion and the output's NSE max after it. ``false-alarms``
 flies fault-free one-hour runs of a random manoeuvre profile (profile seed 0) and prints every
 identification event.
+
+    python bench/bench_ins_gnss.py speed [--sim-s 480] [--md ins_gnss_speed.md]
+
+``speed`` times the three-INS navigation step (``InsGnssNavigation.update`` at 10 Hz on the
+synthetic profile of ``faults``) with the fast paths (shared truth-model discretisation, one
+compiled prediction for the three filters, compiled raw-sensor errors) and with the per-unit
+paths, interleaved in chunks of 10 s simulated in one process (the machine is shared and noisy:
+only the ratio is robust), and writes ``docs/results/ins_gnss_speed.md``.
+
+    python bench/bench_ins_gnss.py montecarlo --from DIR [DIR ...] [--md montecarlo.md]
+
+``montecarlo`` turns the tables of ``fms-testbed montecarlo --out DIR`` runs (``montecarlo.csv``
+and the command in ``run.json``) into ``docs/results/montecarlo.md``.
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
+import sys
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -86,6 +102,91 @@ def false_alarms(n_runs: int, first_seed: int) -> None:
               [(e["t_s"], e["unit"], e["kind"], e["reason"][:50]) for e in nav.events], flush=True)
 
 
+def speed(sim_s: float, md: str) -> None:
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import report
+
+    segs = [Segment(120), Segment(60, 3), Segment(120), Segment(60, -3), Segment(120)]
+    states = aircraft_states(fly_profile(segs, dt_s=0.1))
+    states = [s for s in states if s.t_s <= sim_s + 1e-9]
+    navs = {}
+    for mode in ("per-unit", "fast"):
+        nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=1)
+        nav.fused = nav.bank.share = mode == "fast"
+        navs[mode] = nav
+    spent = {m: [] for m in navs}
+    chunk = 100                                       # 10 s simulated at 10 Hz
+    for k in range(0, len(states), chunk):
+        order = list(navs) if (k // chunk) % 2 == 0 else list(navs)[::-1]
+        for m in order:
+            t0 = time.perf_counter()
+            for s in states[k:k + chunk]:
+                navs[m].update(s)
+            if k > 0:                                 # first chunk: compilation and warm-up
+                spent[m].append((time.perf_counter() - t0) / len(states[k:k + chunk]))
+    us = {m: 1e6 * sum(v) / len(v) for m, v in spent.items()}
+    ratio = [a / b for a, b in zip(spent["fast"], spent["per-unit"])]
+    print(f"three-INS navigation step, {len(states) - chunk} steps timed: fast {us['fast']:.0f} µs,"
+          f" per-unit {us['per-unit']:.0f} µs, ratio fast/per-unit median "
+          f"{statistics.median(ratio):.2f}")
+    rows = [["fast paths (default)", f"**{us['fast']:.0f}**", f"{statistics.median(ratio):.2f}",
+             "≤ 100"],
+            ["per-unit paths (reference)", f"{us['per-unit']:.0f}", "1", "–"]]
+    report.write(md, report.table(["three-INS step (3 INS, 3 filters, identification)",
+                                   "µs per step (mean)", "ratio to per-unit, median over chunks",
+                                   "goal µs"], rows),
+                 note=f"STIM300 ×3, GNSS 1 Hz, baro, 10 Hz, synthetic profile (straight, ±3 °/s "
+                      f"turns) {sim_s:.0f} s, the two configurations interleaved in 10 s chunks "
+                      "in one process (first chunk unmeasured).")
+
+
+def montecarlo_table(dirs: list[str], md: str) -> None:
+    import json
+
+    import pandas as pd
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import report
+
+    ff_rows, f_rows, cmds = [], [], []
+    for d in dirs:
+        run = json.loads((Path(d) / "run.json").read_text())
+        cmds.append("`" + " ".join(a for a in run["command"] if a != "--overwrite") + "`")
+        summ = json.loads((Path(d) / "summary.json").read_text())
+        df = pd.read_csv(Path(d) / "montecarlo.csv")
+        for _, r in df.iterrows():
+            cell = lambda v, f="{:.1f}": "–" if pd.isna(v) else f.format(v)  # noqa: E731
+            if r["phase"] == "fault-free":
+                ff_rows.append([f"{int(r['runs'])} × {r['duration_s'] / 60:.0f} min "
+                                f"({summ['trajectory']})", f"**{int(r['false_exclusions'])}**",
+                                f"{r['false_exclusion_rate_upper95_per_h']:.2e}",
+                                int(r["false_detections"]), cell(r["nse95_gnss_m"], "{:.2f}"),
+                                cell(r.get("nse95_coast_m"), "{:.0f}"),
+                                cell(r.get("outage_nse_max_p95_m"), "{:.0f}"),
+                                cell(r.get("outage_nse_within_rnp"), "{:.4f}"),
+                                cell(r.get("outage_anp_within_rnp"), "{:.4f}"),
+                                f"{r['wall_s']:.0f}"])
+            else:
+                f_rows.append([r["phase"], int(r["runs"]), f"{100 * r['excluded_frac']:.0f} %",
+                               f"{100 * r['missed_detection_rate']:.0f} %",
+                               int(r["wrong_exclusions"]), cell(r["ttd_median_s"]),
+                               cell(r["ttd_p95_s"]), cell(r["tte_median_s"]),
+                               cell(r["tte_p95_s"]), cell(r["nse_max_p95_m"], "{:.2f}")])
+    body = ""
+    if ff_rows:
+        body += report.table(["fault-free runs", "false exclusions",
+                              "false-exclusion rate, 95 % upper bound, 1/h",
+                              "stage-1 detections", "NSE95 with GNSS, m", "NSE95 coasting, m",
+                              "NSE max in outage, p95 over runs, m", "outage samples NSE ≤ RNP",
+                              "outage samples ANP ≤ RNP", "wall s"], ff_rows) + "\n\n"
+    if f_rows:
+        body += report.table(["fault on INS 2 at 200 s", "runs", "faulty unit excluded",
+                              "missed", "healthy unit excluded", "time to detect, median s",
+                              "p95 s", "time to exclude, median s", "p95 s",
+                              "NSE max, p95 over runs, m"], f_rows)
+    report.write(md, body, note="From " + "; ".join(cmds) + " (the CLI's `montecarlo.csv`).")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     sub = ap.add_subparsers(dest="what", required=True)
@@ -94,8 +195,18 @@ def main() -> None:
     fa = sub.add_parser("false-alarms")
     fa.add_argument("--runs", type=int, default=10)
     fa.add_argument("--first-seed", type=int, default=200)
+    sp = sub.add_parser("speed")
+    sp.add_argument("--sim-s", type=float, default=480.0)
+    sp.add_argument("--md", default="ins_gnss_speed.md", help="docs/results table ('' to skip)")
+    mp = sub.add_parser("montecarlo")
+    mp.add_argument("--from", dest="dirs", nargs="+", required=True)
+    mp.add_argument("--md", default="montecarlo.md", help="docs/results table ('' to skip)")
     a = ap.parse_args()
-    if a.what == "approach":
+    if a.what == "montecarlo":
+        montecarlo_table(a.dirs, a.md)
+    elif a.what == "speed":
+        speed(a.sim_s, a.md)
+    elif a.what == "approach":
         approach(a.seeds)
     elif a.what == "faults":
         faults(a.seeds)

@@ -24,6 +24,7 @@ MODULES = [
     "procedures.index", "campaign.cases", "campaign.conditions", "campaign.rows",
     "campaign.worker", "campaign.executors", "campaign.store", "campaign.runner",
     "campaign.diff", "campaign.report", "campaign.figures", "cli.regress",
+    "procedures.testdb", "campaign.manifest",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")

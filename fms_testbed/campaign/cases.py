@@ -96,6 +96,8 @@ class Case:
             proc["runway"] = self.runway
         if self.transition:
             proc["transition"] = self.transition
+        if self.conditions.missed and self.type == "APPROACH":
+            proc["missed"] = True
         return {"name": f"{self.airport}-{self.procedure}-{self.case_id}".lower(),
                 "aircraft": self.aircraft, "procedure": proc, **self.conditions.overrides()}
 

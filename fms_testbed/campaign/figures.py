@@ -37,7 +37,8 @@ def _stacked(counts: pd.DataFrame, title: str, ylabel: str, height: float) -> Fi
     ax.set_xlabel("cases")
     ax.set_ylabel(ylabel)
     ax.set_title(title)
-    ax.legend(fontsize=8, loc="lower right", ncols=2)
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.01, 1.0), title="status",
+              title_fontsize=8)
     ax.grid(axis="x", alpha=0.3)
     fig.tight_layout()
     return fig

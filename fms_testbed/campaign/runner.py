@@ -59,7 +59,8 @@ class RunConfig:
     progress : progress bar (None: on a terminal)
     command : the command line recorded in ``run.json`` (default ``sys.argv``)
     cache_dir : database index cache folder (None: the default)
-    phase : Danilin phase label for the report (None: inferred from the run's size)
+    phase : Danilin phase, ``test-db`` or ``integration`` (None: inferred,
+        :func:`phase_label`)
     batch_rows, batch_s : rows per part file, longest a row waits in memory (s)
     """
 
@@ -126,6 +127,8 @@ def plan(cfg: RunConfig) -> tuple[DatabaseIndex, list[str], list[Case]]:
         raise UserError(f"--batch-rows {cfg.batch_rows}: must be at least 1")
     if cfg.case_timeout_s is not None and not cfg.case_timeout_s > 0:
         raise UserError(f"--case-timeout {cfg.case_timeout_s:g}: must be > 0 s")
+    if cfg.phase is not None:
+        phase_label(cfg.phase, 0, 0, 0, False)      # a bad --phase is refused before flying
     check_sources(cfg.conditions)
     aircraft = aircraft_files(cfg.aircraft)
     index = load_index(cfg.db, cfg.cache_dir)
@@ -149,6 +152,33 @@ def case_set_sha256(cases: list[Case]) -> str:
     return hashlib.sha256("\n".join(sorted(c.case_id for c in cases)).encode()).hexdigest()
 
 
+PHASES = {"test-db": "test database", "integration": "integration"}
+"""``--phase`` values → the phase label ``run.json`` records (Danilin's phases)."""
+
+
+def phase_label(given: str | None, n_airports: int, n_cases: int, n_procedures: int,
+                has_manifest: bool) -> str:
+    """The phase ``run.json`` records: ``--phase`` when given (``test-db`` or
+    ``integration``; the labels themselves are accepted too), else inferred: 'test database'
+    when the database has a test-database manifest, else :func:`infer_phase`.
+
+    Parameters
+    ----------
+    given : the ``--phase`` value (None: infer)
+    n_airports, n_cases, n_procedures : the run's size
+    has_manifest : the database has a manifest of its own (:mod:`.manifest`)
+    """
+    if given is not None:
+        if given in PHASES:
+            return PHASES[given]
+        if given in PHASES.values():
+            return given
+        raise UserError(f"--phase {given!r}: expected one of {', '.join(PHASES)}")
+    if has_manifest:
+        return "test database"
+    return infer_phase(n_airports, n_cases, n_procedures)
+
+
 def infer_phase(n_airports: int, n_cases: int, n_procedures: int) -> str:
     """Danilin's phase a run's size corresponds to: 'integration' (≥ 100 airports and ≥ 5,000
     flights), 'test database' (≤ 100 procedures), else 'between phases'.
@@ -162,6 +192,33 @@ def infer_phase(n_airports: int, n_cases: int, n_procedures: int) -> str:
     if n_procedures <= 100:
         return "test database"
     return "between phases"
+
+
+def manifest_record(index: DatabaseIndex) -> dict | None:
+    """``run.json``'s ``manifest`` entry: the test-database manifest beside the database
+    (``FILE.manifest.json``) when it names this very file (its SHA-256), else None.
+
+    Parameters
+    ----------
+    index : the run's database index
+    """
+    import json
+
+    from fms_testbed.campaign.manifest import MANIFEST_KIND
+
+    path = Path(str(index.path) + ".manifest.json")
+    if not path.is_file():
+        return None
+    raw = path.read_bytes()
+    try:
+        m = json.loads(raw)
+    except ValueError:
+        return None
+    if not isinstance(m, dict) or m.get("kind") != MANIFEST_KIND \
+            or m.get("database_sha256") != index.sha256:
+        return None
+    return {"path": str(path), "sha256": hashlib.sha256(raw).hexdigest(),
+            "cases": len(m.get("procedures", []))}
 
 
 def _status_counts(out: Path) -> Counter:
@@ -211,6 +268,7 @@ def run_campaign(cfg: RunConfig) -> dict:
         done = finished_ids(out)
         todo = [c for c in cases if c.case_id not in done]
         n_proc = len({(c.airport, c.procedure) for c in cases})
+        manifest = manifest_record(index)
         info = {
             "tool": "fms-testbed", "kind": RUN_KIND, "version": _version(),
             "command": cfg.command if cfg.command is not None else sys.argv,
@@ -220,7 +278,9 @@ def run_campaign(cfg: RunConfig) -> dict:
                          "index_load_s": round(index.load_s, 3)},
             "cases": {"count": len(cases), "set_sha256": set_sha, "airports": len(airports),
                       "procedures": n_proc},
-            "phase": cfg.phase or infer_phase(len(airports), len(cases), n_proc),
+            "phase": phase_label(cfg.phase, len(airports), len(cases), n_proc,
+                                 manifest is not None),
+            "manifest": manifest,
             "options": {"airports": airports, "types": [TYPE_NAMES[t] for t in cfg.types],
                         "aircraft": cfg.aircraft,
                         "conditions": [c.canonical() for c in cfg.conditions],
@@ -286,5 +346,6 @@ def _version() -> str:
     return __version__
 
 
-__all__ = ["KEEP", "RUN_KIND", "RunConfig", "case_set_sha256", "infer_phase", "plan",
+__all__ = ["KEEP", "PHASES", "RUN_KIND", "RunConfig", "case_set_sha256", "infer_phase",
+           "manifest_record", "phase_label", "plan",
            "run_campaign", "select_airports"]

@@ -41,6 +41,7 @@ COMMAND_MODULES = (
     "fms_testbed.cli.ins",         # ins
     "fms_testbed.cli.imu_test",     # imu-test
     "fms_testbed.cli.regress",      # regress run / diff / report
+    "fms_testbed.cli.montecarlo",   # montecarlo
 )
 
 

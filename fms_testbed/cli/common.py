@@ -1,4 +1,4 @@
-"""What several commands share: the scenario overrides (``--wind``, ``--nav``, ``--imu``,
+"""What several commands share: the scenario overrides (``--wind``, ``--isa-dev-c``, ``--nav``, ``--imu``,
 ``--aircraft``, ``--rnp``, ``--seed``), given and applied the same way in every command, and the
 printed summary of a flight."""
 
@@ -34,6 +34,26 @@ def parse_wind(text: str) -> dict:
     if unit == "kmh":
         return {"from_deg": d, "speed_mps": s * KMH_MPS}
     return {"from_deg": d, _WIND_UNITS[unit]: s}
+
+
+ISA_DEV_HELP = ("temperature deviation from the ISA, °C, e.g. 15 or -20 (the same at every "
+                "altitude; planned for and flown in JSBSim)")
+
+
+def parse_isa_dev(value) -> float:
+    """``--isa-dev-c`` text → the ISA deviation, °C (−60..60).
+
+    Raises
+    ------
+    UserError : not a number, or out of range
+    """
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise UserError(f"--isa-dev-c {value!r}: expected a number of °C, e.g. 15 or -20") from None
+    if not (math.isfinite(v) and -60.0 <= v <= 60.0):
+        raise UserError(f"--isa-dev-c {value!r}: must be within -60..60 °C")
+    return v
 
 
 def _cell(v) -> str:
@@ -84,6 +104,7 @@ def add_override_options(p, aircraft_default: str | None = None) -> None:
                                                         if aircraft_default else
                                                         " (overrides the scenario's)"))
     p.add_argument("--wind", help=WIND_HELP)
+    p.add_argument("--isa-dev-c", metavar="DEG_C", help=ISA_DEV_HELP)
     p.add_argument("--nav", choices=("truth", "sins", "ins_gnss"),
                    help="navigation source guidance flies on")
     p.add_argument("--imu", help="IMU preset of the INS (with --nav sins or ins_gnss)")
@@ -94,6 +115,9 @@ def add_override_options(p, aircraft_default: str | None = None) -> None:
     p.add_argument("--seed", type=int, default=0,
                    help="seed for turbulence and sensor errors (default 0; a scenario's "
                         "navigation.seed seeds the navigation errors instead)")
+    p.add_argument("--missed", action="store_true",
+                   help="approaches: go around at the MAP and fly the missed approach to its "
+                        "holding fix and one holding circuit (procedure.missed)")
 
 
 def overrides_from_args(args) -> dict:
@@ -103,6 +127,8 @@ def overrides_from_args(args) -> dict:
         out["aircraft"] = args.aircraft
     if getattr(args, "wind", None):
         out["wind"] = parse_wind(args.wind)
+    if getattr(args, "isa_dev_c", None) is not None:
+        out["atmosphere"] = {"isa_dev_c": parse_isa_dev(args.isa_dev_c)}
     nav, imu = getattr(args, "nav", None), getattr(args, "imu", None)
     if nav in ("sins", "ins_gnss"):
         if not imu:
@@ -117,6 +143,8 @@ def overrides_from_args(args) -> dict:
         proc["rnp_nm"] = args.rnp
     if getattr(args, "allow_degraded", False):
         proc["allow_degraded"] = True
+    if getattr(args, "missed", False):
+        proc["missed"] = True
     if proc:
         out["procedure"] = proc
     return out
@@ -149,6 +177,18 @@ def print_results(res) -> None:
         bad = [c for c in s.get("constraints", []) if c.get("ok") is False]
         print(f"  constraints: {len(s.get('constraints', []))} checked, {len(bad)} missed"
               + "".join(f"; leg {c['leg']} {c['fix']}: {c.get('why')}" for c in bad))
+        thr = s.get("threshold")
+        if thr and thr.get("crossed"):
+            def fmt(v, f):
+                return "n/a" if v is None else format(v, f)
+            print(f"  threshold {thr['runway']}: CAS {thr['cas_kt']:.0f} kt (Vapp "
+                  f"{fmt(thr['cas_minus_vapp_kt'], '+.1f')} kt), height {thr['height_ft']:.0f} ft "
+                  f"(TCH {fmt(thr['height_minus_tch_ft'], '+.0f')} ft), path "
+                  f"{fmt(thr['path_angle_deg'], '.2f')} deg (VPA "
+                  f"{fmt(thr['path_angle_minus_vpa_deg'], '+.2f')} deg), "
+                  f"{'configured' if thr['configured'] else 'not configured'}")
+        elif thr:
+            print(f"  threshold {thr['runway']}: {thr.get('reason')}")
         q = s.get("sequencing", {})
         print(f"  sequencing: {q.get('legs_entered')}/{q.get('legs')} legs entered, skipped "
               f"{q.get('skipped')}, repeated {q.get('repeated')}")

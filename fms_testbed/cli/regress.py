@@ -2,18 +2,24 @@
 
     fms-testbed regress run --db FILE [--airports ICAO …] [--sample-airports N --sample-seed S
         [--sample-min-transitions K]] [--types SID,STAR,APPROACH] [--aircraft 737,global5000 …]
-        [--wind FROM_DEG/SPEED_KT …] [--nav truth|sins[:PRESET] …] [--imu PRESET]
+        [--wind FROM_DEG/SPEED_KT …] [--isa-dev-c DEG_C …] [--nav truth|sins[:PRESET] …] [--imu PRESET]
         [--conditions FILE.yaml] [--combinations each|all] [--limit N] [--seed N]
-        [--case-timeout S] [--keep timeseries,plots] (--workers N | --scheduler tcp://HOST:PORT)
-        --out DIR
+        [--case-timeout S] [--keep timeseries,plots] [--phase test-db|integration]
+        (--workers N | --scheduler tcp://HOST:PORT) --out DIR
     fms-testbed regress diff RUN_A RUN_B [--tolerance FILE.yaml] [--markdown FILE.md]
         [--across-conditions]
     fms-testbed regress report DIR [--worst N] [--with OTHER_DIR …]
+    fms-testbed regress testdb --out FILE
+
+``testdb`` writes the phase-1 test database (``procedures/testdb.py``: ~50 synthesised
+procedures, every path terminator) and its manifest ``FILE.manifest.json``; ``regress run --db
+FILE`` flies it (phase ``test database``, inferred from the manifest) and ``regress report``
+checks the outcomes against the manifest.
 
 ``run`` exits 0 once every case is flown (whatever the flights' outcomes: they are the data;
 ``diff`` is the gate), 2 on a user error; re-running the same command resumes. ``diff`` exits 0
-when nothing changed beyond tolerance, 1 otherwise. ``--isa-dev-c`` and ``--missed`` are refused:
-the flight stack does not model them yet.
+when nothing changed beyond tolerance, 1 otherwise. ``--missed`` flies the missed approach of
+every approach case (part of each condition set: it enters the case id).
 """
 
 from __future__ import annotations
@@ -22,7 +28,7 @@ import os
 import sys
 from pathlib import Path
 
-from fms_testbed.cli.common import WIND_HELP, parse_wind
+from fms_testbed.cli.common import WIND_HELP, parse_isa_dev, parse_wind
 from fms_testbed.core.errors import UserError
 
 
@@ -60,20 +66,19 @@ def _navs(values: list[str] | None, imu: str | None) -> list[dict]:
 def config_from_args(args):
     """The :class:`~fms_testbed.campaign.runner.RunConfig` of ``regress run``'s options."""
     from fms_testbed.campaign.cases import parse_types
-    from fms_testbed.campaign.conditions import NOT_YET, command_line_sets, read_conditions
+    from fms_testbed.campaign.conditions import command_line_sets, read_conditions
     from fms_testbed.campaign.runner import RunConfig
 
-    if args.isa_dev_c:
-        raise UserError(f"--isa-dev-c: {NOT_YET['isa_dev_c']}")
-    if args.missed:
-        raise UserError(f"--missed: {NOT_YET['missed']}")
     if args.conditions:
-        if args.wind or args.nav or args.imu:
-            raise UserError("--conditions FILE names the condition sets; --wind/--nav/--imu are "
-                            "not used with it")
+        if args.wind or args.nav or args.imu or args.isa_dev_c or args.missed:
+            raise UserError("--conditions FILE names the condition sets; --wind/--isa-dev-c/"
+                            "--nav/--imu/--missed are not used with it ('missed: true' in a "
+                            "set)")
         sets = read_conditions(args.conditions)
     else:
-        sets = command_line_sets(_winds(args.wind), _navs(args.nav, args.imu))
+        sets = command_line_sets(_winds(args.wind), _navs(args.nav, args.imu),
+                                 [parse_isa_dev(v) for v in args.isa_dev_c or []] or None,
+                                 missed=args.missed)
     if args.sample_airports is None and (args.sample_seed is not None
                                          or args.sample_min_transitions is not None):
         raise UserError("--sample-seed/--sample-min-transitions need --sample-airports N")
@@ -132,6 +137,25 @@ def cmd_report(args) -> int:
     return 0
 
 
+def cmd_testdb(args) -> int:
+    """Write the test database and its manifest."""
+    from fms_testbed.procedures.testdb import PROCEDURES, write_testdb
+
+    out = Path(args.out)
+    if out.is_dir():
+        raise UserError(f"--out {out}: is a folder; give the database file to write")
+    if not out.parent.is_dir():
+        raise UserError(f"--out {out}: folder {out.parent} does not exist")
+    db, man = write_testdb(out)
+    kinds = {k: sum(1 for p in PROCEDURES if p.expect.kind == k) for k in ("fly", "refuse",
+                                                                          "flag")}
+    print(f"wrote {db} ({len(PROCEDURES)} procedures: {kinds['fly']} valid, "
+          f"{kinds['refuse'] + kinds['flag']} miscoded) and {man}")
+    print(f"  fly it: fms-testbed regress run --db {db} --workers 1 --out DIR; then "
+          "fms-testbed regress report DIR")
+    return 0
+
+
 def register(sub) -> None:
     """Add ``regress run|diff|report``."""
     p = sub.add_parser("regress", help="procedure-database regression runs: run, diff, report")
@@ -151,14 +175,16 @@ def register(sub) -> None:
     r.add_argument("--wind", nargs="+", metavar="FROM/SPEED",
                    help=WIND_HELP + "; several give several condition sets; 'calm' for none")
     r.add_argument("--isa-dev-c", nargs="+", metavar="DEG_C",
-                   help="ISA temperature deviation, °C (refused: not modelled yet)")
+                   help="ISA temperature deviations, °C (several give several condition sets; "
+                        "default 0)")
     r.add_argument("--nav", nargs="+", metavar="SOURCE",
                    help="navigation sources: truth, sins, sins:PRESET (default truth)")
     r.add_argument("--imu", help="IMU preset for --nav sins")
     r.add_argument("--conditions", metavar="FILE.yaml",
-                   help="condition sets from a YAML file (instead of --wind/--nav)")
+                   help="condition sets from a YAML file (instead of --wind/--isa-dev-c/--nav)")
     r.add_argument("--missed", action="store_true",
-                   help="fly the missed approach (refused: not flown yet)")
+                   help="approach cases fly their missed approach (go-around at the MAP, "
+                        "one holding circuit)")
     r.add_argument("--combinations", choices=("each", "all"), default="each",
                    help="each: fewest sequences flying every transition once (default); all: "
                         "every runway × en-route/approach transition")
@@ -172,7 +198,9 @@ def register(sub) -> None:
     r.add_argument("--case-timeout", type=float, metavar="S",
                    help="wall-time limit of one case, s")
     r.add_argument("--keep", help="per-case artefacts to keep: timeseries,plots (in DIR/cases)")
-    r.add_argument("--phase", help="Danilin phase label for the report (default: inferred)")
+    r.add_argument("--phase", choices=("test-db", "integration"),
+                   help="Danilin phase of the run for the report (default: test-db when the "
+                        "database has a test-database manifest, else inferred from the size)")
     r.add_argument("--batch-rows", type=int, default=64, metavar="N",
                    help="rows per Parquet part file at most (default 64; a part is also "
                         "written every 15 s)")
@@ -197,6 +225,11 @@ def register(sub) -> None:
     q.add_argument("--no-refly", action="store_true",
                    help="do not re-fly worst cases whose timeseries were not kept")
     q.set_defaults(func=cmd_report)
+
+    t = rs.add_parser("testdb", help="write the phase-1 test database and its manifest")
+    t.add_argument("--out", required=True, metavar="FILE",
+                   help="database file to write (the manifest goes to FILE.manifest.json)")
+    t.set_defaults(func=cmd_testdb)
 
     def _help(args) -> int:
         p.print_help()

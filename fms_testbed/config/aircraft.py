@@ -139,6 +139,88 @@ class CoupledLawGains(_Frozen):
     dH_limit_m: Pos = Field(100.0, description="altitude-error limit (level-change mode), m")
 
 
+class FlapDetent(_Frozen):
+    """One flap detent the approach schedule uses: its name (as the crew calls it), the
+    normalised JSBSim command ``fcs/flap-cmd-norm`` that selects it (the model's own traverse
+    settings), the CAS at or below which it is selected on approach (and above which it is
+    retracted in a go-around), m/s, and its placard (limit) CAS, m/s."""
+
+    name: str
+    cmd_norm: Annotated[float, Field(ge=0, le=1)] = Field(
+        description="JSBSim fcs/flap-cmd-norm selecting this detent")
+    select_cas_mps: Pos = Field(description="selected on approach at or below this CAS, m/s")
+    max_cas_mps: Pos = Field(description="placard (limit) speed of the detent, m/s")
+
+    @model_validator(mode="after")
+    def _select_below_max(self):
+        if self.select_cas_mps > self.max_cas_mps:
+            raise ValueError(f"flap {self.name}: select_cas_mps above max_cas_mps")
+        return self
+
+
+class ApproachSettings(_Frozen):
+    """How the aircraft is slowed and configured for an approach and a go-around.
+
+    Vapp (final approach CAS) is given at a reference mass and scaled with the square root of
+    the mass ratio (stall speed at a given lift coefficient, V ∝ sqrt(m)):
+    ``Vapp(m) = vapp_cas_mps · sqrt(m / mass_ref_kg)``. ``source`` says where the numbers come
+    from.
+    """
+
+    vapp_cas_mps: Pos = Field(description="final approach CAS at mass_ref_kg (Vref + additive), m/s")
+    mass_ref_kg: Pos = Field(description="mass Vapp is given at, kg")
+    flaps: list[FlapDetent] = Field(min_length=1, description="detents used, retracted to "
+                                                               "landing (first: flaps up)")
+    landing_flap: str = Field(description="name of the landing detent")
+    go_around_flap: str = Field(description="name of the go-around detent")
+    gear_with_flap: str | None = Field(None, description="the gear goes down with this detent "
+                                                          "(None: fixed gear)")
+    gear_down_height_m: Pos | None = Field(
+        None, description="the gear goes down at the latest at this height above the runway, m "
+                          "(None: fixed gear)")
+    decel_mps2: Pos = Field(0.25, description="deceleration planned on approach (TAS), m/s²")
+    go_around_add_cas_mps: NonNeg = Field(
+        5.0, description="the go-around climbs at Vapp plus this until the acceleration "
+                         "height, m/s")
+    acceleration_height_m: Pos = Field(
+        300.0, description="height above the runway where a go-around accelerates and "
+                           "cleans up, m")
+    source: str = Field(description="where the speeds come from")
+
+    @model_validator(mode="after")
+    def _names(self):
+        names = [f.name for f in self.flaps]
+        for key in ("landing_flap", "go_around_flap", "gear_with_flap"):
+            v = getattr(self, key)
+            if v is not None and v not in names:
+                raise ValueError(f"{key} {v!r} is not one of the flaps {names}")
+        cmds = [f.cmd_norm for f in self.flaps]
+        sel = [f.select_cas_mps for f in self.flaps]
+        if cmds != sorted(cmds) or sel != sorted(sel, reverse=True):
+            raise ValueError("flaps must be listed from up to landing: cmd_norm increasing, "
+                             "select_cas_mps decreasing")
+        if (self.gear_with_flap is None) != (self.gear_down_height_m is None):
+            raise ValueError("gear_with_flap and gear_down_height_m go together (both null: "
+                             "fixed gear)")
+        return self
+
+    @property
+    def fixed_gear(self) -> bool:
+        """True when the gear is not retractable."""
+        return self.gear_with_flap is None
+
+    def index(self, name: str) -> int:
+        """Position of detent ``name`` in :attr:`flaps`."""
+        return [f.name for f in self.flaps].index(name)
+
+    def vapp_cas_mps_at(self, mass_kg: float | None) -> float:
+        """Final approach CAS at mass ``mass_kg`` (kg; None: the reference mass), m/s:
+        ``vapp_cas_mps · sqrt(mass_kg / mass_ref_kg)``."""
+        if mass_kg is None or not mass_kg > 0:
+            return self.vapp_cas_mps
+        return self.vapp_cas_mps * (mass_kg / self.mass_ref_kg) ** 0.5
+
+
 class AircraftConfig(_Frozen):
     """One aircraft: the JSBSim model plus everything the testbed needs to fly it."""
 
@@ -154,6 +236,9 @@ class AircraftConfig(_Frozen):
     inner_loops: InnerLoopGains
     inner_spec: InnerLoopSpec = Field(default_factory=InnerLoopSpec)
     coupled_law: CoupledLawGains | None = None
+    approach: ApproachSettings | None = Field(
+        None, description="approach speeds and configuration (None: flown clean at the "
+                          "planned approach speed)")
     source_file: str = ""
 
 

@@ -160,7 +160,51 @@ class InsGnssBlock(BaseModel):
                           "2 s, within the 10 s time to alert of terminal/approach)")
 
 
-NavigationBlock = Annotated[Union[TruthBlock, SinsBlock, InsGnssBlock],
+_Ang3 = Annotated[list[Annotated[float, Field(ge=0, le=90)]], Field(min_length=3, max_length=3)]
+"""Three values roll, pitch, heading (a YAML list)."""
+_Val3 = Annotated[list[Annotated[float, Field(ge=-360, le=360)]], Field(min_length=3, max_length=3)]
+
+
+class ReferenceErrorBlock(BaseModel):
+    """Error model of the attitude reference under test (roll, pitch, heading; 1σ): constant
+    errors plus drift (seed 004), optional random walks; the injected values are drawn from
+    the σ by the seed unless ``bias_deg`` / ``drift_dph`` give them."""
+
+    model_config = _FINITE
+    bias_sigma_deg: _Ang3 = Field([0.1, 0.1, 0.5], description="σ of the constant errors, deg")
+    drift_sigma_dph: _Ang3 = Field([0.5, 0.5, 1.0], description="σ of the drift rates, deg/h")
+    arw_deg_rh: _Ang3 = Field([0.003, 0.003, 0.003],
+                              description="angle random walk, deg/√h")
+    drift_rw_dph_rh: _Ang3 = Field([0.0, 0.0, 0.0], description="drift random walk, deg/h/√h")
+    bias_deg: _Val3 | None = Field(None, description="injected constant errors, deg")
+    drift_dph: _Val3 | None = Field(None, description="injected drift rates, deg/h")
+
+
+class AttitudeReferenceBlock(BaseModel):
+    """``navigation: {source: attitude_reference, ...}`` — flight-test mode of seed 004: an
+    attitude reference with injected heading/roll/pitch errors resolves an accurate
+    accelerometer block; a Kalman filter (15 error states + 6 GNSS Markov states) estimates the
+    reference's errors from GNSS position and velocity."""
+
+    model_config = _FINITE
+    source: Literal["attitude_reference"]
+    imu: str | dict[str, Any] = Field(
+        "HG9900", description="accelerometer block: IMU preset, .yaml path or mapping (only its "
+                              "accelerometers are used)")
+    seed: Annotated[int, Field(ge=0)] | None = Field(
+        None, description="seed of every error realisation (default: the run's seed)")
+    reference: ReferenceErrorBlock = Field(default_factory=ReferenceErrorBlock,
+                                           description="the attitude reference's error model")
+    gnss: GnssBlock = Field(default_factory=GnssBlock, description="GNSS receiver")
+    init_pos_sigma_m: Annotated[float, Field(gt=0, le=1000)] = Field(
+        1.0, description="σ of the computer's initial position error per axis, m")
+    init_vel_sigma_mps: Annotated[float, Field(gt=0, le=100)] = Field(
+        0.05, description="σ of the computer's initial velocity error per axis, m/s")
+    gate_sigma: Annotated[float, Field(gt=0, le=100)] = Field(
+        5.0, description="innovation gate per component, σ")
+
+
+NavigationBlock = Annotated[Union[TruthBlock, SinsBlock, InsGnssBlock, AttitudeReferenceBlock],
                             Field(discriminator="source")]
 """The navigation block of a scenario, discriminated by ``source``."""
 
@@ -172,5 +216,5 @@ def with_default_source(raw: Any) -> Any:
     return raw
 
 
-__all__ = ["BaroBlock", "FilterBlock", "GnssBlock", "InsGnssBlock", "NavigationBlock", "SinsBlock",
+__all__ = ["AttitudeReferenceBlock", "ReferenceErrorBlock", "BaroBlock", "FilterBlock", "GnssBlock", "InsGnssBlock", "NavigationBlock", "SinsBlock",
            "TruthBlock", "with_default_source"]

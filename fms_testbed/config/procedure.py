@@ -37,6 +37,10 @@ class ProcedureSpec(BaseModel):
         False, description="build and fly a procedure with a rejected, duplicated or misplaced "
                            "record of its own (refused by default); what is in doubt is "
                            "listed with the built path")
+    missed: StrictBool = Field(
+        False, description="approaches: go around at the missed-approach point and fly the "
+                           "missed approach to its holding fix and one holding circuit "
+                           "(default: the flight ends at the MAP)")
     start_alt_ft: Annotated[float, Field(ge=-1000, le=45000)] | None = Field(
         None, description="start altitude, ft (default: the build's planned start; a SID "
                           "that starts at a fix starts at that fix's 'at or above' altitude)")

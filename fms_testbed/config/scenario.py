@@ -5,7 +5,8 @@ Example::
     aircraft: "737"
     initial: {lat_deg: 47.0, lon_deg: 8.0, alt_m: 3000, tas_kmh: 400, heading_deg: 90}
     duration_s: 120
-    wind: {from_deg: 270, speed_kt: 20}
+    wind: {from_deg: 270, speed_kt: 20}       # or a profile over altitude, see WindLayer
+    atmosphere: {isa_dev_c: 15}               # a day 15 °C warmer than the ISA
     turbulence: {severity: light}
     events:
       - {t_s: 10, heading_deg: 180}
@@ -20,16 +21,17 @@ file and the field (``events.2.bank_deg``) and say why.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any, Literal
+from typing import Annotated, Any, Literal, Union
 
-from pydantic import (BaseModel, ConfigDict, Field, ValidationError, field_validator,
-                      model_validator)
+from pydantic import (BaseModel, ConfigDict, Discriminator, Field, Tag, ValidationError,
+                      field_validator, model_validator)
 
 from fms_testbed.config.aircraft import list_aircraft
 from fms_testbed.config.navigation import NavigationBlock, with_default_source
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.config.yamlfile import read_mapping, validation_message
 from fms_testbed.core.units import FT_M, KMH_MPS, KT_MPS
+from fms_testbed.core.wind import WindProfile
 
 _SPEED_KEYS = {"tas_mps": ("tas", 1.0), "tas_kmh": ("tas", KMH_MPS), "tas_kt": ("tas", KT_MPS),
                "cas_mps": ("cas", 1.0), "cas_kt": ("cas", KT_MPS), "cas_kmh": ("cas", KMH_MPS)}
@@ -140,6 +142,89 @@ class Wind(_Strict):
     def speed_ms(self) -> float:
         """Wind speed, m/s."""
         return self.speed_mps if self.speed_mps is not None else self.speed_kt * KT_MPS
+
+
+class WindLayer(Wind):
+    """One layer of a wind profile: the wind at an altitude (``alt_m`` or ``alt_ft``). The
+    profile interpolates the wind vector linearly in altitude between layers and holds the end
+    layers' beyond them (:class:`~fms_testbed.core.wind.WindProfile`)."""
+
+    alt_m: Alt | None = Field(None, description="layer altitude above mean sea level, m")
+    alt_ft: Annotated[float, Field(ge=-1300, le=82000)] | None = Field(
+        None, description="layer altitude above mean sea level, ft")
+
+    @property
+    def altitude_m(self) -> float:
+        """Layer altitude, m."""
+        return _alt(self.__dict__, "wind layer", True)
+
+    @model_validator(mode="after")
+    def _has_alt(self):
+        _ = self.altitude_m
+        return self
+
+
+def _wind_kind(v: Any) -> str:
+    return "profile" if isinstance(v, list) else "constant"
+
+
+def _layers_increase(layers: list[WindLayer]) -> list[WindLayer]:
+    if not layers:
+        raise ValueError("a wind profile needs at least one layer")
+    alts = [lay.altitude_m for lay in layers]
+    for k in range(1, len(alts)):
+        if alts[k] <= alts[k - 1]:
+            raise ValueError(f"wind layer {k} altitude {alts[k]:.0f} m is not above layer "
+                             f"{k - 1}'s {alts[k - 1]:.0f} m (give the layers bottom up)")
+    return layers
+
+
+WindSpec = Annotated[Union[Annotated[Wind, Tag("constant")],
+                           Annotated[list[WindLayer], Tag("profile")]],
+                     Discriminator(_wind_kind)]
+"""A scenario wind: one steady wind (a mapping) or a profile (a list of :class:`WindLayer`)."""
+
+
+def wind_profile(wind: Wind | list[WindLayer] | None) -> WindProfile | None:
+    """A validated scenario wind (constant or layers) as a :class:`WindProfile` (SI), None for
+    none."""
+    if wind is None:
+        return None
+    if isinstance(wind, Wind):
+        return WindProfile.constant(wind.speed_ms, wind.from_deg)
+    return WindProfile.from_layers([(lay.altitude_m, lay.from_deg, lay.speed_ms)
+                                    for lay in _layers_increase(list(wind))])
+
+
+class Atmosphere(_Strict):
+    """The day's atmosphere: the ISA with a temperature deviation (same at every altitude;
+    pressure hydrostatic from the standard sea-level pressure, :mod:`fms_testbed.core.atmosphere`)."""
+
+    isa_dev_c: Annotated[float, Field(ge=-60, le=60)] = Field(
+        0.0, description="temperature deviation from the ISA, °C (= K)")
+
+
+class Forecast(_Strict):
+    """The conditions the path is planned for when they differ from the actual ones (a
+    forecast): a wind (constant or profile) and an ISA deviation. Absent keys: the actual
+    conditions. In flight the measured conditions are compared with these and the rest of the
+    procedure is rebuilt when they differ too much (:mod:`fms_testbed.guidance.replan`)."""
+
+    wind: WindSpec | None = Field(None, description="planned wind (default: the actual one)")
+    calm: bool = Field(False, description="plan for calm air (whatever the actual wind)")
+    isa_dev_c: Annotated[float, Field(ge=-60, le=60)] | None = Field(
+        None, description="planned ISA deviation, °C (default: the actual one)")
+
+    @field_validator("wind")
+    @classmethod
+    def _wind_layers(cls, v):
+        return _layers_increase(v) if isinstance(v, list) else v
+
+    @model_validator(mode="after")
+    def _calm_or_wind(self):
+        if self.calm and self.wind is not None:
+            raise ValueError("forecast: give calm: true or a wind, not both")
+        return self
 
 
 class Turbulence(_Strict):
@@ -257,7 +342,13 @@ class Scenario(_Strict):
                                          "procedure flight defaults it to the path start)")
     duration_s: Annotated[float, Field(gt=0, le=6 * 3600)] = Field(
         description="simulated time to fly, s (a procedure flight ends when guidance completes)")
-    wind: Wind | None = Field(None, description="steady wind, ramped in over 20 s after trim")
+    wind: WindSpec | None = Field(
+        None, description="steady wind (mapping) or a profile over altitude (list of layers "
+                          "with alt_m|alt_ft), ramped in over 20 s after trim")
+    atmosphere: Atmosphere | None = Field(
+        None, description="the day's atmosphere (ISA deviation); default the ISA")
+    forecast: Forecast | None = Field(
+        None, description="conditions the path is planned for, when not the actual ones")
     turbulence: Turbulence | None = Field(None, description="JSBSim turbulence after trim")
     vertical_law: Literal["coupled", "pi", "tecs"] = Field(
         "coupled", description="law for altitude/speed targets: the coupled thrust/elevator law "
@@ -304,6 +395,37 @@ class Scenario(_Strict):
     @classmethod
     def _nav_default(cls, v):
         return with_default_source(v)
+
+    @field_validator("wind")
+    @classmethod
+    def _wind_layers(cls, v):
+        return _layers_increase(v) if isinstance(v, list) else v
+
+    @property
+    def isa_dev_c(self) -> float:
+        """The actual temperature deviation from the ISA, K (0 without an atmosphere block)."""
+        return self.atmosphere.isa_dev_c if self.atmosphere is not None else 0.0
+
+    @property
+    def wind_profile(self) -> WindProfile | None:
+        """The actual wind as a :class:`~fms_testbed.core.wind.WindProfile`, None for calm."""
+        return wind_profile(self.wind)
+
+    @property
+    def planned_wind_profile(self) -> WindProfile | None:
+        """The wind the path is planned for: the forecast's, else the actual one."""
+        f = self.forecast
+        if f is not None and f.calm:
+            return None
+        if f is not None and f.wind is not None:
+            return wind_profile(f.wind)
+        return self.wind_profile
+
+    @property
+    def planned_isa_dev_c(self) -> float:
+        """The ISA deviation the path is planned for, K: the forecast's, else the actual."""
+        f = self.forecast
+        return f.isa_dev_c if f is not None and f.isa_dev_c is not None else self.isa_dev_c
 
     @property
     def navigation_spec(self) -> dict[str, Any]:

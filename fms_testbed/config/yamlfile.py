@@ -54,7 +54,7 @@ def read_mapping(path: str | Path, what: str = "file") -> dict[str, Any]:
     return raw
 
 
-_TAGGED_FIELDS = ("navigation",)
+_TAGGED_FIELDS = ("navigation", "wind")
 """Fields whose value is a discriminated union (pydantic adds the tag to the error location)."""
 
 

@@ -32,9 +32,10 @@ from fms_testbed.core.units import FT_M, NM_M
 from fms_testbed.guidance.active_path import activate
 from fms_testbed.guidance.geometry import LocalPiece
 from fms_testbed.guidance.lateral import LateralGains
-from fms_testbed.guidance.replan import passed_direct_legs, rebuild_rest
+from fms_testbed.guidance.replan import (ConditionMonitor, measured_params, passed_direct_legs,
+                                         rebuild_rest, rebuildable_here)
 from fms_testbed.guidance.sequencing import OVERRUN_MAX_M, ConditionWatch, hold_exit_reached
-from fms_testbed.guidance.speed_plan import SpeedPlan
+from fms_testbed.guidance.speed_plan import GoAround, SpeedPlan
 from fms_testbed.guidance.steering import steer_bank_rad
 from fms_testbed.guidance.step_log import log_row
 from fms_testbed.guidance.vertical import (altitude_command_m, altitude_lead_s,
@@ -42,9 +43,15 @@ from fms_testbed.guidance.vertical import (altitude_command_m, altitude_lead_s,
 from fms_testbed.legs.model import BuiltLeg, PathSegment
 from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.plan import FlyablePath
+from fms_testbed.procedures.records import Fix
 
 XTK_ABORT_M = 5 * NM_M
 """Cross-track beyond which the flight is declared off the procedure, m."""
+CIRCLING_FLOOR_HEIGHT_M = 180.0
+"""Lowest height above the airport a circling approach (one with no landing runway: ``RNV-A``,
+``VOR-B``…) descends to, m: PANS-OPS (ICAO Doc 8168, Vol. II, circling) lowest OCH for a
+category C aircraft, 180 m (591 ft). The CIFP codes no MDA; its circling MAP is often coded at
+the field elevation, so the coded profile alone would fly into the ground."""
 DEFAULT_CLIMB_TOP_M = 15000 * FT_M
 """Climb top when no procedure spec gives one, m."""
 
@@ -121,11 +128,65 @@ class ProcedureGuidance:
                                fp.path.proc_type in ("E", "F"),
                                cfg.limits.climb_tas_mps, cfg.limits.cas_min_mps,
                                cfg.limits.climb_tas_mps)
+        self.speed.isa_dev_c = fp.params.isa_dev_c if fp.params is not None else 0.0
+        self._approach_speeds(fp, cfg, db)
+        self.floor_m = self._circling_floor_m(fp, db)
         self.watch = ConditionWatch()
         self.done = False
         self.calls = 0
         self.log_every = max(1, int(log_every))
         self.rebuilt: list[FlyablePath] = []
+        self.conditions = ConditionMonitor()
+        """Measured vs planned wind and temperature (:mod:`.replan`): a rebuild when they differ."""
+
+    def _circling_floor_m(self, fp: FlyablePath, db) -> float:
+        """Lowest altitude command, m: for a circling approach the airport elevation plus
+        :data:`CIRCLING_FLOOR_HEIGHT_M`, else −inf."""
+        from fms_testbed.path.runway import approach_runway
+
+        if not self.approach or db is None or approach_runway(db, fp.seq) is not None:
+            return -math.inf
+        apt = db.airports.get(fp.seq.airport)
+        if apt is None or apt.elev_m is None:
+            return -math.inf
+        return apt.elev_m + CIRCLING_FLOOR_HEIGHT_M
+
+    def _approach_speeds(self, fp: FlyablePath, cfg, db) -> None:
+        """Vapp and the go-around speeds of an approach flown by an aircraft with approach
+        settings (:mod:`.speed_plan`); ``go_around_leg``: the first missed-approach leg flown
+        (None: the missed approach is not flown)."""
+        from fms_testbed.path.runway import approach_runway
+
+        self.go_around_leg = None
+        ap = cfg.approach
+        if not self.approach or ap is None:
+            return
+        self.speed.vapp_cas_mps = ap.vapp_cas_mps_at(None)
+        first = next((k for k, r in enumerate(fp.seq.legs) if r.missed_approach_start), None)
+        if first is None:
+            return
+        rw = approach_runway(db, fp.seq) if db is not None else None
+        elev = rw.elev_m if rw is not None and rw.elev_m is not None else \
+            float(fp.path.profile.alt_m[first]) if fp.path.profile is not None else 0.0
+        self.go_around_leg = first
+        self.speed.go_around = GoAround(first, ap.vapp_cas_mps_at(None), ap.go_around_add_cas_mps,
+                                        ap.acceleration_height_m, float(elev))
+
+    def set_mass(self, mass_kg: float) -> None:
+        """The gross weight the FMS flies with (kg): Vapp is scaled to it (approach settings)."""
+        ap = self.cfg.approach
+        if ap is None or self.speed.vapp_cas_mps is None:
+            return
+        self.speed.vapp_cas_mps = ap.vapp_cas_mps_at(mass_kg)
+        if self.speed.go_around is not None:
+            from dataclasses import replace
+            self.speed.go_around = replace(self.speed.go_around,
+                                           vapp_cas_mps=self.speed.vapp_cas_mps)
+
+    @property
+    def go_around_active(self) -> bool:
+        """True once the missed approach is flown (its first leg entered)."""
+        return self.go_around_leg is not None and self.leg >= self.go_around_leg
 
     # ------------------------------------------------------------------ the step
     def update(self, dt_s: float, nav, truth) -> GuidanceOutput:
@@ -138,6 +199,8 @@ class ProcedureGuidance:
                 continue
             if out is not None:
                 return out
+            if self._conditions_changed(w, nav, truth):
+                continue
             hold = self._held_past_plan(w, nav)
             out = self._sequence(w, nav, truth, hold)
             if out is _MOVED:
@@ -150,12 +213,24 @@ class ProcedureGuidance:
                                    f"({w.built.path_term})")
             bank = self._lateral(w, nav, hold)
             s_path = self._s_path_m(w)
-            alt_cmd = altitude_command_m(self.act.prof_s, self.act.prof_h, self.act.climb_tgt,
-                                         s_path, w.gs_mps, self.lead_s, self.t2_s2, self.top_m,
-                                         self.approach, self.act.windows)
+            a = self.act
+            ps, ph, ct, win = a.prof_s, a.prof_h, a.climb_tgt, a.windows
+            if self.go_around_leg is not None and not self.go_around_active:
+                # before the go-around the final approach path goes on through the MAP (no
+                # blend into the missed-approach climb before it): the profile up to the MAP
+                j = self.go_around_leg - a.fp.leg_offset + 1
+                if 1 < j < len(ps):
+                    ps, ph, ct, win = ps[:j], ph[:j], ct[:j], win[:j]
+            alt_cmd = max(altitude_command_m(ps, ph, ct, s_path, w.gs_mps, self.lead_s,
+                                             self.t2_s2, self.top_m, self.approach, win),
+                          self.floor_m)
+            prof = self.act.fp.path.profile
+            sched = getattr(prof, "speed", None)
+            s_sched = s_path - (self.act.prof_s[0] - float(prof.along_m[0])) \
+                if sched is not None else None
             tas_cmd = self.speed.update(nav.t_s, nav.alt_m, w.leg, self.act.pieces, self.i,
                                         w.along_m, w.gs_mps, self.gains.bank_max_deg,
-                                        self.act.piece_legs)
+                                        self.act.piece_legs, sched, s_sched)
             return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=tas_cmd,
                                   log=self._log_due(w, truth, s_path))
         return GuidanceOutput(done=True)
@@ -211,8 +286,10 @@ class ProcedureGuidance:
             nxt = k + 1
         if nxt >= len(self.whole.seq.legs):
             return False
+        gs = math.hypot(float(nav.v_enu_mps[0]), float(nav.v_enu_mps[1]))
         fp = rebuild_rest(self.db, self.whole, self.spec, self.cfg, self.gains, nxt,
-                          nav.lat_rad, nav.lon_rad, w.trk_rad, nav.alt_m)
+                          nav.lat_rad, nav.lon_rad, w.trk_rad, nav.alt_m, gs, nav.roll_rad,
+                          params=self.act.fp.params)
         if fp is None:
             return False
         a = self.act
@@ -223,6 +300,45 @@ class ProcedureGuidance:
         self.i = 0
         self._event(t_s, "rebuild", nxt, f"rest of the procedure rebuilt from the aircraft "
                                           f"state ({len(fp.path.segments)} segments)")
+        return True
+
+    def _conditions_changed(self, w: _Where, nav, truth) -> bool:
+        """Step 2b: the measured wind or temperature differs from the planned one beyond its
+        threshold (:class:`~.replan.ConditionMonitor`): the rest of the procedure, the present
+        leg included, rebuilt from the present position for the measured conditions. True when
+        a rebuilt path is active."""
+        why = self.conditions.update(nav.t_s, nav, truth, self.act.fp.params)
+        if not why or not rebuildable_here(w.seg, w.built) or self.db is None:
+            return False
+        (wn, we), dev = self.conditions.measured
+        params = measured_params(self.act.fp.params, nav.alt_m, (wn, we), dev)
+        k = w.leg
+        prev = None
+        if k > 0:
+            t = self.whole.path.legs[k - 1].termination
+            if t.kind == "fix" and t.lat_deg is not None:
+                prev = Fix(ident=t.fix_ident, region="", section="", lat_deg=t.lat_deg,
+                           lon_deg=t.lon_deg)
+        v = nav.v_enu_mps
+        gs = math.hypot(float(v[0]), float(v[1]))
+        fp = rebuild_rest(self.db, self.whole, self.spec, self.cfg, self.gains, k,
+                          nav.lat_rad, nav.lon_rad, w.trk_rad, nav.alt_m, gs, nav.roll_rad,
+                          params=params, prev_fix=prev)
+        self.conditions.rebuilt(nav.t_s)
+        if fp is None:
+            self._event(nav.t_s, "condition", k, f"conditions changed ({why}); the rest could "
+                                                 "not be rebuilt: the plan is kept")
+            return False
+        a = self.act
+        s_now = a.s_base_m + a.seg_cum_m[w.p.seg_index] + w.p.s0_m + w.along_m
+        self.act = activate(fp, s_now, self.cfg.limits.climb_tas_mps,
+                            lead_from=(math.degrees(nav.lat_rad), math.degrees(nav.lon_rad)))
+        self.rebuilt.append(fp)
+        self.i = 0
+        self.speed.isa_dev_c = params.isa_dev_c
+        self._event(nav.t_s, "rebuild", k, f"conditions changed: {why}; rest of the procedure "
+                                           f"rebuilt from the present position "
+                                           f"({len(fp.path.segments)} segments)")
         return True
 
     def _past_leg(self, w: _Where):

@@ -8,6 +8,13 @@ moved into the CAS band the leg's coded limit allows (:func:`~.vertical.cas_band
 procedure; the 'at' / 'at or below' limit of a fix ahead is flown from the deceleration
 distance before it (:meth:`SpeedPlan.limit_ahead_cap_mps`). The target is refreshed every
 :data:`SPEED_UPDATE_S` and on entering a leg.
+
+Approaches of an aircraft with approach settings also follow the planned speed profile
+(:class:`~fms_testbed.path.speed_profile.SpeedProfile`: deceleration segments before coded
+limits and the FAF, Vapp on the final), read :data:`SPEED_LEAD_S` ahead of the aircraft (the
+speed loop's lag), with Vapp as the floor instead of the clean minimum. In the missed approach
+(:class:`GoAround`) the target is Vapp + the go-around increment until the acceleration
+height above the runway, then the planned (clean) speed again.
 """
 
 from __future__ import annotations
@@ -30,6 +37,22 @@ LOOKAHEAD_M = 30000.0
 """Arcs further ahead than this are not looked at, m."""
 SPEED_UPDATE_S = 1.0
 """The TAS target is recomputed this often, s."""
+SPEED_LEAD_S = 10.0
+"""The planned approach speed is read this far ahead of the aircraft (flight time, s): about
+the coupled law's speed-channel ramp lag 2 ξ_V T_V (10.7 s for the 737)."""
+
+
+@dataclass(frozen=True)
+class GoAround:
+    """Speeds of the missed approach: from whole-procedure leg ``first_leg`` on, Vapp +
+    ``add_cas_mps`` until ``accel_height_m`` above the runway (elevation ``runway_elev_m``),
+    then the planned speed (m/s, m)."""
+
+    first_leg: int
+    vapp_cas_mps: float
+    add_cas_mps: float
+    accel_height_m: float
+    runway_elev_m: float
 
 
 def arc_speed_cap_mps(pieces: list[LocalPiece], i: int, along_m: float, v_mps: float,
@@ -75,6 +98,14 @@ class SpeedPlan:
     tas_cmd_mps: float
     carry_max_cas_mps: float | None = None
     next_t_s: float = -1.0
+    vapp_cas_mps: float | None = None
+    """Final approach speed of the flight's mass (approach settings), m/s; None: clean."""
+    go_around: GoAround | None = None
+    accelerated: bool = False
+    """The go-around has passed its acceleration height."""
+    isa_dev_c: float = 0.0
+    """The day's temperature deviation the CAS → TAS conversions use, K (the plan's; after a
+    rebuild on changed conditions, the measured one)."""
 
     def enter_leg(self, k: int) -> None:
         """Leg ``k`` (whole-procedure index) is entered: in descent its 'at'/'at or below' limit
@@ -109,7 +140,7 @@ class SpeedPlan:
             lim = self.limits[k]
             if lim is not None and lim.desc in ("", "@", "-"):
                 v_lim = cas_to_tas_scalar(lim.cas_mps - (SPEED_MARGIN_MPS if lim.desc == "-"
-                                                         else 0.0), alt_m)
+                                                         else 0.0), alt_m, self.isa_dev_c)
                 need = max(v_mps * v_mps - v_lim * v_lim, 0.0) / (2 * DECEL_MPS2) \
                     + DECEL_EXTRA_S * v_mps
                 if dist <= need:
@@ -120,18 +151,52 @@ class SpeedPlan:
 
     def update(self, t_s: float, alt_m: float, leg: int, pieces: list[LocalPiece], i: int,
                along_m: float, gs_mps: float, bank_max_deg: float,
-               piece_legs: list[int] | None = None) -> float:
+               piece_legs: list[int] | None = None, schedule=None,
+               s_sched_m: float | None = None) -> float:
         """The TAS target at time ``t_s`` (s), altitude (m), on leg ``leg`` (whole-procedure
         index), piece ``i`` at ``along_m`` (m), ground speed (m/s), m/s; ``piece_legs``: the
-        whole-procedure leg of each piece (speed limits of fixes ahead planned before them)."""
+        whole-procedure leg of each piece (speed limits of fixes ahead planned before them);
+        ``schedule``: the approach's planned speeds (``SpeedProfile``) and ``s_sched_m`` the
+        aircraft's distance along the path they were planned on, m."""
         if t_s >= self.next_t_s:
+            ga = self.go_around
+            if ga is not None and leg >= ga.first_leg:
+                return self._go_around_update(t_s, alt_m, leg, pieces, i, along_m, gs_mps,
+                                              bank_max_deg, ga)
             lim = self.limits[leg] if leg < len(self.limits) else None
             lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
-            plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m),
+            plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
                        arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg))
             if piece_legs is not None:
                 plan = min(plan, self.limit_ahead_cap_mps(alt_m, leg, pieces, i, along_m,
                                                           self.tas_cmd_mps, piece_legs))
-            self.tas_cmd_mps = tas_target_mps(plan, alt_m, lo, hi, self.cas_min_mps)
+            floor = None
+            if self.vapp_cas_mps is not None and schedule is not None and s_sched_m is not None:
+                c = schedule.cas_at(s_sched_m + SPEED_LEAD_S * gs_mps, self.vapp_cas_mps)
+                if math.isfinite(c):
+                    plan = min(plan, cas_to_tas_scalar(c, alt_m, self.isa_dev_c))
+                floor = self.vapp_cas_mps
+            self.tas_cmd_mps = tas_target_mps(plan, alt_m, lo, hi, self.cas_min_mps,
+                                              self.isa_dev_c, floor)
             self.next_t_s = t_s + SPEED_UPDATE_S
+        return self.tas_cmd_mps
+
+    def _go_around_update(self, t_s, alt_m, leg, pieces, i, along_m, gs_mps, bank_max_deg,
+                          ga: GoAround) -> float:
+        """The missed approach's TAS target (:class:`GoAround`), m/s: Vapp + the increment up
+        to the acceleration height above the runway, then the planned speed in the leg's coded
+        band."""
+        if not self.accelerated and alt_m - ga.runway_elev_m >= ga.accel_height_m:
+            self.accelerated = True
+        lim = self.limits[leg] if leg < len(self.limits) else None
+        lo, hi = cas_band(lim, None)
+        if self.accelerated:
+            plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
+                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg))
+        else:
+            plan = cas_to_tas_scalar(ga.vapp_cas_mps + ga.add_cas_mps, alt_m, self.isa_dev_c)
+            lo = hi = None
+        self.tas_cmd_mps = tas_target_mps(plan, alt_m, lo, hi, self.cas_min_mps,
+                                          self.isa_dev_c, ga.vapp_cas_mps)
+        self.next_t_s = t_s + SPEED_UPDATE_S
         return self.tas_cmd_mps

@@ -82,15 +82,20 @@ def cas_band(limit: SpeedLimit | None, carried_max_cas_mps: float | None
 
 
 def tas_target_mps(tas_plan_mps: float, alt_m: float, lo_cas_mps: float | None,
-                   hi_cas_mps: float | None, cas_min_mps: float) -> float:
+                   hi_cas_mps: float | None, cas_min_mps: float, isa_dev_c: float = 0.0,
+                   floor_cas_mps: float | None = None) -> float:
     """TAS target, m/s: the planned TAS moved into the allowed CAS band at altitude ``alt_m``
-    (ISA conversion), never below MIN_CAS_FACTOR × ``cas_min_mps``."""
+    (conversion on a day ``isa_dev_c`` K off the ISA), never below MIN_CAS_FACTOR ×
+    ``cas_min_mps`` (clean) or, when ``floor_cas_mps`` is given (an aircraft configured for
+    the approach: its Vapp), below that CAS, m/s."""
+    if floor_cas_mps is not None:
+        cas_min_mps = floor_cas_mps / MIN_CAS_FACTOR
     v = tas_plan_mps
     if hi_cas_mps is not None:
-        v = min(v, cas_to_tas_scalar(hi_cas_mps, alt_m))
+        v = min(v, cas_to_tas_scalar(hi_cas_mps, alt_m, isa_dev_c))
     if lo_cas_mps is not None:
-        v = max(v, cas_to_tas_scalar(lo_cas_mps, alt_m))
-    return max(v, cas_to_tas_scalar(MIN_CAS_FACTOR * cas_min_mps, alt_m))
+        v = max(v, cas_to_tas_scalar(lo_cas_mps, alt_m, isa_dev_c))
+    return max(v, cas_to_tas_scalar(MIN_CAS_FACTOR * cas_min_mps, alt_m, isa_dev_c))
 
 
 def altitude_lead_s(cfg) -> float:

@@ -26,6 +26,16 @@ DIRECT_XTK_M = 50.0
 """A course into a fix whose line passes within this of the present position is flown as the
 straight to the fix (courses referenced to an old station declination differ from the fixes'
 bearing by up to ~5° in the FAA data; beyond this offset the coded course is intercepted), m."""
+CF_FROM_FIX_DEG = 1.0
+"""A course into a fix whose leg starts over the previous fix, with that fix this close to the
+course (the angle its offset subtends from the fix, deg), is flown as the line between the two
+fixes: the coded course is the chart's rounding of that line (KBIS I31: WIGAG 133 m beside the
+311° course into ICONO, 0.33° from 23 km), and intercepting it would put an S-turn of a few
+hundred metres where the turn onto the course needs its fly-by."""
+CF_FROM_FIX_TURN_MAX_DEG = 120.0
+""":data:`CF_FROM_FIX_DEG` applies to a fly-by turn onto the course; a sharper one (a course
+reversal over the fix, e.g. a missed approach coded back along the final) keeps the course
+join, so the monitor still sees the reversal."""
 PARALLEL_TOL_M = 30.0
 """A turn from over a fix that ends closer than this to the coded course line out of the fix
 is left parallel to it; beyond, the line is rejoined with a 45° intercept, m."""
@@ -94,6 +104,11 @@ class LegBuilder:
         self._corner_pending = False
         self._upstream_depth = 0
         self.joined = True
+        self.params0 = params
+        self.leg_params: dict[int, BuildParams] = {}
+        """The settings each leg was built with (the wind at its planned altitude)."""
+        self.leg_alt_m: dict[int, float] = {}
+        """Each leg's planned start altitude, m."""
 
     # ------------------------------------------------------------------ context
     @property
@@ -111,6 +126,12 @@ class LegBuilder:
         """The planned wind speed, m/s: turns whose tracks are not known yet (a leg's turns, a
         hold's 180° turns) are planned for TAS + wind, the most ground speed they can see."""
         return self.params.wind_speed_mps
+
+    def use_leg_params(self, leg_index: int) -> BuildParams:
+        """Build with the settings leg ``leg_index`` was built with (its wind; the corners
+        are rounded after all legs are built) and return them."""
+        self.params = self.leg_params.get(leg_index, self.params0)
+        return self.params
 
     def finding(self, category: str, message: str, branch: str = "") -> None:
         """Record a finding against the current leg."""
@@ -251,6 +272,11 @@ class LegBuilder:
         """
         along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
                                  state.lon_deg)
+        if along < 0 and self._at_previous_fix(state) and \
+                math.degrees(math.atan2(abs(xtk), -along)) <= CF_FROM_FIX_DEG and \
+                (state.track_deg is None or
+                 abs(wrap180(fcrs - state.track_deg)) <= CF_FROM_FIX_TURN_MAX_DEG):
+            return self.direct_to(state, fix, direction, flyby_end)
         toward = state.track_deg is None or abs(wrap180(state.track_deg - fcrs)) < 10.0
         if along < 0 and abs(xtk) <= DIRECT_XTK_M:
             if toward:   # on the course line already (within the tolerance): to the fix
@@ -294,6 +320,13 @@ class LegBuilder:
         state = replace(state, flyby=True)
         self._corner_pending = True
         return self.line_to(state, fix.lat_deg, fix.lon_deg, fix.ident, flyby_end)
+
+    def _at_previous_fix(self, state: FlightState) -> bool:
+        """True when ``state`` lies over the fix the previous leg ended at (within 1 m)."""
+        prev = self.prev_fixes[self.i] if self.i < len(self.prev_fixes) else None
+        if prev is None or not state.fix_ident or state.fix_ident != prev.ident:
+            return False
+        return inverse(state.lat_deg, state.lon_deg, prev.lat_deg, prev.lon_deg)[0] <= 1.0
 
     def _join_upstream(self, state: FlightState, fix: Fix, course_deg: float,
                        direction: str | None, flyby_end: bool) -> FlightState:

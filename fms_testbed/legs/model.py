@@ -9,9 +9,11 @@ leg's kind and its termination condition as data (:class:`Termination`).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.core.segments import Arc, Line
+from fms_testbed.core.wind import WindProfile
 from fms_testbed.core.units import KT_MPS, NM_M
 from fms_testbed.legs.coded import CodedPath
 from fms_testbed.procedures.legrecord import LegRecord
@@ -43,7 +45,40 @@ class BuildParams:
     """The wind the path is planned for (Danilin 2017: the desired trajectory is built for the
     current conditions): turns are planned for their ground speed, R = V_g²/(g tan γ), with
     V_g the largest ground speed over the turn's tracks (:func:`max_tailwind_mps`); m/s and
-    deg true (the direction it blows from)."""
+    deg true (the direction it blows from). With a ``wind_profile`` the builder sets these to
+    the wind at each leg's planned altitude (:meth:`for_altitude`)."""
+    wind_profile: WindProfile | None = None
+    """The planned wind over altitude (None: the constant ``wind_speed_mps``/``wind_from_deg``)."""
+    climb_top_m: float | None = None
+    """Top of the planned climb, m (None: not known): a hold in a climb is flown up to it, so
+    its wind is planned as the profile's strongest from the hold's start up to there."""
+    isa_dev_c: float = 0.0
+    """The planned temperature deviation from the ISA, K: planned CAS → TAS on that day
+    (:func:`isa_tas_mps`), so turn radii are those of the TAS actually flown."""
+
+    def wind_at(self, alt_m: float) -> tuple[float, float]:
+        """Planned (speed m/s, from deg true) at altitude ``alt_m`` (m): the profile's, else
+        the constant wind."""
+        if self.wind_profile is None:
+            return self.wind_speed_mps, self.wind_from_deg
+        return self.wind_profile.at(alt_m)
+
+    def for_band(self, lo_m: float, hi_m: float) -> "BuildParams":
+        """These settings with the constant wind replaced by the profile's strongest between
+        ``lo_m`` and ``hi_m`` (m): a leg flown through that band of altitudes (a hold climbed
+        in). The same object without a profile."""
+        if self.wind_profile is None:
+            return self
+        spd, frm = self.wind_profile.strongest_between(lo_m, hi_m)
+        return replace(self, wind_speed_mps=spd, wind_from_deg=frm)
+
+    def for_altitude(self, alt_m: float) -> "BuildParams":
+        """These settings with the constant wind replaced by the profile's at ``alt_m`` (m):
+        what one leg is built with (the same object without a profile)."""
+        if self.wind_profile is None:
+            return self
+        spd, frm = self.wind_profile.at(alt_m)
+        return replace(self, wind_speed_mps=spd, wind_from_deg=frm)
 
 
 @dataclass(frozen=True, slots=True)
@@ -222,11 +257,12 @@ class ProcedurePath:
         return [lg.path_term for lg in self.legs]
 
 
-def isa_tas_mps(cas_mps: float, alt_m: float) -> float:
-    """TAS from CAS in the ISA troposphere (incompressible), m/s: CAS/sqrt(σ)."""
-    h = min(max(alt_m, 0.0), 11000.0)
-    sigma = (1.0 - 2.25577e-5 * h) ** 4.2559
-    return cas_mps / math.sqrt(sigma)
+def isa_tas_mps(cas_mps: float, alt_m: float, isa_dev_c: float = 0.0) -> float:
+    """TAS (m/s) for a CAS (m/s) at altitude ``alt_m`` (m, ≥ 0) on a day ``isa_dev_c`` (K) off
+    the ISA: the compressible conversion guidance flies
+    (:func:`fms_testbed.core.atmosphere.cas_to_tas_scalar`), so the radius R = V²/(g tan γ)
+    is planned for the TAS actually flown."""
+    return cas_to_tas_scalar(cas_mps, max(alt_m, 0.0), isa_dev_c)
 
 
 def turn_radius_m(tas_mps: float, bank_deg: float, g_mps2: float) -> float:

@@ -22,14 +22,15 @@ import pandas as pd
 from fms_testbed.config.aircraft import AircraftConfig, load_aircraft
 from fms_testbed.config.scenario import Scenario
 from fms_testbed.control import VERTICAL_LAWS
-from fms_testbed.core.atmosphere import cas_to_tas
+from fms_testbed.core.atmosphere import cas_to_tas, tas_to_cas
 from fms_testbed.core.contracts import Guidance, GuidanceOutput
 from fms_testbed.core.errors import UserError
-from fms_testbed.core.units import FT_M, KT_MPS
+from fms_testbed.core.units import FT_M, KT_MPS, SLUG_KG
 from fms_testbed.loop.log import build_frame
 from fms_testbed.loop.procedure import PreparedProcedure
-from fms_testbed.loop.steps import (WIND_RAMP_S, EventQueue, LateralStep, NavHold, Targets,
-                                    VerticalStep, WindRamp, apply_event, merge_guidance)
+from fms_testbed.loop.steps import (WIND_RAMP_S, ConfigStep, EventQueue, LateralStep, NavHold,
+                                    Targets, VerticalStep, WindRamp, apply_event,
+                                    flap_index_for_cas, merge_guidance)
 from fms_testbed.navigation import make_source
 from fms_testbed.sim.divergence import Divergence
 from fms_testbed.sim.jsbsim_core import RAW, JSBSimAircraft
@@ -74,12 +75,25 @@ class Flight:
         ac.fdm["simulation/randomseed"] = self.seed
         ini = scn.initial
         kind, spd = ini.speed
-        tas0 = float(cas_to_tas(spd, ini.altitude_m)) if kind == "cas" else spd
+        ac.set_isa_dev(scn.isa_dev_c)        # the day's temperature, before the trim
+        tas0 = float(cas_to_tas(spd, ini.altitude_m, scn.isa_dev_c)) if kind == "cas" else spd
         # Trim in calm air: JSBSim 1.3.3 fails to trim in wind, and run_ic() resets the
         # atmosphere's wind to the initial condition's. The steady wind is ramped in after the
         # trim (WIND_RAMP_S).
+        # a procedure flight: terrain at its airport; an aircraft with approach settings starts
+        # with the flaps its start speed has out on the approach schedule
+        terrain = procedure.terrain_elev_m if procedure is not None else 0.0
+        ap = cfg.approach if procedure is not None else None
+        k0 = flap_index_for_cas(ap, float(tas_to_cas(tas0, ini.altitude_m))) \
+            if ap is not None else 0
         ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
-                lon_deg=ini.lon_deg)
+                lon_deg=ini.lon_deg, terrain_elev_m=terrain,
+                flap_cmd_norm=ap.flaps[k0].cmd_norm if ap is not None else 0.0)
+        self.config_step = None
+        if ap is not None and guidance is not None:
+            self.config_step = ConfigStep(ap, ac, k0, False, getattr(guidance, "events", None))
+            if hasattr(guidance, "set_mass"):
+                guidance.set_mass(float(ac.fdm["inertia/mass-slugs"]) * SLUG_KG)
         if scn.turbulence is not None:  # after trim: JSBSim cannot trim in turbulence
             idx, w20 = _TURB_SEVERITY[scn.turbulence.severity]
             ac.fdm["atmosphere/turb-type"] = 4
@@ -172,9 +186,13 @@ class Flight:
         check = Divergence(self.cfg)
         wind = WindRamp(ac.fdm, scn, dt_outer)
         wind_end_s = wind.end_s if wind.active else -1.0
+        wind_varies = wind.varies
         lateral = LateralStep(self.cfg, dt_outer)
         vertical = VerticalStep(self.vertical_law, ac, dt_outer)
         i_wow = RAW["wow"]
+        configure = self.config_step
+        go_around = (lambda: guide.go_around_active) if hasattr(guide, "go_around_active") \
+            else (lambda: False)
         state, read, run = ac.state, ac.read_raw, ac.run
         raw = read()
         for k in range(n_total + 1):
@@ -183,8 +201,8 @@ class Flight:
             if why:
                 self.status, self.reason = "diverged", why
                 return
-            if s.t_s <= wind_end_s:                         # wind ramp
-                wind(s.t_s)
+            if s.t_s <= wind_end_s or wind_varies:          # wind (ramp; profile: altitude)
+                wind(s.t_s, s.alt_m)
             nav = navigate(s)                               # navigate
             if events.pending:                              # events
                 for ev in events.due(s.t_s, s.alt_m):
@@ -196,6 +214,8 @@ class Flight:
                 merge_guidance(gout, tg)
             bank_cmd = lateral(tg, nav, gout is not None)   # lateral
             cmd_nx, cmd_ny, alt_cmd, tas_cmd = vertical(s, tg, bank_cmd)   # vertical + command
+            if configure is not None:                       # flaps and gear
+                configure(s, tg, go_around())
             if k % log_every == 0:                          # log: what is at hand, raw
                 raw_log.extend(raw)
                 rows.append((bank_cmd, tg.heading_rad, cmd_nx, cmd_ny, tg.throttle, alt_cmd, tas_cmd,

@@ -48,4 +48,9 @@ def build_frame(raw_log, log_rows: list[tuple]) -> pd.DataFrame:
         "nav_roll_deg": deg(lg["nav_roll_rad"].to_numpy()),
         "nav_pitch_deg": deg(lg["nav_pitch_rad"].to_numpy()),
     }
-    return pd.DataFrame({c: cols[c] for c in names})
+    out = {c: cols[c] for c in names}
+    # after the COLUMNS contract: configuration and height above the terrain (runway), for
+    # the approach evaluation (normalised 0 up .. 1 fully down/extended; m)
+    out["flap_pos_norm"], out["gear_pos_norm"] = r["flap_pos_norm"], r["gear_pos_norm"]
+    out["agl_m"] = r["agl_m"]
+    return pd.DataFrame(out)

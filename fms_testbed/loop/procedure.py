@@ -9,14 +9,19 @@ approaches start at their first fix at the first coded altitude, on the first se
 course. In both cases the aircraft is placed one roll-in anticipation distance (≈ 400 m for the
 737) *before* the path start on that course, so a turn that begins at the path start is entered
 like any other planned turn. The start speed is the planned TAS moved into the first leg's coded
-speed limit. An approach ends at the runway/MAP (the missed approach is not flown). JSBSim's
-terrain is at mean sea level, so height above ground is altitude above MSL.
+speed limit. An approach ends at the runway/MAP unless the missed approach is flown
+(``procedure.missed``: go-around at the MAP, the missed-approach legs to the end of the first
+holding circuit). JSBSim's terrain is set to the procedure's airport
+(:func:`fms_testbed.path.runway.terrain_elevation_m`: an approach's runway threshold, else the
+airport reference elevation, never above a SID's start), so height above ground is height
+above the runway and ground contact ends a flight that gets there.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 from pathlib import Path
 from typing import Any
 
@@ -63,8 +68,9 @@ def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     # first leg's band (coded limit, an approach's planned speed)
     lo, hi = cas_band(planned_limits(fp.seq.legs, fp.path.proc_type,
                                      cfg.limits.cas_min_mps)[0], None)
-    tas = tas_target_mps(cas_to_tas_scalar(cfg.limits.climb_tas_mps, alt), alt, lo, hi,
-                         cfg.limits.cas_min_mps)
+    dev = fp.params.isa_dev_c if fp.params is not None else 0.0
+    tas = tas_target_mps(cas_to_tas_scalar(cfg.limits.climb_tas_mps, alt, dev), alt, lo, hi,
+                         cfg.limits.cas_min_mps, dev)
     hdg = fp.path.segments[0].heading_deg   # a heading leg: its heading (drift in the plan)
     return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,
             "tas_mps": round(tas, 3), "heading_deg": (crs if hdg is None else hdg) % 360.0}
@@ -86,6 +92,26 @@ class PreparedProcedure:
     path: FlyablePath
     db: Any
 
+    @cached_property
+    def terrain_elev_m(self) -> float:
+        """Terrain elevation of the flight, m (module docstring)."""
+        from fms_testbed.core.units import FT_M
+        from fms_testbed.path.runway import terrain_elevation_m
+
+        h = terrain_elevation_m(self.db, self.path.seq)
+        p = self.path.path
+        if p.proc_type == "D" and p.legs:   # a SID starts 35 ft above its runway's end
+            h = min(h, p.legs[0].start.alt_m - 35 * FT_M)
+        return h
+
+    @cached_property
+    def runway(self):
+        """The approach's runway (:class:`~fms_testbed.path.runway.ApproachRunway`; None for
+        other procedures)."""
+        from fms_testbed.path.runway import approach_runway
+
+        return approach_runway(self.db, self.path.seq) if self.db is not None else None
+
     def guidance(self, scn: Scenario, cfg) -> tuple[ProcedureGuidance, Any]:
         """The procedure guidance and the vertical law (None: the scenario's) for a flight."""
         g = ProcedureGuidance(self.path, cfg, db=self.db, spec=self.spec,
@@ -94,19 +120,29 @@ class PreparedProcedure:
         return g, law
 
 
-def planned_wind(raw_wind, source: str) -> tuple[float, float] | None:
-    """(speed m/s, from deg true) of a scenario's ``wind:`` block, for the path to be planned
-    in it (None: calm or no block)."""
-    if not raw_wind:
-        return None
-    from fms_testbed.config.scenario import Wind
-    from pydantic import ValidationError
+def _wind_or_none(raw_wind):
+    from fms_testbed.config.scenario import WindSpec, wind_profile
+    from pydantic import TypeAdapter, ValidationError
 
+    if raw_wind is None or raw_wind == {}:
+        return None
     try:
-        w = Wind.model_validate(raw_wind)
-    except ValidationError:
+        return wind_profile(TypeAdapter(WindSpec).validate_python(raw_wind))
+    except (ValidationError, ValueError):
         return None   # parse_scenario reports it with the file and field
-    return (w.speed_ms, w.from_deg)
+
+
+def planned_conditions(raw: dict):
+    """(wind profile or None, ISA deviation K) the path of a scenario mapping is planned for:
+    its ``forecast:`` block where it gives them, else the actual ``wind:`` and
+    ``atmosphere:`` (invalid blocks count as absent: :func:`parse_scenario` reports them)."""
+    fc = raw.get("forecast") if isinstance(raw.get("forecast"), dict) else {}
+    atm = raw.get("atmosphere") if isinstance(raw.get("atmosphere"), dict) else {}
+    dev = fc.get("isa_dev_c", atm.get("isa_dev_c", 0.0))
+    dev = float(dev) if isinstance(dev, (int, float)) and not isinstance(dev, bool) else 0.0
+    if fc.get("calm") is True:
+        return None, dev
+    return _wind_or_none(fc["wind"] if fc.get("wind") is not None else raw.get("wind")), dev
 
 
 def prepare(raw: dict, source: str = "<scenario>", db=None
@@ -131,10 +167,12 @@ def prepare(raw: dict, source: str = "<scenario>", db=None
     if db is None:
         base = Path(source).parent if source and not source.startswith("<") else None
         db = load_db(spec.db, base)
-    wind = planned_wind(raw.get("wind"), source)
-    fp = build_procedure(db, spec, cfg, wind=wind)
+    wind, isa_dev_c = planned_conditions(raw)
+    fp = build_procedure(db, spec, cfg, wind=wind, isa_dev_c=isa_dev_c)
     raw.setdefault("initial", initial_from_path(fp, cfg))
-    v_min = max(cfg.limits.climb_tas_mps - (wind[0] if wind else 0.0),
+    actual = _wind_or_none(raw.get("wind"))
+    w_max = max(wind.max_speed_mps if wind else 0.0, actual.max_speed_mps if actual else 0.0)
+    v_min = max(cfg.limits.climb_tas_mps - w_max,
                 0.5 * cfg.limits.climb_tas_mps)   # into the wind
     # + two full turns: a path rebuilt in flight after a conditional leg may loop back
     r_turn = cfg.limits.climb_tas_mps ** 2 / (G0_MPS2 * math.tan(math.radians(20.0)))

@@ -5,7 +5,8 @@ read (JSBSim → :class:`AircraftState`, in :mod:`fms_testbed.sim.jsbsim_core`) 
 (the navigation source, or :class:`NavHold` between slower updates) → events (:class:`EventQueue`
 into :class:`Targets`) → guide (the guidance, merged by :func:`merge_guidance`) → lateral
 (:class:`LateralStep`: heading hold or bank hold, roll-rate limit) → vertical + command
-(:class:`VerticalStep`: the vertical law or the direct inner-loop targets, sent to JSBSim) → log.
+(:class:`VerticalStep`: the vertical law or the direct inner-loop targets, sent to JSBSim) →
+configuration (:class:`ConfigStep`: flaps and gear on the approach schedule, go-around) → log.
 
 Each step is small and testable alone; tuning (gains, limits from the aircraft file) is given at
 construction, run-time state lives in the step object.
@@ -103,30 +104,42 @@ def merge_guidance(gout: GuidanceOutput, tg: Targets) -> None:
         tg.speed_kind, tg.speed_mps, tg.vertical = "tas", gout.tas_mps, True
 
 
-def wind_ned_mps(scn: Scenario) -> tuple[float, float, float]:
-    """The scenario's steady wind as the velocity of the air, NED, m/s."""
-    if scn.wind is None:
+def wind_ned_mps(scn: Scenario, alt_m: float = 0.0) -> tuple[float, float, float]:
+    """The scenario's wind at ``alt_m`` (m; a profile is interpolated) as the velocity of the
+    air, NED, m/s."""
+    prof = scn.wind_profile
+    if prof is None:
         return (0.0, 0.0, 0.0)
-    to = math.radians(scn.wind.from_deg + 180.0)
-    return (scn.wind.speed_ms * math.cos(to), scn.wind.speed_ms * math.sin(to), 0.0)
+    n, e = prof.ned_at(alt_m)
+    return (n, e, 0.0)
 
 
 class WindRamp:
-    """Ramp the steady wind in over :data:`WIND_RAMP_S` after trim (JSBSim wind properties)."""
+    """The scenario's wind in JSBSim: ramped in over :data:`WIND_RAMP_S` after trim, and, for a
+    profile over altitude, the wind at the aircraft's present altitude set every outer step
+    (``varies``; a steady wind is set only during the ramp)."""
 
     def __init__(self, fdm, scn: Scenario, dt_outer_s: float):
-        self.wind_ned = wind_ned_mps(scn)
-        self.active = any(self.wind_ned)
+        self.profile = scn.wind_profile
+        self.active = self.profile is not None and self.profile.max_speed_mps > 0.0
+        self.varies = self.active and self.profile.layered
         self.end_s = WIND_RAMP_S + dt_outer_s
+        self.wind_ned = wind_ned_mps(scn)
         pm = fdm.get_property_manager()
         self.nodes = [pm.get_node(f"atmosphere/wind-{c}-fps", False)
                       for c in ("north", "east", "down")]
 
-    def __call__(self, t_s: float) -> None:
-        """Set the wind for time ``t_s`` (s after trim); call while ``t_s <= end_s``."""
+    def __call__(self, t_s: float, alt_m: float = 0.0) -> None:
+        """Set the wind for time ``t_s`` (s after trim) at altitude ``alt_m`` (m); call while
+        ``t_s <= end_s``, and every step when :attr:`varies`."""
         frac = min(1.0, t_s / WIND_RAMP_S)
-        for node, w in zip(self.nodes, self.wind_ned):
-            node.set_double_value(frac * w / FT_M)
+        if self.varies:
+            n, e = self.profile.ned_at(alt_m)
+            w = (n, e, 0.0)
+        else:
+            w = self.wind_ned
+        for node, c in zip(self.nodes, w):
+            node.set_double_value(frac * c / FT_M)
 
 
 class NavHold:
@@ -190,11 +203,13 @@ class VerticalStep:
     target is active (the law works in the vertical plane and returns the vertical component of
     n_y, divided here by cos φ), else the direct n_y/n_x/throttle targets."""
 
-    __slots__ = ("law", "command", "dt_s", "engaged")
+    __slots__ = ("law", "command", "dt_s", "engaged", "isa_dev_c")
 
     def __init__(self, law, aircraft, dt_outer_s: float):
         self.law, self.command, self.dt_s = law, aircraft.command, dt_outer_s
         self.engaged = False
+        # a CAS target flown as its TAS on the day (the air-data computer's temperature)
+        self.isa_dev_c = getattr(aircraft, "isa_dev_c", 0.0)
 
     def __call__(self, s: AircraftState, tg: Targets, bank_rad: float
                  ) -> tuple[float, float, float, float]:
@@ -206,7 +221,8 @@ class VerticalStep:
             alt_cmd = tg.alt_m
             if tg.speed_mps is None:
                 tg.speed_kind, tg.speed_mps = "tas", s.tas_mps
-            tas_cmd = (cas_to_tas_scalar(tg.speed_mps, s.alt_m) if tg.speed_kind == "cas"
+            tas_cmd = (cas_to_tas_scalar(tg.speed_mps, s.alt_m, self.isa_dev_c)
+                       if tg.speed_kind == "cas"
                        else tg.speed_mps)
             law = self.law
             if not self.engaged:
@@ -227,5 +243,80 @@ class VerticalStep:
         return cmd_nx, cmd_ny, nan, nan
 
 
-__all__ = ["WIND_RAMP_S", "Targets", "EventQueue", "apply_event", "merge_guidance",
+FLAP_RETRACT_MARGIN_MPS = 2.5
+"""In a go-around a detent is retracted once the CAS is this much above its selection speed,
+m/s (5 kt: no retraction at the edge of the schedule)."""
+POSITIVE_RATE_MPS = 1.0
+"""A go-around raises the gear once climbing faster than this, m/s (positive rate)."""
+
+
+def flap_index_for_cas(ap, cas_mps: float) -> int:
+    """The detent (index into ``ap.flaps``) the approach schedule has out at CAS ``cas_mps``
+    (m/s): the last one whose selection speed is at or above it."""
+    k = 0
+    for j, f in enumerate(ap.flaps):
+        if cas_mps <= f.select_cas_mps:
+            k = j
+    return min(k, ap.index(ap.landing_flap))
+
+
+class ConfigStep:
+    """Flaps and gear of an aircraft with approach settings (``AircraftConfig.approach``).
+
+    On approach a detent is selected once both the CAS and the CAS target are at or below its
+    selection speed (one detent at a time, never past the landing detent); the gear goes down
+    with ``gear_with_flap`` or at ``gear_down_height_m`` above the terrain (the runway),
+    whichever comes first. In a go-around (``go_around`` true) the flaps go to the go-around
+    detent at once, the gear comes up at a positive rate of climb, and each detent is retracted
+    when the CAS is :data:`FLAP_RETRACT_MARGIN_MPS` above its selection speed. Each change is
+    appended to ``events`` (t_s, kind 'config', detail).
+    """
+
+    __slots__ = ("ap", "configure", "k", "gear_down", "go_around", "events", "k_land",
+                 "k_ga", "k_gear")
+
+    def __init__(self, ap, aircraft, flap_index: int = 0, gear_down: bool = False,
+                 events: list | None = None):
+        self.ap, self.configure = ap, aircraft.configure
+        self.k, self.gear_down, self.go_around = flap_index, gear_down, False
+        self.events = events if events is not None else []
+        self.k_land, self.k_ga = ap.index(ap.landing_flap), ap.index(ap.go_around_flap)
+        self.k_gear = None if ap.fixed_gear else ap.index(ap.gear_with_flap)
+
+    def _event(self, t_s: float, detail: str) -> None:
+        self.events.append({"t_s": round(t_s, 2), "kind": "config", "detail": detail})
+
+    def __call__(self, s: AircraftState, tg: Targets, go_around: bool) -> None:
+        """Move flaps and gear for this step (state ``s``, targets ``tg``)."""
+        flaps, k0, g0 = self.ap.flaps, self.k, self.gear_down
+        cas = s.cas_mps
+        if go_around and not self.go_around:
+            self.go_around = True
+            self.k = min(self.k, self.k_ga)
+            self._event(s.t_s, "go-around")
+        if not self.go_around:
+            tgt = cas
+            if tg.speed_mps is not None:
+                tgt = tg.speed_mps * (cas / s.tas_mps if tg.speed_kind == "tas" and s.tas_mps > 1
+                                      else 1.0)
+            while self.k < self.k_land and cas <= flaps[self.k + 1].select_cas_mps                     and tgt <= flaps[self.k + 1].select_cas_mps:
+                self.k += 1
+            if self.k_gear is not None and not self.gear_down and (
+                    self.k >= self.k_gear or s.agl_m <= self.ap.gear_down_height_m):
+                self.gear_down = True
+        else:
+            if self.gear_down and self.k_gear is not None and s.vs_mps > POSITIVE_RATE_MPS:
+                self.gear_down = False
+            while self.k > 0 and cas >= flaps[self.k].select_cas_mps + FLAP_RETRACT_MARGIN_MPS:
+                self.k -= 1
+        if self.k != k0:
+            self._event(s.t_s, f"flaps {flaps[self.k].name}")
+        if self.gear_down != g0:
+            self._event(s.t_s, "gear down" if self.gear_down else "gear up")
+        if self.k != k0 or self.gear_down != g0:
+            self.configure(flap_cmd_norm=flaps[self.k].cmd_norm,
+                           gear_down=None if self.k_gear is None else self.gear_down)
+
+
+__all__ = ["WIND_RAMP_S", "ConfigStep", "flap_index_for_cas", "Targets", "EventQueue", "apply_event", "merge_guidance",
            "wind_ned_mps", "WindRamp", "NavHold", "LateralStep", "VerticalStep"]

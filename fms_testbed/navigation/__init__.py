@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from fms_testbed.core.contracts import NavigationSource
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.navigation.attitude_reference import AttitudeReferenceNavigation
 from fms_testbed.navigation.ins_gnss import InsGnssNavigation
 from fms_testbed.navigation.sins import SinsNavigation
 from fms_testbed.navigation.truth import TruthNavigation
@@ -20,6 +21,7 @@ SOURCES: dict[str, type] = {
     "truth": TruthNavigation,
     "sins": SinsNavigation,
     "ins_gnss": InsGnssNavigation,
+    "attitude_reference": AttitudeReferenceNavigation,
 }
 
 
@@ -40,4 +42,4 @@ def make_source(spec: dict | None, seed: int | None = None) -> NavigationSource:
 
 
 __all__ = ["SOURCES", "make_source", "NavigationSource", "TruthNavigation", "SinsNavigation",
-           "InsGnssNavigation"]
+           "InsGnssNavigation", "AttitudeReferenceNavigation"]

@@ -53,6 +53,18 @@ class FdiTuning:
     k_sensor : sensor-level step threshold in σ of the window-mean difference
     accel_window_s, gyro_window_s : short windows of the sensor-level step test, s
     reference_s : the reference window before the short one, s
+    k_residual : the fault-tolerant estimator's ε_i = k_residual √S_ii for |y_i - ŷ_i| ≤ ε_i
+    baro_fails, baro_window_s : a unit's baro channel is excluded (its gain column zeroed for
+        good) after ``baro_fails`` failed residual tests within ``baro_window_s`` s
+    k_adapt : adaptive R — a component with |ν_i| > k_adapt √S_ii inflates its R_ii
+    adapt_max : largest R inflation factor;  adapt_decay : per-update decay of the inflation
+        back towards 1
+    diverge_gamma : divergence check νᵀν > γ tr(S) (seed 001's covariance-trace test)
+
+    Every threshold is a multiple of a σ derived from the declared unit performance: the
+    filters' covariance (built from the declared IMU/GNSS/baro models) for the output and
+    estimator tests, the declared VRW/ARW densities and scale-factor/misalignment variances
+    (:func:`declared_sensor_noise`) for the sensor-level test.
     """
 
     k_pair: float = 6.0
@@ -65,6 +77,13 @@ class FdiTuning:
     accel_window_s: float = 1.0
     gyro_window_s: float = 10.0
     reference_s: float = 60.0
+    k_residual: float = 5.0
+    baro_fails: int = 5
+    baro_window_s: float = 10.0
+    k_adapt: float = 3.0
+    adapt_max: float = 100.0
+    adapt_decay: float = 0.9
+    diverge_gamma: float = 25.0
 
 
 @dataclass
@@ -82,6 +101,126 @@ def channel_sigmas(P: np.ndarray) -> np.ndarray:
     d = np.sqrt(np.maximum(P.diagonal()[:9], 0.0))
     d[6] = d[7] = max(d[6], d[7])
     return d
+
+
+VERTICAL_CHANNELS = (2, 5)
+"""Comparison channels of the vertical channel: position U and velocity U."""
+
+VERTICAL_STATES = (2, 5, 21)
+"""Filter states of the vertical channel: δp_U, δV_U and the baro bias (when there is one)."""
+
+
+def declared_sensor_noise(imus: list, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+    """The declared unit performance the sensor-level thresholds are built from.
+
+    Parameters
+    ----------
+    imus : each unit's declared :class:`~fms_testbed.sensors.sins.presets.ImuModel`
+    dt_s : sample interval, s
+
+    Returns
+    -------
+    (q_white (n, 6): accelerometer VRW² ((m/s²)²·s) and gyro ARW² (rad²/s) densities,
+    sf_var (n, 2): accelerometer and gyro scale-factor + 2 × misalignment variance), the inputs
+    of :class:`SensorComparator`
+    """
+    q = np.array([np.r_[imu.q_psd[3:6], imu.q_psd[6:9]] for imu in imus])
+    sf = np.array([(float(imu.p0_var[15:18].mean() + 2.0 * imu.p0_var[21:27].mean()),
+                    float(imu.p0_var[18:21].mean() + 2.0 * imu.p0_var[27:33].mean()))
+                   for imu in imus])
+    return q, sf
+
+
+def channel_mask(vertical_frozen: bool) -> np.ndarray:
+    """(9,) bool: the comparison channels in use — all, or all but the vertical ones when the
+    vertical channel is frozen (seed 001: no altitude → the vertical channel is excluded)."""
+    m = np.ones(9, bool)
+    if vertical_frozen:
+        m[list(VERTICAL_CHANNELS)] = False
+    return m
+
+
+def pair_flags(y: np.ndarray, sig: np.ndarray, k: float,
+               mask: np.ndarray | None = None) -> np.ndarray:
+    """Stage 1 of one instant: ν_ij = 1 when some channel of y_i - y_j exceeds
+    ε_N = k √(σ_i² + σ_j²) (seed 001), for the pairs (1,2), (1,3), (2,3).
+
+    Parameters
+    ----------
+    y : (n, 9) comparison vectors (position m, velocity m/s, roll/pitch/heading rad)
+    sig : (n, 9) their σ (:func:`channel_sigmas`);  k : threshold in σ
+    mask : (9,) bool channels compared (None: all)
+
+    Returns
+    -------
+    (3,) int, 0 for a pair with a unit beyond ``n``
+    """
+    y, sig = np.asarray(y, float), np.asarray(sig, float)
+    m = np.ones(y.shape[1], bool) if mask is None else np.asarray(mask, bool)
+    out = np.zeros(3, int)
+    for k_, (a, b) in enumerate(PAIRS):
+        if b < y.shape[0]:
+            d = _diff(y[a], y[b])
+            out[k_] = int((np.abs(d) > k * np.sqrt(sig[a] ** 2 + sig[b] ** 2))[m].any())
+    return out
+
+
+def majority(nu) -> int | None:
+    """Seed 001's table: the failed unit's index for (ν12, ν13, ν23), None when it names none."""
+    return MAJORITY.get(tuple(int(v) for v in nu))
+
+
+def residual_ok(nu: np.ndarray, S: np.ndarray, k: float) -> np.ndarray:
+    """Seed 001's channel test |y_i - ŷ_i| ≤ ε_i, ε_i = k √S_ii, per measurement component.
+
+    Parameters
+    ----------
+    nu : (m,) innovations y - H ẑ;  S : (m, m) their covariance;  k : threshold in σ
+    """
+    return np.abs(nu) <= k * np.sqrt(np.diag(S))
+
+
+def frozen_states(n_states: int, vertical: bool) -> np.ndarray:
+    """(n,) bool gain-row mask of the fault-tolerant estimator ż = Φ(ẑ) + K (y - H ẑ): rows of
+    a frozen channel are zeroed (those states keep their prediction); ``vertical`` freezes
+    :data:`VERTICAL_STATES` (those that exist)."""
+    m = np.zeros(n_states, bool)
+    if vertical:
+        m[[s for s in VERTICAL_STATES if s < n_states]] = True
+    return m
+
+
+def adaptive_r(scale: np.ndarray, nu: np.ndarray, S: np.ndarray, R: np.ndarray,
+               tuning: FdiTuning = FdiTuning()) -> tuple[np.ndarray, bool]:
+    """Adaptive-R step (seed 001's adaptive variant) for one measurement group.
+
+    A component with |ν_i| > k_adapt √S_ii gets R_ii inflated to what its innovation says,
+    R_ii ← ν_i² - (H P Hᵀ)_ii (innovation matching, H P Hᵀ = S - R_used), capped at
+    ``adapt_max`` × nominal; otherwise the inflation decays by ``adapt_decay`` towards 1.
+    Divergence check: νᵀν > γ tr(S') with S' = H P Hᵀ + R at the new inflation and that
+    inflation at its cap — more R cannot explain the residual, the channel is diverging.
+
+    Parameters
+    ----------
+    scale : (m,) current inflation of the nominal R's diagonal (≥ 1)
+    nu : (m,) innovations;  S : (m, m) their covariance with the inflated R
+    R : (m, m) nominal measurement covariance;  tuning : ``k_adapt``, ``adapt_max``,
+        ``adapt_decay``, ``diverge_gamma``
+
+    Returns
+    -------
+    (new scale (m,), diverging)
+    """
+    scale = np.asarray(scale, float)
+    r0 = np.diag(R)
+    hph = np.diag(S) - r0 * scale
+    bad = ~residual_ok(nu, S, tuning.k_adapt)
+    want = np.clip((np.asarray(nu) ** 2 - hph) / r0, 1.0, tuning.adapt_max)
+    new = np.where(bad, np.maximum(scale, want), np.maximum(1.0, scale * tuning.adapt_decay))
+    S_new = hph.sum() + float(r0 @ new)                   # tr(S) with the new inflation
+    diverging = bool(float(nu @ nu) > tuning.diverge_gamma * S_new
+                     and (new >= tuning.adapt_max - 1e-9).any())
+    return new, diverging
 
 
 def _diff(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -117,16 +256,17 @@ class TwoStageFdi:
         total, dof = sum(b[1] for b in buf), sum(b[2] for b in buf)
         return total > chi2.isf(self.tuning.alpha, dof)
 
-    def pairwise(self, t_s: float, y: list[np.ndarray], sig: list[np.ndarray]) -> tuple:
-        """Stage 1: (ν12, ν13, ν23) with persistence (pairs with a unit out of use read 0)."""
+    def pairwise(self, t_s: float, y: list[np.ndarray], sig: list[np.ndarray],
+                 mask: np.ndarray | None = None) -> tuple:
+        """Stage 1: (ν12, ν13, ν23) with persistence (pairs with a unit out of use read 0) over
+        the channels in ``mask`` (:func:`channel_mask`)."""
         out = []
-        for a, b in PAIRS:
+        flags = pair_flags(np.array(y), np.array(sig), self.tuning.k_pair, mask)
+        for k, (a, b) in enumerate(PAIRS):
             if b >= self.n or not (self.state.used[a] and self.state.used[b]):
                 out.append(0)
                 continue
-            bad = bool((np.abs(_diff(y[a], y[b]))
-                        > self.tuning.k_pair * np.sqrt(sig[a] ** 2 + sig[b] ** 2)).any())
-            if bad:
+            if flags[k]:
                 t0 = self.state.since.setdefault((a, b), t_s)
                 out.append(int(t_s - t0 >= self.tuning.persist_s - 1e-9))
             else:
@@ -134,21 +274,22 @@ class TwoStageFdi:
                 out.append(0)
         return tuple(out)
 
-    def _prediction_fails(self, i: int, y, sig) -> bool:
+    def _prediction_fails(self, i: int, y, sig, mask=None) -> bool:
         others = [j for j in range(self.n) if j != i and self.state.used[j]]
         if not others:
             return False
         ym = sum(y[j] for j in others) / len(others)
         sm2 = sum(sig[j] ** 2 for j in others) / len(others)
-        return bool((np.abs(_diff(y[i], ym)) > self.tuning.k_est * np.sqrt(sig[i] ** 2 + sm2)).any())
+        bad = np.abs(_diff(y[i], ym)) > self.tuning.k_est * np.sqrt(sig[i] ** 2 + sm2)
+        return bool(bad[mask].any() if mask is not None else bad.any())
 
     def update(self, t_s: float, y: list[np.ndarray], sig: list[np.ndarray],
-               nu_sensor: tuple = (0, 0, 0)) -> list[dict]:
-        """Run both stages at ``t_s`` (s) on the output comparison (``y``, ``sig``) and the
-        sensor-level pair verdicts ``nu_sensor``; return the events (detected, isolated,
-        excluded, reconfigured) and update :attr:`state.used`."""
+               nu_sensor: tuple = (0, 0, 0), mask: np.ndarray | None = None) -> list[dict]:
+        """Run both stages at ``t_s`` (s) on the output comparison (``y``, ``sig``, channels in
+        ``mask``) and the sensor-level pair verdicts ``nu_sensor``; return the events
+        (detected, isolated, excluded, reconfigured) and update :attr:`state.used`."""
         events: list[dict] = []
-        nu_out = self.pairwise(t_s, y, sig)
+        nu_out = self.pairwise(t_s, y, sig, mask)
         nu = tuple(int(a or (b and self._pair_live(k))) for k, (a, b) in
                    enumerate(zip(nu_out, nu_sensor)))
         if any(nu) and not any(self.nu):
@@ -165,7 +306,8 @@ class TwoStageFdi:
         if suspect is not None:
             events.append({"t_s": round(t_s, 3), "unit": f"ins{suspect + 1}", "kind": "isolated",
                            "stage": "pairwise", "reason": f"majority table {nu}"})
-            if self._innovation_fails(suspect, t_s) or self._prediction_fails(suspect, y, sig):
+            if (self._innovation_fails(suspect, t_s)
+                    or self._prediction_fails(suspect, y, sig, mask)):
                 events += self._exclude(suspect, t_s, "estimator check failed")
             elif t_s - self._suspect[1] >= self.tuning.isolate_s - 1e-9:
                 events += self._exclude(suspect, t_s, f"named by the majority table for "
@@ -196,15 +338,13 @@ class TwoStageFdi:
                 {"t_s": round(t_s, 3), "unit": "fms", "kind": "reconfigured",
                  "stage": "estimator", "reason": "output from " + (", ".join(left) or "none")}]
 
-    def vote(self, y: list[np.ndarray], sig: list[np.ndarray]) -> list[int]:
+    def vote(self, y: list[np.ndarray], sig: list[np.ndarray],
+             mask: np.ndarray | None = None) -> list[int]:
         """Majority voting: the units the majority table of this instant's output comparison
         (all units, no persistence, no sensor level, no estimator) does not flag."""
         if self.n != 3:
             return list(range(self.n))
-        nu = tuple(int((np.abs(_diff(y[a], y[b]))
-                        > self.tuning.k_pair * np.sqrt(sig[a] ** 2 + sig[b] ** 2)).any())
-                   for a, b in PAIRS)
-        bad = MAJORITY.get(nu)
+        bad = majority(pair_flags(np.array(y), np.array(sig), self.tuning.k_pair, mask))
         return [i for i in range(self.n) if i != bad]
 
 
@@ -296,4 +436,84 @@ class SensorComparator:
         return tuple(out.get(p, 0) for p in PAIRS)
 
 
-__all__ = ["FdiTuning", "MAJORITY", "SensorComparator", "TwoStageFdi", "channel_sigmas"]
+class FaultTolerantEstimator:
+    """Seed 001's fault-tolerant estimator around the units' filters: the channel test
+    |y_i - ŷ_i| ≤ ε_i on every measurement component, latched exclusion of a unit's baro
+    channel (its gain column zeroed for good), freezing of the vertical channel when a unit has
+    no altitude measurement left (its gain rows zeroed, :func:`frozen_states`, and the vertical
+    comparison channels excluded, :func:`channel_mask`), and the adaptive-R variant
+    (:func:`adaptive_r`, off unless ``adaptive``).
+
+    Parameters
+    ----------
+    filters : the units' filters (their public ``frozen`` mask and ``r_scale`` are set)
+    tuning : thresholds;  adaptive : run the adaptive-R variant
+    """
+
+    def __init__(self, filters: list, tuning: FdiTuning = FdiTuning(), adaptive: bool = False):
+        self.filters, self.tuning, self.adaptive = filters, tuning, bool(adaptive)
+        n = len(filters)
+        self.baro_excluded = [False] * n
+        self.vertical_frozen = [False] * n
+        self._baro_fails: list[list[float]] = [[] for _ in range(n)]
+        self._diverging = [dict() for _ in range(n)]
+
+    def _unit(self, i: int, sensor: str) -> str:
+        return sensor if len(self.filters) == 1 else f"{sensor}@ins{i + 1}"
+
+    def check(self, i: int, t_s: float, groups: list) -> list[dict]:
+        """Residual tests of unit ``i``'s measurement groups (:class:`.ins_filter.GroupResult`)
+        at ``t_s`` (s); returns the events (baro channel excluded, adaptive-R divergence)."""
+        ev: list[dict] = []
+        f = self.filters[i]
+        for g in groups:
+            ok = residual_ok(g.innovation, g.S, self.tuning.k_residual)
+            if g.name == "baro" and not self.baro_excluded[i]:
+                buf = self._baro_fails[i]
+                if not ok.all():
+                    buf.append(t_s)
+                while buf and buf[0] < t_s - self.tuning.baro_window_s:
+                    buf.pop(0)
+                if len(buf) >= self.tuning.baro_fails:
+                    self.baro_excluded[i] = True
+                    ev.append({"t_s": round(t_s, 3), "unit": self._unit(i, "baro"),
+                               "kind": "excluded", "stage": "estimator",
+                               "reason": f"baro residual beyond {self.tuning.k_residual:g}σ "
+                                         f"{len(buf)} times in {self.tuning.baro_window_s:g} s: "
+                                         "its gain column zeroed"})
+            if self.adaptive and hasattr(f, "r_scale") and g.name in f.r_scale:
+                R = f.nominal_r(g.name)
+                f.r_scale[g.name], div = adaptive_r(f.r_scale[g.name], g.innovation, g.S, R,
+                                                    self.tuning)
+                if div and not self._diverging[i].get(g.name):
+                    ev.append({"t_s": round(t_s, 3), "unit": self._unit(i, g.name.split("_")[0]),
+                               "kind": "detected", "stage": "adaptive_r",
+                               "reason": f"{g.name} diverging: νᵀν > {self.tuning.diverge_gamma:g}"
+                                         f" tr(S) with R at {self.tuning.adapt_max:g}× nominal"})
+                self._diverging[i][g.name] = div
+        return ev
+
+    def set_vertical(self, i: int, t_s: float, has_altitude: bool) -> list[dict]:
+        """Freeze (``has_altitude`` False) or release unit ``i``'s vertical channel; returns the
+        ``reconfigured`` event of a change."""
+        frozen = not has_altitude
+        if frozen == self.vertical_frozen[i]:
+            return []
+        self.vertical_frozen[i] = frozen
+        f = self.filters[i]
+        if hasattr(f, "frozen"):
+            f.frozen[:] = frozen_states(f.frozen.size, frozen)
+        return [{"t_s": round(t_s, 3), "unit": self._unit(i, "ins"), "kind": "reconfigured",
+                 "stage": "estimator",
+                 "reason": ("vertical channel frozen and excluded: no altitude measurement"
+                            if frozen else "vertical channel released: altitude measured")}]
+
+    def mask(self, used: list[bool] | None = None) -> np.ndarray:
+        """Comparison channels: the vertical ones out when a unit in use has it frozen."""
+        live = range(len(self.filters)) if used is None else [i for i, u in enumerate(used) if u]
+        return channel_mask(any(self.vertical_frozen[i] for i in live))
+
+
+__all__ = ["FaultTolerantEstimator", "FdiTuning", "MAJORITY", "SensorComparator", "TwoStageFdi",
+           "VERTICAL_CHANNELS", "VERTICAL_STATES", "adaptive_r", "channel_mask", "channel_sigmas",
+           "declared_sensor_noise", "frozen_states", "majority", "pair_flags", "residual_ok"]

@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import numpy as np
+from numba import njit
 
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.navigation.sins import SinsNavigation
@@ -23,10 +24,32 @@ from fms_testbed.sensors.sins.analysis import SinsOptions
 from fms_testbed.sensors.sins.presets import ImuModel
 
 
-def _gamma(v: np.ndarray) -> np.ndarray:
-    """Γ (3×6) of the misalignment model: rows [v_y v_z 0 0 0 0], [0 0 v_x v_z 0 0],
-    [0 0 0 0 v_x v_y] (paper eq. 5.1)."""
-    return np.array([[v[1], v[2], 0, 0, 0, 0], [0, 0, v[0], v[2], 0, 0], [0, 0, 0, 0, v[0], v[1]]])
+@njit(cache=True)
+def _advance(phi, x, L, noise):
+    """x_k = Φ x_{k-1} + S N_k (paper eq. 6.11), the same expression as the SINS kernel's."""
+    return phi @ x + L @ noise
+
+
+@njit(cache=True)
+def _sensor_errors(X, comp, f, w, sd, z):
+    """(n, 6) raw IMU output errors of n units (see :meth:`InsBank.sensor_errors`): X (n, 33)
+    error states, comp (n, 6) compensation fed back, f (3,) m/s², w (3,) rad/s, sd (n, 6) white
+    σ per sample, z (n, 6) standard normals."""
+    n = X.shape[0]
+    out = np.empty((n, 6))
+    for i in range(n):
+        x = X[i]
+        # Γ(v) m (paper eq. 5.1): rows [v_y v_z 0 0 0 0], [0 0 v_x v_z 0 0], [0 0 0 0 v_x v_y]
+        ga = (f[1] * x[21] + f[2] * x[22], f[0] * x[23] + f[2] * x[24],
+              f[0] * x[25] + f[1] * x[26])
+        gw = (w[1] * x[27] + w[2] * x[28], w[0] * x[29] + w[2] * x[30],
+              w[0] * x[31] + w[1] * x[32])
+        for a in range(3):
+            out[i, a] = (x[9 + a] + comp[i, a]) + x[15 + a] * f[a] + ga[a]
+            out[i, 3 + a] = (x[12 + a] + comp[i, 3 + a]) + x[18 + a] * w[a] + gw[a]
+        for c in range(6):
+            out[i, c] += sd[i, c] * z[i, c]
+    return out
 
 
 def derive_seeds(seed: int, n: int) -> list[int]:
@@ -42,16 +65,22 @@ class InsBank:
     imus : one declared IMU model per unit
     seeds : one seed per unit (:func:`derive_seeds`)
     method : discretisation of the truth error model (``picard`` or ``vanloan``)
+    share : units with the same IMU model object share one step's (Φ_k, S_k): every unit's
+        error model is built at the same true state, so the matrices are the same numbers;
+        only x_k = Φ x + S N_k (own noise N_k) is per unit (False: each unit rebuilds them)
     """
 
-    def __init__(self, imus: list[ImuModel], seeds: list[int], method: str = "picard"):
+    def __init__(self, imus: list[ImuModel], seeds: list[int], method: str = "picard",
+                 share: bool = True):
         if len(imus) != len(seeds):
             raise ValueError("one seed per INS unit")
         opts = SinsOptions(method=method, vertical="free")
         self.units = [SinsNavigation(imu, seed=s, opts=opts) for imu, s in zip(imus, seeds)]
         self.stuck: dict[int, NavSolution] = {}          # unit → its frozen output
         self.compensation = np.zeros((len(self.units), 6))  # bias compensation fed back so far
+        self.fed_back = np.zeros((len(self.units), 15))      # corrections since take_fed_back
         self._rng = np.random.default_rng(np.random.SeedSequence(seeds).spawn(1)[0])
+        self.share = bool(share)
 
     def __len__(self) -> int:
         return len(self.units)
@@ -59,7 +88,22 @@ class InsBank:
     def update(self, truth: AircraftState) -> list[NavSolution]:
         """Advance every unit to ``truth.t_s`` and return their outputs (indicated solutions); a
         stuck unit repeats its frozen output (time stamp advancing)."""
-        out = [u.update(truth) for u in self.units]
+        out = []
+        lead = None                          # a unit that just built this step's matrices
+        for u in self.units:
+            prev = u._prev
+            lm = lead.last_matrices if lead is not None else None
+            if (lm is not None and prev is lm[0] and u.imu is lead.imu and u.opts == lead.opts
+                    and u.matrices_dt_s == 0 and truth.t_s - prev.t_s == lm[1]):
+                u.x = _advance(lm[2], u.x, lm[3], u._next_noise())
+                u._gains = lead._gains
+                u._prev = truth
+                out.append(u.solution(truth))
+                continue
+            out.append(u.update(truth))
+            lm = u.last_matrices
+            lead = u if (self.share and prev is not None and lm is not None and lm[0] is prev
+                         ) else None
         for i, held in self.stuck.items():
             out[i] = replace(held, t_s=truth.t_s)
         return out
@@ -75,6 +119,15 @@ class InsBank:
         b_g rad/s) from unit ``i``'s error state."""
         self.units[i].x[:15] -= dx
         self.compensation[i] += dx[9:15]
+        self.fed_back[i] += dx
+
+    def take_fed_back(self) -> np.ndarray:
+        """(n, 15) the corrections fed back to each unit since the last call (δp m, δV m/s, ε
+        rad, b_a m/s², b_g rad/s), then zeroed: what a free-running copy of each unit would not
+        have had (:mod:`.reference_description`)."""
+        out = self.fed_back.copy()
+        self.fed_back[:] = 0.0
+        return out
 
     def sensor_errors(self, truth: AircraftState, dt_s: float) -> np.ndarray:
         """(n, 6) what each unit's IMU outputs minus the truth over the last ``dt_s`` (s): the
@@ -85,15 +138,11 @@ class InsBank:
         the same density as the noise inside the error model, not the same numbers)."""
         f = np.asarray(truth.f_body_mps2, float)
         w = np.array([truth.p_rps, truth.q_rps, truth.r_rps])
-        gf, gw = _gamma(f), _gamma(w)
-        out = np.empty((len(self.units), 6))
-        for i, u in enumerate(self.units):
-            x = u.x
-            b = x[9:15] + self.compensation[i]       # the sensor's bias, not the residual
-            out[i, :3] = b[:3] + x[15:18] * f + gf @ x[21:27]
-            out[i, 3:] = b[3:] + x[18:21] * w + gw @ x[27:33]
-            out[i] += np.sqrt(u.imu.q_psd[3:9] / dt_s) * self._rng.standard_normal(6)
-        return out
+        n = len(self.units)
+        # the sensor's bias is the error state's residual plus the compensation fed back
+        X = np.array([u.x for u in self.units])
+        sd = np.array([np.sqrt(u.imu.q_psd[3:9] / dt_s) for u in self.units])
+        return _sensor_errors(X, self.compensation, f, w, sd, self._rng.standard_normal((n, 6)))
 
     def freeze(self, i: int, last: NavSolution) -> None:
         """Unit ``i``'s output sticks at ``last`` from now on (a stuck-output fault)."""

@@ -122,7 +122,19 @@ def _predict_step(x, P, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol)
     """Fused prediction: F at the INS output (33-state model's INS block, free vertical; the
     GNSS/baro states' decay) → Picard (Φ, Q_k) → (Φ x, Φ P Φᵀ + Q_k, Φ, status); status 0 ok,
     1 Δt/τ beyond the Picard range, 2 no convergence. Returns (x, P, Φ, Q_k, status)."""
-    n = x.size
+    phi, qk, status = _filter_phi_q(x.size, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt,
+                                    tol)
+    if status:
+        return x, P, phi, qk, status
+    xn, Pn = predict(x, P, phi, qk)
+    return xn, Pn, phi, qk, 0
+
+
+@njit(cache=True)
+def _filter_phi_q(n, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol):
+    """(Φ, Q_k, status) of the filter's n-state model over ``dt`` at the given state (see
+    :func:`_predict_step`; status 0 ok, 1 Picard range, 2 no convergence; F returned twice when
+    status != 0)."""
     c = _c_bn(rpy[0], rpy[1], rpy[2])
     w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(lat), OMEGA_IE_RPS * math.sin(lat)])
     w_ib = w_eb + c.T @ w_ie
@@ -135,12 +147,66 @@ def _predict_step(x, P, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol)
             F[i, i] = -decay[i]
         rate = max(rate, abs(F[i, i]))
     if rate * dt > PICARD_MAX_RATE_DT:
-        return x, P, F, F, 1
+        return F, F, 1
     phi, qk, _, ok = _picard_sins(F, q, dt, tol, PICARD_MAX_ORDER)
     if not ok:
-        return x, P, F, F, 2
-    xn, Pn = predict(x, P, phi, qk)
-    return xn, Pn, phi, qk, 0
+        return F, F, 2
+    return phi, qk, 0
+
+
+@njit(cache=True)
+def _predict_many(X, P, lat, alt, V, RPY, w_eb, f_b, decay24, decay, q, dt, tol):
+    """:func:`_predict_step` for k filters of one IMU model at once (one call instead of k):
+    X (k, n), P (k, n, n), lat/alt (k,), V/RPY (k, 3) their INS outputs; the same arithmetic per
+    filter, so the same numbers. Returns (X, P, Φ (k, n, n), Q_k (k, n, n), status (k,))."""
+    k, n = X.shape
+    Xn, Pn = np.empty_like(X), np.empty_like(P)
+    phis, qks = np.empty_like(P), np.empty_like(P)
+    status = np.zeros(k, np.int64)
+    for i in range(k):
+        x, Pi, phi, qk, st = _predict_step(X[i], P[i], lat[i], alt[i], V[i], RPY[i], w_eb, f_b,
+                                           decay24, decay, q, dt, tol)
+        status[i] = st
+        if st == 0:
+            Xn[i], Pn[i], phis[i], qks[i] = x, Pi, phi, qk
+    return Xn, Pn, phis, qks, status
+
+
+def predict_filters(filters: list["InsGnssFilter"], ins: list[NavSolution],
+                    truth: AircraftState, dt_s: float) -> None:
+    """``filters[i].predict(ins[i], truth, dt_s)`` for every filter, in one compiled call when
+    they share one IMU model, receiver, baro and tuning with the Picard method (the process noise
+    of the step, which depends only on the truth and the IMU model, is computed once); the same
+    numbers as the per-filter calls.
+
+    Raises
+    ------
+    DiscretisationError : as :meth:`InsGnssFilter.predict`
+    """
+    f0 = filters[0]
+    if (len(filters) == 1 or f0.tuning.method != "picard"
+            or any(f.imu is not f0.imu or f.gnss is not f0.gnss or f.baro is not f0.baro
+                   or f.tuning != f0.tuning for f in filters[1:])):
+        for f, sol in zip(filters, ins):
+            f.predict(sol, truth, dt_s)
+        return
+    lat = np.array([s.lat_rad for s in ins])
+    alt = np.array([s.alt_m for s in ins])
+    V = np.array([s.v_enu_mps for s in ins], float)
+    RPY = np.array([(s.roll_rad, s.pitch_rad, s.heading_rad) for s in ins])
+    X = np.array([f.x for f in filters])
+    P = np.array([f.P for f in filters])
+    X, P, phis, qks, status = _predict_many(
+        X, P, lat, alt, V, RPY, np.array([truth.p_rps, truth.q_rps, truth.r_rps]),
+        np.asarray(truth.f_body_mps2, float), f0._decay24, f0.decay, f0._process_noise(truth),
+        float(dt_s), 1e-12)
+    if status.any():
+        raise DiscretisationError(
+            f"navigation.filter: Picard series unsuitable at dt = {dt_s:g} s (Δt/τ > "
+            f"{PICARD_MAX_RATE_DT} or no convergence); set navigation.filter.method: vanloan")
+    for i, f in enumerate(filters):
+        f.x, f.P = X[i], P[i]
+        f._record_step(ins[i].t_s, phis[i], qks[i], dt_s)
 
 
 class InsGnssFilter:
@@ -173,6 +239,10 @@ class InsGnssFilter:
         self.P = np.zeros((n, n))
         self._decay24 = np.ascontiguousarray(imu.decay_rps, float)
         self._no_freeze = np.zeros(n, np.bool_)
+        # public view of the gain-row mask (seed 001's fault-tolerant estimator, set by
+        # fdi.FaultTolerantEstimator) and the adaptive-R inflation per group (1: nominal R)
+        self.frozen = self._no_freeze
+        self.r_scale = {"gnss_pos": np.ones(3), "gnss_vel": np.ones(3), "baro": np.ones(1)}
         self._lag: list[tuple[float, np.ndarray, np.ndarray]] = []   # (t_start_s, Φ, Q_k)
         self.t_s: float | None = None
         R = np.zeros(n)
@@ -269,10 +339,14 @@ class InsGnssFilter:
                 phi, qk = discretize(F, np.diag(q), dt_s, method="vanloan")
             x, P = predict(self.x, self.P, phi, qk)
         self.x, self.P = x, P
-        self._lag.append((ins.t_s, phi, qk))
+        self._record_step(ins.t_s, phi, qk, dt_s)
+
+    def _record_step(self, t0_s: float, phi: np.ndarray, qk: np.ndarray, dt_s: float) -> None:
+        """Keep a prediction step's (Φ, Q_k) for delayed measurements; advance the time."""
+        self._lag.append((t0_s, phi, qk))
         if len(self._lag) > 64:
             del self._lag[:-64]
-        self.t_s = ins.t_s + dt_s
+        self.t_s = t0_s + dt_s
 
     # -- measurements ----------------------------------------------------------------------
     def _lag_since(self, t_m: float):
@@ -286,7 +360,15 @@ class InsGnssFilter:
             q_lag = phi @ q_lag @ phi.T + qk
         return phi_lag, q_lag
 
+    def nominal_r(self, name: str) -> np.ndarray:
+        """The declared measurement covariance of group ``name`` (before adaptive inflation)."""
+        return {"gnss_pos": self._r_pos, "gnss_vel": self._r_vel}.get(name) if name != "baro" \
+            else self._r_baro
+
     def _group(self, name, z, H, R, lag) -> GroupResult:
+        sc = self.r_scale[name]
+        if (sc != 1.0).any():
+            R = R * np.sqrt(np.outer(sc, sc))
         if lag is None:
             nu, S, nis = innovation(self.x, self.P, z, H, R)
         else:
@@ -324,4 +406,5 @@ class InsGnssFilter:
         return dx
 
 
-__all__ = ["FilterTuning", "GroupResult", "InsGnssFilter", "STATE_NAMES", "enu_difference_m"]
+__all__ = ["FilterTuning", "GroupResult", "InsGnssFilter", "STATE_NAMES", "enu_difference_m",
+           "predict_filters"]

@@ -46,10 +46,14 @@ from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.navigation.ins_bank import InsBank, derive_seeds
 from fms_testbed.navigation.faults import check_fault, inject
-from fms_testbed.navigation.fdi import SensorComparator, TwoStageFdi, channel_sigmas
+from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
+                                        TwoStageFdi,
+                                        channel_sigmas, declared_sensor_noise)
 from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter,
-                                               _unmodelled_variances, enu_difference_m)
+                                               _unmodelled_variances, enu_difference_m,
+                                               predict_filters)
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
+from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor
 from fms_testbed.sensors.baro import BaroAltimeter, BaroSpec
 from fms_testbed.sensors.gnss import GnssReceiver, GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.analysis import horizontal_radius
@@ -125,6 +129,10 @@ class InsGnssNavigation:
         self.bank, self.receiver, self.baro, self.filters = bank, receiver, baro, filters
         self.alert_delay_s = float(alert_delay_s)
         self.fdi = fdi
+        # seed 001's fault-tolerant estimator (channel tests, baro exclusion, vertical freezing)
+        self.ft = FaultTolerantEstimator(filters, fdi.tuning if fdi is not None else FdiTuning())
+        # Zaitseva's reference-description monitor (three units; set by from_spec)
+        self.refdesc: ReferenceDescriptionMonitor | None = None
         self.comparator: SensorComparator | None = None     # built at the second step (dt)
         self.events: list[dict] = []
         self._prev_truth: AircraftState | None = None
@@ -134,6 +142,7 @@ class InsGnssNavigation:
         self._last_fix_used_s = -math.inf
         self._prev_sensor_t: float | None = None
         self.nis_log: list[tuple[float, str, float, int]] = []   # unit 0: (t_s, group, NIS, dim)
+        self.fused = True        # one compiled prediction for all filters (False: one per filter)
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "InsGnssNavigation":
@@ -160,6 +169,8 @@ class InsGnssNavigation:
         src = cls(bank, GnssReceiver(g, seeds[0]), baro, filters,
                   DEFAULT_ALERT_DELAY_S if b.alert_delay_s is None else b.alert_delay_s, fdi)
         src.seed = sd
+        if b.n_ins == 3:
+            src.refdesc = ReferenceDescriptionMonitor([f.imu for f in filters])
         return src
 
     # -- faults ----------------------------------------------------------------------------
@@ -200,11 +211,16 @@ class InsGnssNavigation:
         ins = self.bank.update(truth)
         t = truth.t_s
         prev = self._prev_truth
-        for i, f in enumerate(self.filters):
-            if prev is None:
+        if prev is None:
+            for i, f in enumerate(self.filters):
                 f.initialise(ins[i])
-            elif t > prev.t_s:
-                f.predict(self._prev_ins[i], prev, t - prev.t_s)
+        elif t > prev.t_s:
+            if self.fused:
+                predict_filters(self.filters, self._prev_ins, prev, t - prev.t_s)
+            else:
+                for i, f in enumerate(self.filters):
+                    f.predict(self._prev_ins[i], prev, t - prev.t_s)
+        for i in range(len(self.filters)):
             buf = self._buffer[i]
             buf.append(ins[i])
             while buf and buf[0].t_s < t - _BUFFER_S:
@@ -214,7 +230,9 @@ class InsGnssNavigation:
                 at = self._ins_at(i, fix.t_s)
                 if at is None:
                     continue
+                self.events += self.ft.set_vertical(i, t, True)      # altitude measured
                 groups = f.gnss_update(fix, at)
+                self.events += self.ft.check(i, t, groups)
                 for r in groups:
                     if i == 0:
                         self.nis_log.append((fix.t_s, r.name, r.nis, r.innovation.size))
@@ -229,7 +247,11 @@ class InsGnssNavigation:
         reading = self.baro.update(truth) if self.baro is not None else None
         if reading is not None:
             for i, f in enumerate(self.filters):
-                self._gate_events(i, t, [f.baro_update(reading, ins[i])])
+                if self.ft.baro_excluded[i]:
+                    continue                       # the baro channel's gain column is zero
+                g = f.baro_update(reading, ins[i])
+                self._gate_events(i, t, [g])
+                self.events += self.ft.check(i, t, [g])
         self._prev_truth, self._prev_ins = truth, ins
         return self.solution(truth, ins)
 
@@ -241,8 +263,7 @@ class InsGnssNavigation:
             return (0, 0, 0)
         dt = truth.t_s - prev
         if self.comparator is None:
-            q = np.array([np.r_[u.imu.q_psd[3:6], u.imu.q_psd[6:9]] for u in self.bank.units])
-            sf = np.array([_unmodelled_variances(f.imu) for f in self.filters])
+            q, sf = declared_sensor_noise([f.imu for f in self.filters], dt)
             self.comparator = SensorComparator(len(self.bank), q, dt, sf, self.fdi.tuning)
         return self.comparator.update(truth.t_s, self.bank.sensor_errors(truth, dt),
                                       truth.f_body_mps2, (truth.p_rps, truth.q_rps, truth.r_rps))
@@ -259,23 +280,56 @@ class InsGnssNavigation:
             out.append(y)
         return out
 
+    def _reference_description(self, truth: AircraftState, ins: list[NavSolution],
+                               sols: list[tuple], used: list[int], extra: dict) -> list[int]:
+        """Run the reference-description monitor against the integrated solution of the units
+        in ``used``; log its output (``nse_ref_*``, ``ins_used_ref``, ``refdesc_d_ins*``) and
+        return the units both it and the two-stage identification keep (``used`` if none)."""
+        base = used or list(range(len(sols)))
+        P_int = sum(self.filters[i].P for i in base) / len(base)
+        self.events += self.refdesc.update(truth, ins, _mean_solution([sols[i] for i in base]),
+                                           P_int, [f.P for f in self.filters],
+                                           self.bank.take_fed_back())
+        ref_used = [i for i in range(len(sols)) if self.refdesc.used[i]]
+        ref = _mean_solution([sols[i] for i in ref_used])
+        rm, rn = radii_m(truth.lat_rad)
+        extra["nse_ref_east_m"] = ((ref[1] - truth.lon_rad) * (rn + truth.alt_m)
+                                   * math.cos(truth.lat_rad))
+        extra["nse_ref_north_m"] = (ref[0] - truth.lat_rad) * (rm + truth.alt_m)
+        extra["ins_used_ref"] = float(sum(1 << i for i in ref_used))
+        for i, d in enumerate(self.refdesc.d):
+            extra[f"refdesc_d_ins{i + 1}"] = float(d)
+        both = [i for i in used if i in ref_used]
+        return both or used
+
     def solution(self, truth: AircraftState, ins: list[NavSolution]) -> NavSolution:
         """The output: the mean of the units in use (unit 0 alone without identification), the
         mean of their covariances, ANP, and the logged columns."""
         sols = [corrected(ins[i], f.x[:9]) for i, f in enumerate(self.filters)]
         used = list(range(len(sols)))
         extra: dict[str, float] = {}
+        coasting = (math.isfinite(self._last_fix_used_s)      # not before the first fix
+                    and truth.t_s - self._last_fix_used_s > 2.0 * self.receiver.period_s
+                    + self.receiver.spec.latency_s + 1e-6)
+        for i in range(len(self.filters)):         # no altitude measurement: vertical frozen
+            has_alt = not coasting or (self.baro is not None and not self.ft.baro_excluded[i])
+            self.events += self.ft.set_vertical(i, truth.t_s, has_alt)
         if self.fdi is not None:
             y = self._comparison(sols)
             sig = [channel_sigmas(f.P) for f in self.filters]
-            self.events += self.fdi.update(truth.t_s, y, sig, self._sensor_pairs(truth))
+            mask = self.ft.mask(self.fdi.state.used)
+            self.events += self.fdi.update(truth.t_s, y, sig, self._sensor_pairs(truth), mask)
             used = [i for i, u in enumerate(self.fdi.state.used) if u]
-            vote = _mean_solution([sols[i] for i in self.fdi.vote(y, sig)])
+            voted = self.fdi.vote(y, sig, mask)
+            vote = _mean_solution([sols[i] for i in voted])
             rm, rn = radii_m(truth.lat_rad)
-            extra = {"nse_vote_east_m": (vote[1] - truth.lon_rad) * (rn + truth.alt_m)
+            extra = {"ins_used_vote": float(sum(1 << i for i in voted)),
+                     "nse_vote_east_m": (vote[1] - truth.lon_rad) * (rn + truth.alt_m)
                      * math.cos(truth.lat_rad),
                      "nse_vote_north_m": (vote[0] - truth.lat_rad) * (rm + truth.alt_m),
                      "fdi_nu": float(self.fdi.nu[0] + 2 * self.fdi.nu[1] + 4 * self.fdi.nu[2])}
+        if self.refdesc is not None:
+            used = self._reference_description(truth, ins, sols, used, extra)
         valid = bool(used)
         pick = used if valid else [int(np.argmin([np.trace(f.P[:3, :3]) for f in self.filters]))]
         lat, lon, alt, v, roll, pitch, hdg = _mean_solution([sols[i] for i in pick])

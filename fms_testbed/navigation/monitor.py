@@ -150,9 +150,36 @@ def monitor_flight(df: pd.DataFrame, source, rnp_m: float | None
             "raised": bool(raised), "first_t_s": raised[0]["t_s"] if raised else None,
             "time_to_alert_s": [round(x, 2) for x in trace.time_to_alert_s], "delay_s": delay,
             "anp_max_m": round(float(np.nanmax(anp)), 2) if np.isfinite(anp).any() else None}
+    nse95 = nse95_by_output(df)
+    if nse95:
+        block["nse95_m"] = nse95
     block["events"] = sorted(events, key=lambda e: e["t_s"])
     return df, block
 
 
-__all__ = ["AlertTrace", "monitor_flight", "DEFAULT_ALERT_DELAY_S", "NAV_MODES", "TIME_TO_ALERT_S", "rnp_alerts",
+NSE_OUTPUTS = {"output": "nse", "reference": "nse_ref", "vote": "nse_vote"}
+"""Outputs whose horizontal NSE is logged: the flown output, the reference-description
+monitor's and the majority-voting baseline's (``<prefix>_east_m``, ``<prefix>_north_m``)."""
+
+
+def nse95_by_output(df: pd.DataFrame) -> dict:
+    """95th percentile of the horizontal NSE √(E² + N²) of each logged output, m (the flown
+    output, the reference-description monitor's, majority voting's; only those logged).
+
+    Parameters
+    ----------
+    df : the timeseries with ``nse_east_m``/``nse_north_m`` and optionally ``nse_ref_*``,
+        ``nse_vote_*`` (m)
+    """
+    out = {}
+    for name, pre in NSE_OUTPUTS.items():
+        if f"{pre}_east_m" in df and f"{pre}_north_m" in df:
+            h = np.hypot(df[f"{pre}_east_m"].to_numpy(float), df[f"{pre}_north_m"].to_numpy(float))
+            h = h[np.isfinite(h)]
+            if h.size:
+                out[name] = round(float(np.percentile(h, 95)), 2)
+    return out
+
+
+__all__ = ["AlertTrace", "NSE_OUTPUTS", "monitor_flight", "nse95_by_output", "DEFAULT_ALERT_DELAY_S", "NAV_MODES", "TIME_TO_ALERT_S", "rnp_alerts",
            "time_to_alert_limit_s"]

@@ -116,6 +116,7 @@ class SinsNavigation:
         self._prev: AircraftState | None = None
         self._gains: tuple[float, float] | None = None       # baro gains, set at the first step
         self._held = None                                    # (t_built_s, dt_s, Φ, S)
+        self.last_matrices = None                            # (prev state, dt_s, Φ, S) of the last step
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "SinsNavigation":
@@ -152,12 +153,17 @@ class SinsNavigation:
             raise ConfigError(f"navigation.matrices_dt_s: must be >= 0 s, got {matrices_dt_s}")
         return cls(imu, seed=sd, opts=opts, dt_s=dt_s, matrices_dt_s=matrices_dt_s)
 
-    def _propagate(self, prev: AircraftState, dt: float) -> None:
+    def _next_noise(self) -> np.ndarray:
+        """This step's standard-normal process-noise vector (drawn NOISE_BLOCK steps at once)."""
         if self._noise_i >= len(self._noise):
             self._noise = self.rng.standard_normal((NOISE_BLOCK, self.x.size))
             self._noise_i = 0
         noise = self._noise[self._noise_i]
         self._noise_i += 1
+        return noise
+
+    def _propagate(self, prev: AircraftState, dt: float) -> None:
+        noise = self._next_noise()
         held = self._held
         if (held is not None and abs(held[1] - dt) <= 1e-6 * dt
                 and prev.t_s - held[0] < self.matrices_dt_s - 1e-9):
@@ -192,6 +198,7 @@ class SinsNavigation:
                                                 f"(method {o.method})")
             x = phi @ self.x + L @ noise
         self.x = x
+        self.last_matrices = (prev, dt, phi, L)     # for units sharing this step (ins_bank)
         if self.matrices_dt_s > 0:
             self._held = (prev.t_s, dt, phi, L)
 

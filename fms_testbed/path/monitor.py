@@ -15,6 +15,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+from fms_testbed.core.atmosphere import cas_to_tas, tas_to_cas
 from fms_testbed.core.geodesy import inverse, wrap180
 from fms_testbed.core.segments import Arc, project
 from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
@@ -76,6 +77,37 @@ def leg_end_checks(path: ProcedurePath) -> list[FixCheck]:
     return out
 
 
+def arc_conditions_text(tas_mps: float, wind_mps: float, isa_dev_c: float, alt_m: float,
+                        radius_m: float, bank_deg: float, g_mps2: float) -> str:
+    """The conditions behind a coded arc's bank or speed correction (class 1), '' in calm ISA
+    air: e.g. "; at 245 kt TAS + 30 kt tailwind, ISA+20 the bank needed is 27.1° (19.4° in
+    calm ISA air): forced by the conditions" — γ = atan((V + W)² / (R g)) against the
+    calm-ISA γ for the same CAS (:func:`~fms_testbed.path.segmentation.conditions_text`'s
+    twin for arcs of fixed radius).
+
+    Parameters
+    ----------
+    tas_mps : planned TAS, m/s; wind_mps : planned wind speed (its tailwind part at worst), m/s
+    isa_dev_c : planned ISA deviation, K; alt_m : the leg's planned altitude, m
+    radius_m : the arc's radius, m; bank_deg : the planned bank, deg; g_mps2 : gravity, m/s²
+    """
+    if wind_mps <= 0.05 and abs(isa_dev_c) < 0.05:
+        return ""
+    cond = f"{tas_mps / KT_MPS:.0f} kt TAS"
+    if wind_mps > 0.05:
+        cond += f" + {wind_mps / KT_MPS:.0f} kt tailwind"
+    if abs(isa_dev_c) >= 0.05:
+        cond += f", ISA{isa_dev_c:+.0f}"
+    v_isa = tas_mps
+    if isa_dev_c:
+        v_isa = float(cas_to_tas(tas_to_cas(tas_mps, alt_m, isa_dev_c), alt_m))
+    g_now = math.degrees(math.atan((tas_mps + wind_mps) ** 2 / (radius_m * g_mps2)))
+    g_calm = math.degrees(math.atan(v_isa ** 2 / (radius_m * g_mps2)))
+    forced = ": forced by the conditions" if g_calm <= bank_deg + 1e-9 else ""
+    return (f"; at {cond} the bank needed is "
+            f"{g_now:.1f}° ({g_calm:.1f}° in calm ISA air){forced}")
+
+
 def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                 g: float) -> list[Finding]:
     """(R, Ω, γ) checks of the coded arcs (RF, AF) with the γ and V,γ corrections."""
@@ -116,7 +148,10 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                                    f"give {arc.radius_m / NM_M:.3f} NM: path follows the fixes",
                                    "R"))
         v = lg.speed_mps
-        w = params.wind_speed_mps   # the ground speed on an arc reaches TAS + wind (class 1)
+        # the ground speed on an arc reaches TAS + wind (class 1): the wind at the leg's
+        # planned altitude
+        w = params.wind_at(lg.start.alt_m)[0]
+        why = arc_conditions_text(v, w, params.isa_dev_c, lg.start.alt_m, arc.radius_m, gplan, g)
         for _ in range(params.max_iterations):
             g_req = math.degrees(math.atan((v + w) ** 2 / (arc.radius_m * g)))
             if g_req <= gplan + 1e-9:
@@ -124,13 +159,13 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
             if g_req <= gmax:
                 out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
                                    f"{arc.radius_m / NM_M:.2f} NM at {v / KT_MPS:.0f} kt: bank "
-                                   f"{gplan:.0f} -> {g_req:.1f}°", "γ"))
+                                   f"{gplan:.0f} -> {g_req:.1f}°{why}", "γ"))
                 break
             v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax))) - w
             if v_reg >= perf.tas_min_mps:
                 out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
                                    f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT_MPS:.0f} -> "
-                                   f"{v_reg / KT_MPS:.0f} kt at bank {gmax:.0f}°", "V,γ"))
+                                   f"{v_reg / KT_MPS:.0f} kt at bank {gmax:.0f}°{why}", "V,γ"))
                 break
             out.append(Finding(lg.index, "impossible", f"{lg.path_term} radius "
                                f"{arc.radius_m / NM_M:.2f} NM needs bank {g_req:.0f}° > "
@@ -232,6 +267,40 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
     return out, prof
 
 
+LONG_WAY_TURN_DEG = 270.0
+"""A TF or CF whose coded turn direction makes it turn more than this (deg) is reported: the
+short way round is less than 90°, so the coded direction is more likely a coding error than a
+design (Danilin's class 3; the leg is flown as coded)."""
+
+
+def _long_way_turns(path: ProcedurePath) -> list[Finding]:
+    """TF/CF legs with a coded turn direction flown more than :data:`LONG_WAY_TURN_DEG` round.
+
+    The turn is the summed sweep of the leg's own turn and fly-by arcs, reported when its net
+    track change is under 360° − that limit (a course reversal, 180° either way, is a design
+    and not reported); legs whose design turns
+    far (RF, AF, holds, procedure turns, direct-tos and heading legs after a runway climb) are
+    not checked."""
+    out = []
+    for lg in path.legs:
+        if lg.path_term not in ("TF", "CF") or lg.record.turn_dir not in ("L", "R"):
+            continue
+        arcs = [sg.geom for sg in path.segments if sg.leg_index == lg.index
+                and sg.geom.kind == "arc" and sg.role in ("turn", "flyby")]
+        sweep = sum(abs(a.sweep_deg) for a in arcs)
+        if sweep <= LONG_WAY_TURN_DEG:
+            continue
+        net = abs(wrap180(arcs[-1].end_course_deg - arcs[0].start_course_deg))
+        if net <= 360.0 - LONG_WAY_TURN_DEG:   # the short way was under 90°
+            side = {"L": "left", "R": "right"}[lg.record.turn_dir]
+            ident = lg.record.fix.ident if lg.record.fix else lg.path_term
+            out.append(Finding(lg.index, "loop", f"leg {lg.index + 1} ({lg.path_term} {ident}): "
+                               f"the coded {side} turn is flown {sweep:.0f}° round for a "
+                               f"{net:.0f}° track change (turn direction coded against the "
+                               f"short way?)"))
+    return out
+
+
 def _topology_checks(path: ProcedurePath) -> list[Finding]:
     """Gaps between segments, duplicated/looping paths (Fig. 4) and doubled-back legs."""
     out = []
@@ -260,6 +329,7 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
                                    f"(legs {seen[key] + 1} and {lg.index + 1})"))
             seen.setdefault(key, lg.index)
         prev_fix = f if lg.termination.kind == "fix" else ""
+    out += _long_way_turns(path)
     lines = [s for s in segs if s.geom.kind == "line" and s.role == "leg"
              and s.geom.length_m() > 100.0]
     for a, b in zip(lines, lines[1:]):

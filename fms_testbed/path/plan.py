@@ -6,7 +6,9 @@ A flyable procedure is the concatenation of the database's transitions, in flyin
 * SID:  runway transition (``RWxx`` / ``RWxxB``) → common route → en-route transition
 * STAR: en-route transition → common route → runway transition
 * approach: approach transition (route type ``A``) → final approach, cut at the missed-approach
-  point (an approach ends at the runway/MAP: the flight stops there)
+  point (an approach ends at the runway/MAP: the flight stops there) unless the missed
+  approach is flown (``procedure.missed``): then its legs follow, to the end of the first
+  holding circuit
 
 The ``IF`` that starts a later part is dropped when it repeats the fix the previous part ends at;
 after a transition that ends in a hold at a fix the next part reaches later, the next part is
@@ -101,9 +103,9 @@ def select_parts(db, airport: str, procedure: str, transition: str | None,
     return parts
 
 
-def merge_parts(parts: list):
+def merge_parts(parts: list, missed: bool = False):
     """One :class:`~fms_testbed.procedures.database.Sequence` from the parts; the approach is cut
-    at its missed-approach point."""
+    at its missed-approach point unless ``missed`` (the missed-approach legs are flown)."""
     legs = list(parts[0].legs)
     for p in parts[1:]:
         nxt = list(p.legs)
@@ -121,7 +123,7 @@ def merge_parts(parts: list):
             if j is not None:
                 nxt = nxt[j + 1:]
         legs += nxt
-    if parts[0].proc_type == "F":
+    if parts[0].proc_type == "F" and not missed:
         cut = next((i for i, lg in enumerate(legs) if lg.missed_approach_start), len(legs))
         legs = legs[:cut]
     trans = "+".join(p.transition for p in parts if p.transition)
@@ -162,18 +164,26 @@ class FlyablePath:
     an in-flight rebuild uses the same."""
 
 
-def _perf_params(cfg, spec: ProcedureSpec, wind: tuple[float, float] | None = None):
+def _perf_params(cfg, spec: ProcedureSpec, wind=None, isa_dev_c: float = 0.0):
     """Performance and build settings for aircraft ``cfg``; ``wind`` (speed m/s, from deg
-    true): the wind the path is planned for."""
+    true; or a :class:`~fms_testbed.core.wind.WindProfile` over altitude): the wind the path
+    is planned for; ``isa_dev_c``: the planned ISA deviation, K."""
+    from fms_testbed.core.wind import WindProfile
     from fms_testbed.legs.model import BuildParams, Performance
 
     perf = Performance.from_aircraft(cfg)
     grad = spec.climb_gradient or plan_climb_rate_mps(cfg) / perf.tas_plan_mps
     perf = replace(perf, climb_gradient_max=min(grad, perf.climb_gradient_max))
+    prof = wind if isinstance(wind, WindProfile) else None
+    if prof is not None:   # the constant fields: the wind at the lowest layer (per leg: its own)
+        wind = prof.at(prof.alt_m[0])
+        prof = prof if prof.layered else None
     w_mps, w_from = wind if wind is not None else (0.0, 0.0)
     params = BuildParams(manual_leg_m=spec.manual_leg_nm * NM_M,
                          bank_limit_deg=min(25.0, cfg.limits.bank_max_deg),
-                         wind_speed_mps=float(w_mps), wind_from_deg=float(w_from))
+                         wind_speed_mps=float(w_mps), wind_from_deg=float(w_from),
+                         wind_profile=prof, isa_dev_c=float(isa_dev_c),
+                         climb_top_m=spec.climb_top_ft * FT_M)
     return perf, params
 
 
@@ -186,26 +196,55 @@ def _rnp(seq, spec: ProcedureSpec, offset: int = 0) -> tuple[float, ...]:
     return tuple(out)
 
 
-def _finish(path, seq, spec, cfg, perf, params, offset: int) -> FlyablePath:
+def _finish(path, seq, spec, cfg, perf, params, offset: int,
+            in_missed: bool = False) -> FlyablePath:
     from fms_testbed.path.monitor import check_path
     from fms_testbed.path.profile import plan_profile
 
     checked = check_path(path, perf, params)
     if checked.legs:
         grad = perf.climb_gradient_at(perf.tas_plan_mps)
+        # a missed approach climbs to its own coded altitudes (the highest of them), not to
+        # the SID climb top
+        missed = in_missed or any(r.missed_approach_start for r in seq.legs)
+        top = None if checked.proc_type == "F" and missed else spec.climb_top_ft * FT_M
         prof = plan_profile(checked, grad, checked.legs[0].start.alt_m,
-                            params.descent_angle_deg, climb_top_m=spec.climb_top_ft * FT_M,
+                            params.descent_angle_deg, climb_top_m=top,
                             descent_gradient_max=perf.descent_rate_max_mps / perf.tas_plan_mps,
                             descent_rate_mps=PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
-                            wind=(params.wind_speed_mps, params.wind_from_deg))
+                            wind=(params.wind_speed_mps, params.wind_from_deg),
+                            start_in_climb=in_missed)
+        if checked.proc_type == "F" and cfg.approach is not None:
+            prof = replace(prof, speed=approach_speed_profile(checked, prof, cfg))
         checked = replace(checked, profile=prof)
     return FlyablePath(checked, seq, offset, _rnp(seq, spec, 0))
 
 
-def build_procedure(db, spec: ProcedureSpec, cfg,
-                    wind: tuple[float, float] | None = None) -> FlyablePath:
-    """Select, merge, build and check the procedure a spec names, for aircraft ``cfg`` and the
-    planned ``wind`` (speed m/s, from deg true; None: calm).
+def approach_clean_cas_mps(cfg) -> float:
+    """CAS an approach is planned at before it slows (clean), m/s: the builder's approach
+    speed (:func:`fms_testbed.legs.model.approach_cas_caps`), never above the aircraft's
+    planned terminal-area speed."""
+    from fms_testbed.legs.model import APPROACH_CAS_MPS
+
+    return min(max(APPROACH_CAS_MPS, 1.15 * cfg.limits.cas_min_mps), cfg.limits.climb_tas_mps)
+
+
+def approach_speed_profile(path, prof, cfg):
+    """The planned speeds of an approach for aircraft ``cfg`` (its ``approach`` settings:
+    Vapp at the reference mass, the planned deceleration), on the nodes of ``prof``
+    (:func:`fms_testbed.path.speed_profile.plan_speed_profile`)."""
+    from fms_testbed.path.speed_profile import plan_speed_profile
+
+    ap = cfg.approach
+    return plan_speed_profile(path, prof.along_m, prof.alt_m, approach_clean_cas_mps(cfg),
+                              ap.vapp_cas_mps_at(None), ap.decel_mps2)
+
+
+def build_procedure(db, spec: ProcedureSpec, cfg, wind=None,
+                    isa_dev_c: float = 0.0) -> FlyablePath:
+    """Select, merge, build and check the procedure a spec names, for aircraft ``cfg``, the
+    planned ``wind`` (speed m/s, from deg true, or a
+    :class:`~fms_testbed.core.wind.WindProfile`; None: calm) and ISA deviation (K).
 
     Raises
     ------
@@ -217,13 +256,16 @@ def build_procedure(db, spec: ProcedureSpec, cfg,
     from fms_testbed.path.segmentation import build_sequence
     from fms_testbed.procedures.integrity import refusal
 
-    seq = merge_parts(select_parts(db, spec.airport, spec.procedure, spec.transition,
-                                   spec.runway))
+    parts = select_parts(db, spec.airport, spec.procedure, spec.transition, spec.runway)
+    if spec.missed and parts[0].proc_type != "F":
+        raise UserError(f"{spec.airport} {spec.procedure}: missed: only an approach has a "
+                        f"missed approach")
+    seq = merge_parts(parts, missed=spec.missed)
     if seq.degraded and not spec.allow_degraded:
         raise UserError(refusal(seq.name, seq.defects))
     if not seq.legs:
         raise UserError(f"{seq.name}: no leg left to fly (every record rejected)")
-    perf, params = _perf_params(cfg, spec, wind)
+    perf, params = _perf_params(cfg, spec, wind, isa_dev_c)
     path = build_sequence(db, seq, perf, params)
     start_alt = spec.start_alt_ft * FT_M if spec.start_alt_ft is not None else None
     if start_alt is None and seq.proc_type == "D" and path.start_kind != "runway" and path.legs:
@@ -249,16 +291,20 @@ def build_procedure(db, spec: ProcedureSpec, cfg,
 
 
 def rebuild_from(db, whole: FlyablePath, spec: ProcedureSpec, cfg, next_leg: int,
-                 lat_deg: float, lon_deg: float, track_deg: float, alt_m: float
-                 ) -> FlyablePath | None:
+                 lat_deg: float, lon_deg: float, track_deg: float, alt_m: float,
+                 params=None, prev_fix=None) -> FlyablePath | None:
     """Build legs ``next_leg..`` of the procedure from the aircraft's actual state.
 
     Used when a conditional leg (altitude, DME, radial) ends in flight somewhere other than
-    planned. Returns None when nothing is left or the rest cannot be built.
+    planned, and when the measured conditions differ from the planned ones (``params``: the
+    build settings for the measured wind and temperature; default the whole path's;
+    ``prev_fix``: the fix leg ``next_leg`` starts from, for a leg rebuilt mid-way). Returns
+    None when nothing is left or the rest cannot be built.
     """
     from fms_testbed.legs.model import FlightState
     from fms_testbed.path.segmentation import build_sequence
 
+    params_in = params
     legs = whole.seq.legs[next_leg:]
     if not legs:
         return None
@@ -266,9 +312,14 @@ def rebuild_from(db, whole: FlyablePath, spec: ProcedureSpec, cfg, next_leg: int
     perf, params = _perf_params(cfg, spec)
     if whole.params is not None:
         params = whole.params
+    if params_in is not None:
+        params = params_in
     start = FlightState(lat_deg, lon_deg, track_deg, alt_m)
-    path = build_sequence(db, seq, perf, params, start=start)
+    path = build_sequence(db, seq, perf, params, start=start, prev_fix=prev_fix)
     if not path.segments or path.status == "impossible":
         return None
-    fp = _finish(path, seq, spec, cfg, perf, params, next_leg)
+    # the rest of a missed approach climbs from its start (its first leg is not coded as the
+    # missed-approach start)
+    in_missed = any(r.missed_approach_start for r in whole.seq.legs[:next_leg])
+    fp = _finish(path, seq, spec, cfg, perf, params, next_leg, in_missed)
     return replace(fp, rnp_m=whole.rnp_m[next_leg:], degraded=whole.degraded, params=params)

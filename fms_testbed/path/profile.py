@@ -38,13 +38,16 @@ class VerticalProfile:
 
     along_m, alt_m: node distances from the path start (m) and planned altitudes (m);
     climb: per node, True where the segment ending at that node is a climb phase;
-    windows: the coded constraints.
+    windows: the coded constraints; speed: the planned CAS of an approach with its
+    deceleration segments (:class:`~fms_testbed.path.speed_profile.SpeedProfile`; None for
+    other procedures and aircraft without approach settings).
     """
 
     along_m: np.ndarray
     alt_m: np.ndarray
     climb: np.ndarray
     windows: tuple[AltitudeWindow, ...]
+    speed: object = None
 
     def alt_at(self, s_m: float | np.ndarray) -> float | np.ndarray:
         """Planned altitude at distance ``s_m`` (m) along the path, m."""
@@ -146,7 +149,8 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
                  descent_angle_deg: float = 3.0, climb_top_m: float | None = None,
                  descent_gradient_max: float | None = None,
                  descent_rate_mps: float | None = None,
-                 wind: tuple[float, float] | None = None) -> VerticalProfile:
+                 wind: tuple[float, float] | None = None,
+                 start_in_climb: bool = False) -> VerticalProfile:
     """Plan the vertical profile of a built path.
 
     Parameters
@@ -165,6 +169,8 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
         leg's planned ground speed (``BuiltLeg.speed_mps`` plus the ``wind`` component along
         the leg's track), m/s
     wind : (speed m/s, from deg true) the path is planned for; None: calm
+    start_in_climb : the path is the rest of a missed approach (rebuilt in flight): a climb
+        phase from its start
 
     Notes
     -----
@@ -181,7 +187,7 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     ends = leg_end_distances(path)
     windows = []
     climb = np.zeros(n + 1, dtype=bool)
-    climbing = path.proc_type == "D"
+    climbing = path.proc_type == "D" or start_in_climb
     for k, lg in enumerate(path.legs):
         r = lg.record
         if r.missed_approach_start:

@@ -18,13 +18,14 @@ from __future__ import annotations
 import math
 from dataclasses import replace
 
+from fms_testbed.core.atmosphere import cas_to_tas, tas_to_cas
 from fms_testbed.core.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
-from fms_testbed.path.profile import arrival_join_alt_m
+from fms_testbed.path.profile import arrival_join_alt_m, window
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
@@ -90,15 +91,22 @@ def sid_join_alt_m(db: Database, seq: Sequence, fix, elev_m: float,
     """Altitude at which a SID joined at ``fix`` (not from its runway: the runway part is
     vectors or was not asked for) is planned to be there: 35 ft above the field plus a climb at
     the aircraft's gradient over the distance from the airport to the fix, capped by every 'at
-    or below' constraint of the transition and by :data:`SID_JOIN_CAP_M`, m — not the field
-    elevation (issue 12, class H: a start thousands of feet below the climb windows)."""
+    or below', 'at' or 'between' constraint of the transition (the top of its window) and by
+    :data:`SID_JOIN_CAP_M`, and raised into the first fix's own window, m — not the field
+    elevation (issue 12, class H: a start thousands of feet below the climb windows), nor
+    above an 'at' first fix (KAPA ECHOO1: joined at 18,000 ft over BAPME coded at 8,000 ft)."""
     alt = elev_m + 35 * FT_M
     apt = db.airports.get(seq.airport)
     if perf is not None and apt is not None and fix is not None:
         d = inverse(apt.lat_deg, apt.lon_deg, fix.lat_deg, fix.lon_deg)[0]
         alt += perf.climb_gradient_at(perf.tas_plan_mps) * d
-    caps = [r.alt1_m for r in seq.legs if r.alt1_m is not None and r.alt_desc in ("-", "Y")]
-    return min([alt, SID_JOIN_CAP_M] + caps)
+    # capped by the top of every window ('at or below', 'at', 'between': an 'at 8,000 ft' at
+    # the first fix is a cap too), and inside the first fix's own window
+    wins = [window(r.alt_desc, r.alt1_m, r.alt2_m) for r in seq.legs]
+    caps = [hi for _, hi in wins if hi is not None]
+    alt = min([alt, SID_JOIN_CAP_M] + caps)
+    lo_first = wins[0][0] if wins else None
+    return alt if lo_first is None else max(alt, lo_first)
 
 
 def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
@@ -134,18 +142,19 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
 
 
 def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float,
-                      cas_cap_mps: float | None = None) -> float:
+                      cas_cap_mps: float | None = None, isa_dev_c: float = 0.0) -> float:
     """Planned TAS: the aircraft's planned speed (flown as a CAS: its TAS at ``alt_m``; no more
     than ``cas_cap_mps``, an approach's planned speed: :func:`~fms_testbed.legs.model.
     approach_cas_caps`) capped by an 'at or below' speed limit, raised to
     an 'at or above' one, and equal to an 'at' one — the speed guidance will fly there, so turn
-    radii are planned for it (limits are IAS, turned to TAS in the ISA), m/s."""
+    radii are planned for it (limits are IAS, turned to TAS on a day ``isa_dev_c`` K off the
+    ISA: a warm day flies a higher TAS for the same CAS, so a larger radius), m/s."""
     v = isa_tas_mps(perf.tas_plan_mps if cas_cap_mps is None else
-                    min(perf.tas_plan_mps, cas_cap_mps), alt_m)  # flown as a CAS
+                    min(perf.tas_plan_mps, cas_cap_mps), alt_m, isa_dev_c)  # flown as a CAS
     lim = leg.rec.speed_limit_mps
     if lim is None:
         return v
-    lim_tas = isa_tas_mps(lim, alt_m)
+    lim_tas = isa_tas_mps(lim, alt_m, isa_dev_c)
     if leg.rec.speed_desc == "-":
         return min(v, lim_tas)
     if leg.rec.speed_desc == "+":
@@ -153,9 +162,14 @@ def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float,
     return lim_tas  # blank or '@': at
 
 
+def leg_cls_hold(leg: ResolvedLeg) -> bool:
+    """True for a hold leg (HA/HF/HM)."""
+    return LEG_TYPES[leg.pt].hold
+
+
 def build_sequence(db: Database, seq: Sequence, perf: Performance,
-                   params: BuildParams | None = None, start: FlightState | None = None
-                   ) -> ProcedurePath:
+                   params: BuildParams | None = None, start: FlightState | None = None,
+                   prev_fix: Fix | None = None) -> ProcedurePath:
     """Build one procedure transition into a :class:`ProcedurePath` (segments + legs).
 
     Parameters
@@ -166,6 +180,8 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     params : build settings; defaults :class:`BuildParams`
     start : planned start state (position deg, track deg true, altitude m); default
         :func:`start_state`. Guidance uses this to rebuild from the aircraft's actual state.
+    prev_fix : the fix the first leg starts from (a leg rebuilt mid-way: a TF rejoins the track
+        from it; its coded path is kept for the PDE); default none
 
     Returns
     -------
@@ -187,7 +203,8 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     ref = legs[0].fix or db.airports.get(seq.airport)
     g = gravity_mps2(ref.lat_deg if ref else state.lat_deg)
     # a TF starts from the previous leg's fix when that leg ends at its fix
-    prev_fixes = [None] + [lg.fix if LEG_TYPES[lg.pt].ends_at_fix else None for lg in legs[:-1]]
+    prev_fixes = [prev_fix] + [lg.fix if LEG_TYPES[lg.pt].ends_at_fix else None
+                               for lg in legs[:-1]]
     b = LegBuilder(legs, perf, params, g, prev_fixes)
     b.climbing = seq.proc_type == "D"
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
@@ -198,7 +215,19 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         if leg.rec.missed_approach_start:
             b.climbing = True
         speed_in = b.speed_mps if i else None
-        b.speed_mps = planned_speed_mps(perf, leg, state.alt_m, caps[i])
+        # the conditions at the leg's planned altitude (a wind profile: its wind there)
+        alt_plan = state.alt_m   # the builder's planned altitude at the leg's start
+        b.params = params.for_altitude(alt_plan)
+        if b.climbing and leg_cls_hold(leg) and params.climb_top_m is not None:
+            # a hold in a climb is flown from here up to the climb top (guidance climbs on to
+            # it; an HA is left only at the end of a circuit): its turns are planned for the
+            # TAS at the top (constant CAS: the largest) and the strongest wind on the way
+            top = max(alt_plan, params.climb_top_m)
+            b.params = params.for_band(alt_plan, top)
+            alt_plan = top
+        b.leg_params[i] = b.params
+        b.leg_alt_m[i] = alt_plan
+        b.speed_mps = planned_speed_mps(perf, leg, alt_plan, caps[i], params.isa_dev_c)
         b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
         # a turn at the start of the leg is entered at the previous leg's speed: plan its radius
         # for the faster of the two
@@ -282,9 +311,10 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         # the aircraft enters the turn at the inbound speed and leaves it at the outbound one:
         # plan the radius for the faster, which the bank limit must cover
         v = max(a.speed_mps, seg.speed_mps)
-        # planned for the largest ground speed over the turn's tracks (class 1: the wind)
-        w = max_tailwind_mps(params.wind_speed_mps, params.wind_from_deg,
-                             a.geom.end_course_deg, omega)
+        # planned for the largest ground speed over the turn's tracks (class 1: the wind at
+        # the corner, where the leg after it starts)
+        cp = b.use_leg_params(seg.leg_index)
+        w = max_tailwind_mps(cp.wind_speed_mps, cp.wind_from_deg, a.geom.end_course_deg, omega)
         r = turn_radius_m(v + w, bank_deg, b.g)
         t = math.tan(math.radians(abs(omega)) / 2.0)
         avail_a = a.geom.length_m()  # already trimmed by the previous corner, if any
@@ -295,20 +325,22 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
         if r * t > l_avail:
             r_geom = l_avail / t
             b.i = a.leg_index
+            why = conditions_text(v, w, cp.isa_dev_c, b.leg_alt_m.get(seg.leg_index, 0.0), r,
+                                  l_avail / t, bank_deg, b.g)
             if r_geom <= 1.0:
                 out.extend(_flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g), depth))
                 continue
             g_reg = math.degrees(math.atan((v + w) ** 2 / (r_geom * b.g)))
             if g_reg <= gmax:
                 b.finding("correction", f"fly-by at {fix}: radius {r:.0f} -> {r_geom:.0f} m, "
-                          f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°)", "R")
+                          f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°){why}", "R")
                 r, bank = r_geom, g_reg
             else:
                 v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax))) - w
                 if v_reg >= perf.tas_min_mps:
                     b.finding("correction", f"fly-by at {fix}: speed {v / KT_MPS:.0f} -> "
                               f"{v_reg / KT_MPS:.0f} kt, bank {gmax:.0f}°, radius "
-                              f"{r_geom:.0f} m (turn {omega:+.0f}°)", "V,γ")
+                              f"{r_geom:.0f} m (turn {omega:+.0f}°){why}", "V,γ")
                     r, bank, v = r_geom, gmax, v_reg
                 else:
                     # flown over at the bank limit and the speed flown there: slowing down
@@ -337,6 +369,39 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
     return out
 
 
+def conditions_text(tas_mps: float, tailwind_mps: float, isa_dev_c: float, alt_m: float,
+                    radius_m: float, radius_fit_m: float, bank_deg: float, g_mps2: float) -> str:
+    """What the planned conditions do to a turn that does not fit, for a class-1 finding
+    (Danilin 2017: the current conditions change the plan parameters): '' in calm ISA air,
+    else e.g. "; turn radius 3120 m at 245 kt TAS + 30 kt tailwind, ISA+20 (2480 m in calm ISA
+    air) exceeds the 2800 m the legs leave: forced by the conditions" — the radius
+    R = (V + W)² / (g tan γ) against the calm-ISA one for the same CAS.
+
+    Parameters
+    ----------
+    tas_mps : planned TAS, m/s; tailwind_mps : planned wind along the turn, m/s
+    isa_dev_c : planned ISA deviation, K; alt_m : the leg's planned altitude, m
+    radius_m : radius planned in these conditions, m
+    radius_fit_m : largest radius the legs leave room for, m; bank_deg : planned bank, deg
+    g_mps2 : gravity, m/s²
+    """
+    if tailwind_mps <= 0.05 and abs(isa_dev_c) < 0.05:
+        return ""
+    cond = f"{tas_mps / KT_MPS:.0f} kt TAS"
+    if tailwind_mps > 0.05:
+        cond += f" + {tailwind_mps / KT_MPS:.0f} kt tailwind"
+    if abs(isa_dev_c) >= 0.05:
+        cond += f", ISA{isa_dev_c:+.0f}"
+    v_isa = tas_mps
+    if isa_dev_c:
+        v_isa = float(cas_to_tas(tas_to_cas(tas_mps, alt_m, isa_dev_c), alt_m))
+    r_calm = turn_radius_m(v_isa, bank_deg, g_mps2)
+    forced = ": forced by the conditions" if r_calm <= radius_fit_m else ""
+    return (f"; turn radius {radius_m:.0f} m at {cond} ({r_calm:.0f} m in calm ISA air) "
+            f"exceeds the "
+            f"{radius_fit_m:.0f} m the legs leave{forced}")
+
+
 def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
                      perf: Performance, params: BuildParams, bank_deg: float
                      ) -> list[PathSegment]:
@@ -347,6 +412,7 @@ def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
     jump)."""
     a = out[-1]
     v = min(a.speed_mps, seg.speed_mps)
+    b.use_leg_params(seg.leg_index)
     w = b.wind_mps
     gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for bank in (bank_deg, gmax):
@@ -382,6 +448,7 @@ def _arc_line_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
     flown over the fix: the line's leg rejoins its course (branch V,γ,φ,λ)."""
     a = out[-1]
     v = max(a.speed_mps, seg.speed_mps)
+    b.use_leg_params(seg.leg_index)
     w = b.wind_mps
     gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for bank in (bank_deg, gmax):

@@ -26,7 +26,7 @@ from fms_testbed.core.units import FT_M
 RECORD_COLUMNS = 132
 """Length of every ARINC-424 record, characters."""
 
-_CHARSET = re.compile(r"[A-Z0-9 \"#&'()+,\-./:]*")
+_CHARSET = re.compile(r"[A-Z0-9 \"#&'()+,\-./:@]*")
 _UNSIGNED = re.compile(r"[0-9]+")
 _SIGNED = re.compile(r"-?[0-9]+")
 

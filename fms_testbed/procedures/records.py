@@ -55,6 +55,7 @@ class Fix:
     length_m: float | None = None      # runway: length, m
     line: int = 0
     name: str = ""                     # airport/heliport: name (cols 94-123)
+    tch_m: float | None = None         # runway: threshold crossing height (cols 76-77), m
 
 
 def parse_waypoint(rec: str, line: int) -> Fix:
@@ -108,8 +109,12 @@ def parse_airport(rec: str, line: int) -> Fix:
 
 
 def parse_runway(rec: str, line: int) -> Fix:
-    """Runway threshold (PG): bearing (magnetic, tenths) at 28, threshold elevation at 67."""
+    """Runway threshold (PG): bearing (magnetic, tenths) at 28, threshold elevation at 67,
+    threshold crossing height (ft) at 76-77."""
     brg = _int(rec, 28, 31, "runway bearing")
+    # lenient: a blank or non-numeric TCH leaves the threshold usable (no TCH known)
+    tch_txt = _f(rec, 76, 77)
+    tch = int(tch_txt) if tch_txt.isascii() and tch_txt.isdigit() else None
     length = _int(rec, 23, 27, "runway length")
     elev = _int(rec, 67, 71, "threshold elevation", signed=True, rng="elevation")
     return Fix(ident=read_ident(rec, 14, 18, "runway ident", required=True),
@@ -118,7 +123,8 @@ def parse_runway(rec: str, line: int) -> Fix:
                elev_m=None if elev is None else elev * FT_M,
                airport=read_ident(rec, 7, 10, "airport ident", required=True),
                bearing_deg=None if brg is None else brg / 10.0,
-               length_m=None if length is None else length * FT_M, line=line)
+               length_m=None if length is None else length * FT_M, line=line,
+               tch_m=None if tch is None else tch * FT_M)
 
 
 def parse_localizer(rec: str, line: int) -> Fix:

@@ -66,8 +66,10 @@ def airport_record(ident: str, lat: float, lon: float, var_deg: float = 0.0,
 
 
 def runway_record(airport: str, ident: str, lat: float, lon: float, bearing_deg: float,
-                  length_ft: int = 8000, elev_ft: int = 0, region: str = "K1") -> str:
-    """Runway threshold (PG); ``bearing_deg`` magnetic."""
+                  length_ft: int = 8000, elev_ft: int = 0, region: str = "K1",
+                  tch_ft: int | None = None) -> str:
+    """Runway threshold (PG); ``bearing_deg`` magnetic; ``tch_ft`` threshold crossing height
+    (cols. 76-77), ft."""
     b = _blank()
     _put(b, 5, "P ")
     _put(b, 7, f"{airport:<4}")
@@ -80,6 +82,8 @@ def runway_record(airport: str, ident: str, lat: float, lon: float, bearing_deg:
     _put(b, 33, fmt_lat(lat))
     _put(b, 42, fmt_lon(lon))
     _put(b, 67, f"{elev_ft:05d}")
+    if tch_ft is not None:
+        _put(b, 76, f"{tch_ft:02d}")
     return "".join(b)
 
 
@@ -131,8 +135,9 @@ def leg_record(airport: str, proc: str, pt: str, seq: int, *, proc_type: str = "
                distance_nm: float | None = None, time_min: float | None = None,
                alt_desc: str = " ", alt1_ft: int | None = None, alt2_ft: int | None = None,
                speed_kt: int | None = None, speed_desc: str = " ", centre: str = "",
-               centre_section: str = "EA") -> str:
-    """One primary procedure leg record (PD/PE/PF) in ARINC-424 columns."""
+               centre_section: str = "EA", vpa_deg: float | None = None) -> str:
+    """One primary procedure leg record (PD/PE/PF) in ARINC-424 columns (``vpa_deg``: the
+    vertical angle, col. 103-106, negative descending, deg)."""
     b = _blank()
     _put(b, 5, "P ")
     _put(b, 7, f"{airport:<4}")
@@ -173,6 +178,9 @@ def leg_record(airport: str, proc: str, pt: str, seq: int, *, proc_type: str = "
         _put(b, 90, f"{alt2_ft:05d}")
     if speed_kt is not None:
         _put(b, 100, f"{speed_kt:03d}")
+    if vpa_deg is not None:
+        v = round(vpa_deg * 100)
+        _put(b, 103, f"-{-v:03d}" if v < 0 else f"{v:04d}")
     if centre:
         _put(b, 107, f"{centre:<5}")
         _put(b, 113, region)

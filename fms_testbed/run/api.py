@@ -19,6 +19,7 @@ from fms_testbed.evaluation.flight_errors import error_columns, flight_errors
 from fms_testbed.evaluation.outcome import DEFAULT_ENROUTE_RNP_NM, decide
 from fms_testbed.loop.flight import Flight
 from fms_testbed.loop.procedure import PreparedProcedure, prepare_procedure
+from fms_testbed.navigation.attitude_reference import attitude_reference_summary
 from fms_testbed.navigation.monitor import monitor_flight
 from fms_testbed.run.results import Results, Summary
 
@@ -111,6 +112,11 @@ def results_of(flight: Flight) -> Results:
     if proc is not None:
         summary["procedure"] = _procedure_summary(flight.scn, proc)
         summary.update(flight_errors(df, proc.path, g))
+        if proc.path.path.proc_type == "F":            # approaches: the threshold crossing
+            from fms_testbed.evaluation.threshold import threshold_crossing
+            summary["threshold"] = threshold_crossing(
+                df, proc.path.path, proc.runway, getattr(g.speed, "vapp_cas_mps", None),
+                flight.cfg.approach)
         summary["guidance_events"] = g.events
         if "xtk_m" in df:
             df = error_columns(df)
@@ -123,6 +129,9 @@ def results_of(flight: Flight) -> Results:
     df, nav_block = monitor_flight(df, flight.navigation, None if rnp_nm is None else rnp_nm * NM_M)
     if nav_block is not None:
         summary["navigation"] = nav_block
+    att_block = attitude_reference_summary(df)      # flight-test attitude-reference mode
+    if att_block is not None:
+        summary["attitude_reference"] = att_block
     decide(summary, df, flight.cfg, rnp_nm)
     return Results(df=df, summary=summary, scenario=flight.scn, procedure=proc,
                    flown_paths=rebuilt)

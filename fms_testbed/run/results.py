@@ -19,6 +19,7 @@ from fms_testbed.core.errors import UserError
 from fms_testbed.core.jsonio import dumps
 from fms_testbed.loop.procedure import PreparedProcedure
 from fms_testbed.run.outputs import OutputFolder, file_sha256
+from fms_testbed.viz.attitude_reference import plot_attitude_reference_run
 from fms_testbed.viz.figure import save as save_figure
 from fms_testbed.viz.geojson import write_track_geojson
 from fms_testbed.viz.kml import write_track_kml
@@ -95,8 +96,10 @@ class Results:
     def plot(self) -> dict[str, Any]:
         """The standard figures of the flight, by file stem (``ground_track``, ``time_histories``
         and, for a procedure flight, ``procedure_track``, ``procedure_vertical``,
-        ``procedure_errors``); matplotlib :class:`~matplotlib.figure.Figure` objects."""
+        ``procedure_errors``; ``attitude_reference`` in the flight-test attitude-reference
+        mode); matplotlib :class:`~matplotlib.figure.Figure` objects."""
         figs = dict(plot_run(self.df, self.summary))
+        figs.update(plot_attitude_reference_run(self.df, self.summary))
         if self.procedure is not None:
             figs.update(plot_procedure(self.df, self.summary, self.procedure.path,
                                        self.flown_paths))

@@ -106,6 +106,25 @@ def count_engines(model: str) -> int:
     return len(root.findall("./propulsion/engine"))
 
 
+def has_piston_engines(model: str) -> bool:
+    """Whether the wheel's model ``model`` is powered by JSBSim piston engines.
+
+    Reads each ``<engine file=…>`` of the model and the root element of that engine file
+    (``<piston_engine>``) in the package's ``engine`` folder or the model's own ``Engines``.
+    """
+    root_dir = Path(jsbsim.get_default_root_dir())
+    root = ET.parse(root_dir / "aircraft" / model / f"{model}.xml").getroot()
+    for el in root.findall("./propulsion/engine"):
+        name = el.get("file", "")
+        for folder in (root_dir / "engine", root_dir / "aircraft" / model / "Engines"):
+            f = folder / f"{name}.xml"
+            if f.exists():
+                if ET.parse(f).getroot().tag == "piston_engine":
+                    return True
+                break
+    return False
+
+
 def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None,
                             frames_per_update: int = 1) -> Path:
     """Copy ``model`` from the jsbsim wheel into the sandbox without I/O elements.
@@ -134,7 +153,8 @@ def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None,
             removed += 1
     n_eng = len(root.findall("./propulsion/engine"))
     if elevator_rate_max_ps:
-        root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S, frames_per_update)))
+        root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S, frames_per_update,
+                                             piston=has_piston_engines(model))))
     tree.write(dst / f"{model}.xml", encoding="utf-8", xml_declaration=True)
     log.debug("sanitised %s: removed %d I/O elements, %d engines", model, removed, n_eng)
     return dst_root
@@ -205,6 +225,8 @@ _READ = {  # state field -> (property, scale)
     "aileron": ("fcs/aileron-cmd-norm", 1.0),
     "rudder": ("fcs/rudder-cmd-norm", 1.0),
     "wow": ("gear/wow", 1.0),
+    "flap_pos_norm": ("fcs/flap-pos-norm", 1.0),
+    "gear_pos_norm": ("gear/gear-pos-norm", 1.0),
 }
 
 
@@ -252,6 +274,7 @@ class JSBSimAircraft:
         self.cfg = cfg
         self.dt_s = dt_s
         self._trim: TrimResult | None = None
+        self.isa_dev_c = 0.0
         self._load()
 
     def _load(self) -> None:
@@ -286,6 +309,8 @@ class JSBSimAircraft:
             "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle")}
         self._setters = tuple(self._w[k].set_double_value for k in (
             "fms/cmd/bank-rad", "fms/cmd/ny", "fms/cmd/nx", "fms/cmd/throttle", "fms/ap/nx-engage"))
+        self._w_flap = pm.get_node("fcs/flap-cmd-norm", True)
+        self._w_gear = pm.get_node("gear/gear-cmd-norm", True)
         self._write_gains()
 
     # -- properties ------------------------------------------------------------------
@@ -304,17 +329,32 @@ class JSBSimAircraft:
         for prop, val in gain_properties(self.cfg).items():
             self.fdm[prop] = float(val)
 
+    # -- atmosphere and wind (the day's conditions) --------------------------------------
+    def set_isa_dev(self, isa_dev_c: float) -> None:
+        """Fly a day ``isa_dev_c`` (K) off the ISA: JSBSim's ``atmosphere/delta-T`` (°R, the
+        temperature bias over the whole standard profile; sea-level pressure kept, pressure
+        hydrostatic through the biased temperature — :mod:`fms_testbed.core.atmosphere`).
+        Kept across a re-load (trim retry) and set before every trim."""
+        self.isa_dev_c = float(isa_dev_c)
+        self.fdm["atmosphere/delta-T"] = self.isa_dev_c * 1.8
+
     # -- trim ------------------------------------------------------------------------
     def trim(self, alt_m: float, tas_mps: float, heading_deg: float = 0.0,
-             lat_deg: float = 45.0, lon_deg: float = 0.0, gamma_deg: float = 0.0) -> TrimResult:
+             lat_deg: float = 45.0, lon_deg: float = 0.0, gamma_deg: float = 0.0,
+             terrain_elev_m: float = 0.0, flap_cmd_norm: float = 0.0,
+             gear_down: bool = False) -> TrimResult:
         """Trim in steady straight flight in calm air; raise :class:`TrimError` naming aircraft and
         condition (JSBSim 1.3.3 cannot trim in wind: the runner ramps the wind in afterwards).
 
-        Bounded alpha search (``trim.alpha_max_deg``), engines running, gear up. JSBSim's trim
+        Bounded alpha search (``trim.alpha_max_deg``), engines running, gear up unless
+        ``gear_down``, flaps at ``flap_cmd_norm`` (``fcs/flap-cmd-norm``, already extended),
+        the terrain at ``terrain_elev_m`` above mean sea level (``ic/terrain-elevation-ft``:
+        height above ground and ground contact are then relative to it, m). JSBSim's trim
         sometimes fails from the state a previous run left (engine and FCS internals survive
         ``run_ic``); a failure is retried once on a freshly loaded instance before it is reported.
         """
-        args = (alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg)
+        args = (alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg, terrain_elev_m,
+                flap_cmd_norm, gear_down)
         if self.fdm.get_sim_time() > 0.0:
             try:
                 return self._trim_once(*args)
@@ -323,12 +363,15 @@ class JSBSimAircraft:
                 self._load()
         return self._trim_once(*args)
 
-    def _trim_once(self, alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg):
+    def _trim_once(self, alt_m, tas_mps, heading_deg, lat_deg, lon_deg, gamma_deg,
+                   terrain_elev_m=0.0, flap_cmd_norm=0.0, gear_down=False):
         fdm, c = self.fdm, self.cfg
         cond = (f"{c.name} ({c.jsbsim_model}) at {alt_m:.0f} m / {mps_to_kmh(tas_mps):.0f} km/h TAS, "
                 f"gamma {gamma_deg:.1f} deg")
+        fdm["atmosphere/delta-T"] = self.isa_dev_c * 1.8   # a re-loaded instance: again
         fdm["ic/lat-geod-deg"] = lat_deg
         fdm["ic/long-gc-deg"] = lon_deg
+        fdm["ic/terrain-elevation-ft"] = terrain_elev_m / FT_M
         fdm["ic/h-sl-ft"] = alt_m / FT_M
         fdm["ic/vt-kts"] = tas_mps / KT_MPS
         fdm["ic/psi-true-deg"] = heading_deg
@@ -348,8 +391,10 @@ class JSBSimAircraft:
             fdm[prop] = val
         for i in range(self.n_engines):
             fdm[f"fcs/throttle-cmd-norm[{i}]"] = 0.5
-        fdm["gear/gear-cmd-norm"] = 0.0
-        fdm["gear/gear-pos-norm"] = 0.0
+        fdm["gear/gear-cmd-norm"] = 1.0 if gear_down else 0.0
+        fdm["gear/gear-pos-norm"] = 1.0 if gear_down else 0.0
+        fdm["fcs/flap-cmd-norm"] = flap_cmd_norm
+        fdm["fcs/flap-pos-norm"] = flap_cmd_norm
         for i in range(self.n_engines):
             fdm[f"fcs/mixture-cmd-norm[{i}]"] = 1.0
             fdm[f"fcs/advance-cmd-norm[{i}]"] = 1.0
@@ -417,6 +462,16 @@ class JSBSimAircraft:
         if throttle is not None:
             set_thr(throttle)
             set_nx_engage(0.0)
+
+    def configure(self, flap_cmd_norm: float | None = None,
+                  gear_down: bool | None = None) -> None:
+        """Select a flap detent (``fcs/flap-cmd-norm``, the model's normalised flap command;
+        the model's kinematic moves the flaps at its own rate) and/or the gear
+        (``gear/gear-cmd-norm`` 1 down, 0 up); None leaves a control as it is."""
+        if flap_cmd_norm is not None:
+            self._w_flap.set_double_value(float(flap_cmd_norm))
+        if gear_down is not None:
+            self._w_gear.set_double_value(1.0 if gear_down else 0.0)
 
     # -- stepping and state ----------------------------------------------------------------
     def run(self, n_steps: int = 1) -> bool:

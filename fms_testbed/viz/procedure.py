@@ -135,10 +135,33 @@ def plot_vertical(df, summary, fp) -> Figure:
     ax.grid(alpha=0.3)
     cons = summary.get("constraints", [])
     missed = sum(c.get("ok") is False for c in cons)
-    ax.set_title(f"{fp.path.name}: vertical profile — {len(cons)} constraints checked, "
-                 f"{missed} missed")
+    thr = summary.get("threshold") or {}
+    title = (f"{fp.path.name}: vertical profile — {len(cons)} constraints checked, "
+             f"{missed} missed")
+    if thr.get("crossed"):
+        row = np.searchsorted(df["t_s"].to_numpy(), thr["t_s"])
+        x = df["along_m"].to_numpy()[min(row, len(df) - 1)] / NM_M
+        h_ft = float(np.interp(thr["t_s"], df["t_s"], df["alt_m"])) / FT_M
+        ax.plot(x, h_ft, "g*", ms=12, label=f"threshold {thr['runway']} crossed: "
+                f"{thr['height_ft']:.0f} ft (TCH {thr['tch_ft']}), "
+                f"{thr['path_angle_deg'] if thr['path_angle_deg'] is not None else float('nan'):.2f}°"
+                f" (VPA {thr['vpa_deg']}), {thr['cas_kt']:.0f} kt")
+        title += (f"\nthreshold: CAS − Vapp {thr['cas_minus_vapp_kt']:+.1f} kt, "
+                  f"height − TCH {thr['height_minus_tch_ft']:+.0f} ft, "
+                  f"angle − VPA {thr['path_angle_minus_vpa_deg']:+.2f}°, "
+                  f"{'configured' if thr['configured'] else 'NOT configured'}"
+                  if thr.get("cas_minus_vapp_kt") is not None
+                  and thr.get("height_minus_tch_ft") is not None
+                  and thr.get("path_angle_minus_vpa_deg") is not None else "")
+    ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="best")
     ax2.plot(s_nm, df["cas_mps"] / KT_MPS, color="crimson", lw=1.2, label="flown CAS")
+    sp = getattr(prof, "speed", None) if prof is not None else None
+    if sp is not None:
+        ax2.plot(np.asarray(sp.along_m) / NM_M, np.asarray(sp.cas_mps) / KT_MPS, "b-",
+                 lw=0.9, alpha=0.6, label=f"planned CAS (decelerations; Vapp "
+                                          f"{sp.vapp_cas_mps / KT_MPS:.0f} kt)")
+    _config_marks(ax2, df, summary)
     for c in summary.get("constraints", []):
         if "cas_kt" in c:
             lim = float(str(c["speed_limit_kt"]).lstrip("+-@"))
@@ -154,6 +177,22 @@ def plot_vertical(df, summary, fp) -> Figure:
     ax2.legend(fontsize=8, loc="best")
     fig.tight_layout()
     return fig
+
+
+def _config_marks(ax, df, summary) -> None:
+    """Flap and gear changes (guidance events of kind 'config') as labelled ticks on the CAS
+    panel, at the distance flown when they were commanded."""
+    ev = [e for e in summary.get("guidance_events", []) if e.get("kind") == "config"]
+    if not ev or df.empty:
+        return
+    t, s = df["t_s"].to_numpy(), df["along_m"].to_numpy() / NM_M
+    cas = df["cas_mps"].to_numpy() / KT_MPS
+    for k, e in enumerate(ev):
+        i = min(int(np.searchsorted(t, e["t_s"])), len(t) - 1)
+        ax.plot(s[i], cas[i], "|", color="darkgreen", ms=14, mew=2,
+                label="flap / gear commanded" if k == 0 else None)
+        ax.annotate(e["detail"], (s[i], cas[i]), fontsize=7, rotation=60, color="darkgreen",
+                    xytext=(2, 6), textcoords="offset points")
 
 
 def plot_errors(df, summary, fp) -> Figure:
@@ -190,6 +229,10 @@ def plot_errors(df, summary, fp) -> Figure:
     if "pde_m" in df and np.isfinite(df["pde_m"]).any():
         ax_n.plot(s_nm, df["pde_m"], lw=1.0, ls=":", color="C4",
                   label="PDE: |built − coded path|, m")
+    dist = [df[c].to_numpy(dtype=float) for c in ("nse_m", "pde_m") if c in df]
+    top = max([np.nanmax(v) for v in dist if np.isfinite(v).any()], default=0.0)
+    # at least 10 m: round-off of a zero NSE (truth navigation) is not drawn as a signal
+    ax_n.set_ylim(0.0, max(10.0, 1.1 * top))
     legs = df["leg_index"].to_numpy()
     codes = df["leg_code"].to_numpy()
     starts = np.flatnonzero(np.r_[True, legs[1:] != legs[:-1]])

@@ -102,10 +102,13 @@ def test_airport_sample_is_a_seeded_rule():
 
 
 def test_conditions_refuse_what_the_stack_cannot_fly(tmp_path):
-    with pytest.raises(ConfigError, match="isa_dev_c.*not modelled"):
-        make_conditions({"isa_dev_c": 15}, "x")
-    with pytest.raises(ConfigError, match="missed.*not flown"):
-        make_conditions({"missed": True}, "x")
+    with pytest.raises(ConfigError, match="isa_dev_c.*less than or equal to 60"):
+        make_conditions({"isa_dev_c": 95}, "x")
+    with pytest.raises(ConfigError, match="field 'wind'.*not above layer"):
+        make_conditions({"wind": [{"alt_ft": 5000, "from_deg": 1, "speed_kt": 5},
+                                  {"alt_ft": 0, "from_deg": 1, "speed_kt": 5}]}, "x")
+    with pytest.raises(ConfigError, match="field 'missed': expected true or false"):
+        make_conditions({"missed": "yes"}, "x")
     with pytest.raises(ConfigError, match="wind.from_deg"):
         make_conditions({"wind": {"from_deg": 400, "speed_kt": 10}}, "x")
     f = tmp_path / "c.yaml"
@@ -120,8 +123,8 @@ def test_conditions_refuse_what_the_stack_cannot_fly(tmp_path):
 
 
 @pytest.mark.parametrize("argv, msg", [
-    (["--isa-dev-c", "10"], "--isa-dev-c: ISA temperature deviation"),
-    (["--missed"], "--missed: missed approaches are not flown"),
+    (["--isa-dev-c", "99"], "--isa-dev-c '99': must be within -60..60"),
+    (["--isa-dev-c", "warm"], "expected a number of °C"),
     (["--nav", "sins"], "give the IMU preset"),
     (["--nav", "sins:NOPE"], "unknown IMU preset"),
     (["--keep", "movies"], "'movies' is not one of"),
@@ -133,3 +136,47 @@ def test_run_refuses_in_one_line(argv, msg, tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert msg in err and len(err.splitlines()) == 1
     assert not (tmp_path / "o").exists()
+
+
+def test_isa_deviation_and_wind_profile_enter_the_condition_set_and_case_id():
+    """An ISA deviation and a wind profile are condition-set keys: they go into the scenario
+    overrides, the canonical JSON the case id hashes, and the default name; an ISA set keeps the
+    case id it had before the key existed (no 'atmosphere' key at 0)."""
+    from fms_testbed.campaign.conditions import command_line_sets
+
+    isa = make_conditions({}, "x")
+    hot = make_conditions({"isa_dev_c": 20}, "x")
+    prof = make_conditions({"wind": [{"alt_ft": 0, "from_deg": 250, "speed_kt": 10},
+                                     {"alt_ft": 10000, "from_deg": 280, "speed_kt": 50}]}, "x")
+    assert isa.overrides() == {"navigation": {"source": "truth"}}
+    assert "atmosphere" not in isa.canonical()
+    assert hot.overrides()["atmosphere"] == {"isa_dev_c": 20.0}
+    assert hot.name == "calm ISA+20" and not hot.nominal and isa.nominal
+    assert '"isa_dev_c":20.0' in hot.canonical()
+    assert prof.name == "wind profile 2 layers"
+    assert prof.wind_speed_mps == pytest.approx(50 * 0.514444, rel=1e-4)
+    assert prof.overrides()["wind"][1]["alt_ft"] == 10000
+    sets = command_line_sets([None], [{"source": "truth"}], [0.0, 15.0, -15.0])
+    assert [c.name for c in sets] == ["calm", "calm ISA+15", "calm ISA-15"]
+    assert len({c.canonical() for c in sets}) == 3
+
+
+def test_regress_run_takes_isa_deviations_as_condition_sets(tmp_path):
+    """``regress run --wind calm 270/30 --isa-dev-c 0 20``: four condition sets, the ISA ones
+    named and hashed as before, the warm ones with 'ISA+20' and an atmosphere override."""
+    from fms_testbed.cli import build_parser
+    from fms_testbed.cli.regress import config_from_args
+
+    args = build_parser().parse_args(["regress", "run", "--wind", "calm", "270/30",
+                                      "--isa-dev-c", "0", "20", "--out", str(tmp_path / "o")])
+    sets = config_from_args(args).conditions
+    assert [c.name for c in sets] == ["calm", "calm ISA+20", "wind 270/30kt",
+                                      "wind 270/30kt ISA+20"]
+    assert sets[1].overrides()["atmosphere"] == {"isa_dev_c": 20.0}
+    assert sets[0].canonical() == make_conditions({}, "x").canonical()
+    f = tmp_path / "c.yaml"
+    f.write_text("conditions:\n  - name: hot-shear\n    isa_dev_c: 20\n    wind:\n"
+                 "      - {alt_ft: 0, from_deg: 250, speed_kt: 10}\n"
+                 "      - {alt_ft: 10000, from_deg: 280, speed_kt: 50}\n")
+    (c,) = read_conditions(f)
+    assert c.isa_dev_c == 20.0 and len(c.overrides()["wind"]) == 2

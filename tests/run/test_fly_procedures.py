@@ -160,7 +160,8 @@ def test_timeseries_has_the_contract_columns(db):
 
 def test_an_impossible_speed_ends_the_flight_with_a_clear_status(db, tmp_path):
     """A 737 whose planned speed is 60 m/s TAS (far below its stall speed) starts trimmed at a
-    normal 118 m/s, then guidance asks for 60 m/s: it stalls and the run ends 'diverged' with
+    normal 118 m/s, then guidance asks for 60 m/s, clean (its approach block with the flap
+    schedule removed): it stalls and the run ends 'diverged' with
     the reason — no hang, no exception."""
     import yaml
 
@@ -170,6 +171,7 @@ def test_an_impossible_speed_ends_the_flight_with_a_clear_status(db, tmp_path):
     raw["name"] = "737-slow"
     raw["limits"]["climb_tas_mps"] = 60.0
     raw["limits"]["cas_min_mps"] = 40.0
+    raw.pop("approach", None)   # clean throughout: no flaps to slow down with
     p = tmp_path / "737-slow.yaml"
     p.write_text(yaml.safe_dump(raw))
     scn, spec, fp, d = prepare({"aircraft": str(p), "procedure": {

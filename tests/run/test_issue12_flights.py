@@ -171,3 +171,38 @@ def test_I_heading_legs_drift_is_predicted_in_wind(cifp):
     direct-to after them starts where the aircraft is (FTE95 608 m before)."""
     res, fp = fly(cifp, "KBCT", "MYZNR2", runway="05", wind_kt=30)
     within_goals(res)
+
+
+def test_rebuild_in_a_turn_starts_after_the_roll_out(cifp):
+    """KHLN DIVD1 RW09 (CA VI FA DF): the FA's altitude is met while the aircraft still banks
+    left on the VI, and the DF is rebuilt from there. Rebuilt from the present track with a
+    wings-level roll-in, the aircraft rolled through the reversal 205 m outside the DF turn
+    (FTE95 150 m); started where the roll-out ends (guidance/replan.roll_out_state), the
+    turn is flown on its path."""
+    res, fp = fly(cifp, "KHLN", "DIVD1", runway="09")
+    e = within_goals(res)
+    assert e["max_m"] < 100.0, e
+    assert res.summary["status"] == "ok", res.summary["reason"]
+
+
+def test_sid_joined_at_an_at_fix_starts_at_its_altitude(cifp):
+    """KAPA ECHOO1 RW35B (runway part 'B' for both runways, first leg IF BAPME 'at 8,000 ft',
+    the transition altitude 18,000 ft in the same record): the start was capped only by 'at or
+    below' windows and joined BAPME at the 18,000 ft cap, 10,000 ft above its window."""
+    res, fp = fly(cifp, "KAPA", "ECHOO1", "SHAYK", runway="35B")
+    within_goals(res)
+    assert abs(fp.path.legs[0].start.alt_m - 8000 * FT) < 1.0
+    assert res.summary["status"] == "ok", res.summary["reason"]
+
+
+def test_cf_from_a_fix_just_off_its_course_turns_onto_it_as_a_fly_by(cifp):
+    """KBIS ILS 31 via YIRNU (AF → IF WIGAG → CF ICONO): WIGAG lies 133 m beside the 311°
+    course into ICONO. The CF intercepted it with a 702 m S-turn; the 83° turn off the arc
+    found no room for its fly-by on that, was flown over WIGAG and looped back: 747 m max FTE,
+    not contained in RNP 0.3. Flown as the line WIGAG → ICONO (legs/builder.CF_FROM_FIX_DEG)
+    the turn is a fly-by off the arc."""
+    res, fp = fly(cifp, "KBIS", "I31", "YIRNU")
+    e = within_goals(res)
+    assert e["max_m"] < 50.0, e
+    assert not [f for f in fp.path.findings if "does not fit" in f.message]
+    assert res.summary["status"] == "ok", res.summary["reason"]

@@ -1,0 +1,352 @@
+"""Flight-test attitude-reference mode (seed 004, Filyashkin & Rogozhin): estimate the heading,
+roll and pitch errors of an attitude reference in flight from GNSS position and velocity.
+
+The reference's angles resolve an accurate accelerometer block in a strapdown computer
+(:mod:`fms_testbed.sensors.attitude_reference`, truth side); the differences between the
+computer's and the GNSS receiver's position and velocity feed a discrete Kalman filter over
+seed 004's state vector — 15 computer/reference errors (δp, δV, the reference's δγ, δϑ, δψ, their
+drifts, accelerometer biases) plus 6 GNSS Markov errors (position, velocity)::
+
+    z_p = p_comp - p_GNSS = δp - m_p - w_p      z_v = V_comp - V_GNSS = δV - m_v - w_v
+
+Φ_k and Q_k come from the Picard series over F at the computer's indicated state
+(:func:`~fms_testbed.sensors.attitude_reference.system_matrix`, at the angles the computer
+resolves with); prediction and the Joseph-form correction (delayed for a late fix) are
+:mod:`.kalman`'s. After a used fix the estimate of (δp, δV, angle and drift residuals) is fed
+back: the computer resets its position and velocity and adds the angle and drift parts to its
+correction c, c_d of the reference's angles (the reference itself is not touched: it is the unit
+under test). The estimate of the reference's errors is c + x̂_θ, its σ the filter's (the
+covariance of the residual). What guidance flies on is the computer's solution corrected by the
+filter.
+
+Scenario block (``navigation:``, validated by
+:class:`~fms_testbed.config.navigation.AttitudeReferenceBlock`)::
+
+    source: attitude_reference
+    imu: HG9900                       # the accelerometer block (its accelerometers only)
+    reference: {bias_sigma_deg: [0.1, 0.1, 0.5], drift_sigma_dph: [0.5, 0.5, 1.0],
+                arw_deg_rh: [0.003, 0.003, 0.003], bias_deg: [..], drift_dph: [..]}
+    gnss: {...}                       # as for ins_gnss
+    init_pos_sigma_m: 1.0
+    init_vel_sigma_mps: 0.05
+    gate_sigma: 5
+
+Logged columns (``NavSolution.errors``), per angle in (roll, pitch, heading):
+``att_ref_err_<a>_deg`` (injected: the reference's error, indicated minus true),
+``att_ref_est_<a>_deg`` (the filter's estimate), ``att_ref_sigma_<a>_deg`` (its 1σ), plus
+``anp_m`` and ``nse_{east,north,up}_m``. :func:`attitude_reference_summary` turns them into the
+``summary.json`` block: the estimation error at 60 s and after, against the paper's goal and the
+filter's 3σ.
+
+Observability (why the profiles matter): the reference's errors reach the velocity only through
+[f^N ×] ε. In straight and level flight f^N ≈ (0, 0, g): the tilt errors show (against the
+accelerometer biases, which they cannot be told from while the heading is constant: the floor
+is σ_ba/g), the heading error does not — it needs horizontal specific force (turns, speed
+changes).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pandas as pd
+from pydantic import ValidationError
+
+from fms_testbed.config.navigation import AttitudeReferenceBlock
+from fms_testbed.config.yamlfile import validation_message
+from fms_testbed.core.earth import radii_m
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.state import AircraftState, NavSolution
+from fms_testbed.core.units import DEG_RAD, DPH_RPS
+from fms_testbed.navigation.ins_bank import derive_seeds
+from fms_testbed.navigation.ins_filter import enu_difference_m
+from fms_testbed.navigation.ins_gnss import gnss_spec
+from fms_testbed.navigation.kalman import correct, correct_delayed, innovation, predict
+from fms_testbed.sensors.attitude_reference import (ANGLES, N_STATES, AttitudeReferenceSpec,
+                                                    FlightTestErrors, initial_variance,
+                                                    noise_density, system_matrix)
+from fms_testbed.sensors.gnss import GnssFix, GnssReceiver, GnssSpec
+from fms_testbed.sensors.sins.analysis import horizontal_radius
+from fms_testbed.sensors.sins.discretize import discretize
+from fms_testbed.sensors.sins.presets import ImuModel, load_imu
+
+N_FILTER = N_STATES + 6
+MP, MV = slice(15, 18), slice(18, 21)
+GOAL_DEG = {"roll": 0.01, "pitch": 0.02, "heading": 0.06}
+"""Seed 004's reported estimation errors of the reference's angles (after 50-120 s), deg."""
+GOAL_AT_S = 60.0
+"""Time by which the goal is to be met (and held), s."""
+_BUFFER_S = 2.0
+
+
+class AttitudeReferenceFilter:
+    """The 21-state Kalman filter of the flight-test mode (module docstring).
+
+    Parameters
+    ----------
+    spec : the reference's declared error model;  imu : the accelerometer block
+    gnss : the GNSS receiver's declared error model
+    p0 : (15,) prior variance of the computer/reference states (GNSS states: stationary)
+    gate_sigma : innovation gate per component, σ
+    """
+
+    def __init__(self, spec: AttitudeReferenceSpec, imu: ImuModel, gnss: GnssSpec,
+                 p0: np.ndarray, gate_sigma: float = 5.0):
+        n = N_FILTER
+        self.gnss, self.gate_sigma = gnss, float(gate_sigma)
+        self.q = np.zeros(n)
+        self.q[:N_STATES] = noise_density(spec, imu)
+        self.q[15:21] = 2.0 * gnss.markov_sigma ** 2 / gnss.markov_tau_s
+        self._decay = np.zeros(n)
+        self._decay[15:21] = 1.0 / gnss.markov_tau_s
+        self._ba_decay = np.asarray(imu.decay_rps[0:3], float)
+        self.x = np.zeros(n)
+        self.P = np.diag(np.r_[p0, gnss.markov_sigma ** 2])
+        self._no_freeze = np.zeros(n, np.bool_)
+        self._lag: list[tuple[float, np.ndarray, np.ndarray]] = []
+        self._H_pos = np.zeros((3, n))
+        self._H_pos[:, 0:3], self._H_pos[:, MP] = np.eye(3), -np.eye(3)
+        self._H_vel = np.zeros((3, n))
+        self._H_vel[:, 3:6], self._H_vel[:, MV] = np.eye(3), -np.eye(3)
+        w = gnss.white_sigma ** 2
+        self._r_pos, self._r_vel = np.diag(w[:3]), np.diag(w[3:6])
+
+    def predict(self, t_s: float, lat_rad: float, alt_m: float, v_enu_mps, rpy_rad, f_b_mps2,
+                dt_s: float) -> None:
+        """Propagate over ``dt_s`` (s) from ``t_s`` with F at the computer's indicated state
+        (latitude rad, height m, velocity m/s, the reference's angles rad) and the specific
+        force (body, m/s²): x⁻ = Φ x, P⁻ = Φ P Φᵀ + Q_k (Picard, Babich eq. 2.9, 4.5)."""
+        F = np.zeros((N_FILTER, N_FILTER))
+        F[:N_STATES, :N_STATES] = system_matrix(lat_rad, alt_m, v_enu_mps, f_b_mps2, rpy_rad,
+                                                self._ba_decay)
+        F[np.arange(15, 21), np.arange(15, 21)] = -self._decay[15:21]
+        phi, qk = discretize(F, np.diag(self.q), dt_s, method="picard")
+        self.x, self.P = predict(self.x, self.P, phi, qk)
+        self._lag.append((t_s, phi, qk))
+        if len(self._lag) > 64:
+            del self._lag[:-64]
+
+    def _lag_since(self, t_m: float):
+        steps = [(phi, qk) for t0, phi, qk in self._lag if t0 >= t_m - 1e-9]
+        if not steps:
+            return None
+        phi_lag, q_lag = steps[0]
+        for phi, qk in steps[1:]:
+            phi_lag, q_lag = phi @ phi_lag, phi @ q_lag @ phi.T + qk
+        return phi_lag, q_lag
+
+    def _group(self, z, H, R, lag) -> tuple[np.ndarray, float, bool]:
+        if lag is None:
+            nu, S, nis = innovation(self.x, self.P, z, H, R)
+        else:
+            _, _, nu, S, nis = correct_delayed(self.x, self.P, z, H, R, lag[0], lag[1],
+                                               self._no_freeze)
+        used = bool(np.all(np.abs(nu) <= self.gate_sigma * np.sqrt(np.diag(S))))
+        if used:
+            if lag is None:
+                self.x, self.P, *_ = correct(self.x, self.P, z, H, R, self._no_freeze)
+            else:
+                self.x, self.P, *_ = correct_delayed(self.x, self.P, z, H, R, lag[0], lag[1],
+                                                     self._no_freeze)
+        return nu, nis, used
+
+    def gnss_update(self, fix: GnssFix, comp_at_fix: tuple) -> list[tuple[str, float, bool]]:
+        """Use a fix (position, then velocity) against the computer's output at its time of
+        validity, ``(lat rad, lon rad, alt m, V (3,) m/s)``; returns (group, NIS, used) each."""
+        lag = self._lag_since(fix.t_s)
+        lat, lon, alt, v = comp_at_fix
+        zp = enu_difference_m(lat, lon, alt, fix.lat_rad, fix.lon_rad, fix.alt_m)
+        zv = np.asarray(v, float) - fix.v_enu_mps
+        out = []
+        for name, z, H, R in (("gnss_pos", zp, self._H_pos, self._r_pos),
+                              ("gnss_vel", zv, self._H_vel, self._r_vel)):
+            _, nis, used = self._group(z, H, R, lag)
+            out.append((name, nis, used))
+        return out
+
+    def take_feedback(self) -> np.ndarray:
+        """The (δp, δV, angle, drift) block of x̂ (12,), handed to the computer; zeroed in the
+        filter (the accelerometer-bias and GNSS states stay)."""
+        dx = self.x[0:12].copy()
+        self.x[0:12] = 0.0
+        return dx
+
+
+def reference_spec(block) -> AttitudeReferenceSpec:
+    """:class:`AttitudeReferenceSpec` (SI) from a validated ``navigation.reference`` block."""
+    def rad(v):
+        return None if v is None else tuple(x * DEG_RAD for x in v)
+
+    def rps(v):
+        return None if v is None else tuple(x * DPH_RPS for x in v)
+
+    # deg/√h → rad/√s: deg→rad, and 1/√h = 1/60 per √s
+    return AttitudeReferenceSpec(
+        rad(block.bias_sigma_deg), rps(block.drift_sigma_dph),
+        tuple(x * DEG_RAD / 60.0 for x in block.arw_deg_rh),
+        tuple(x * DPH_RPS / 60.0 for x in block.drift_rw_dph_rh), rad(block.bias_deg),
+        rps(block.drift_dph))
+
+
+class AttitudeReferenceNavigation:
+    """Navigation source of the flight-test mode; see the module docstring for the keys.
+
+    Parameters
+    ----------
+    errors : the truth-side reference and computer errors
+    receiver : the GNSS receiver;  flt : the filter
+    """
+
+    def __init__(self, errors: FlightTestErrors, receiver: GnssReceiver,
+                 flt: AttitudeReferenceFilter):
+        self.errors, self.receiver, self.filter = errors, receiver, flt
+        self.events: list[dict] = []
+        self._prev: tuple | None = None        # (truth, computer output, reference angles)
+        self._buffer: list[tuple[float, tuple]] = []
+        self._gate_open = {"gnss_pos": True, "gnss_vel": True}
+        self.nis_log: list[tuple[float, str, float]] = []
+
+    @classmethod
+    def from_spec(cls, spec: dict, seed: int | None = None) -> "AttitudeReferenceNavigation":
+        """Build from a scenario's ``navigation`` mapping (``spec['seed']`` wins over ``seed``).
+
+        Raises
+        ------
+        ConfigError : unknown key or bad value (named ``navigation.<key>``), unknown IMU
+        """
+        try:
+            b = AttitudeReferenceBlock.model_validate(spec)
+        except ValidationError as err:
+            msg = validation_message("navigation", err)
+            raise ConfigError(msg.replace("navigation: field '", "field 'navigation.", 1)) from None
+        imu = load_imu(b.imu)
+        sd = b.seed if b.seed is not None else (0 if seed is None else int(seed))
+        s_gnss, s_ref = derive_seeds(sd, 2)
+        ref, g = reference_spec(b.reference), gnss_spec(b.gnss)
+        errs = FlightTestErrors(ref, imu, s_ref, b.init_pos_sigma_m, b.init_vel_sigma_mps)
+        p0 = initial_variance(ref, imu, b.init_pos_sigma_m, b.init_vel_sigma_mps)
+        src = cls(errs, GnssReceiver(g, s_gnss), AttitudeReferenceFilter(ref, imu, g, p0,
+                                                                         b.gate_sigma))
+        src.seed = sd
+        return src
+
+    def _at(self, t_s: float) -> tuple | None:
+        for t, comp in reversed(self._buffer):
+            if abs(t - t_s) <= 1e-6:
+                return comp
+        return None
+
+    def update(self, truth: AircraftState) -> NavSolution:
+        """Advance to ``truth.t_s``: truth-side errors, prediction, any delivered GNSS fix
+        (gated; then the computer's reset); return the corrected solution."""
+        errs, flt = self.errors, self.filter
+        errs.update(truth)
+        comp = errs.computer_position(truth)
+        ref = errs.computer_angles(truth)
+        prev = self._prev
+        if prev is not None and truth.t_s > prev[0].t_s:
+            pt, pc, pr = prev
+            flt.predict(pt.t_s, pc[0], pc[2], pc[3], pr, pt.f_body_mps2, truth.t_s - pt.t_s)
+        self._buffer.append((truth.t_s, comp))
+        while self._buffer and self._buffer[0][0] < truth.t_s - _BUFFER_S:
+            self._buffer.pop(0)
+        for fix in self.receiver.update(truth):
+            at = self._at(fix.t_s)
+            if at is None:
+                continue
+            groups = flt.gnss_update(fix, at)
+            for name, nis, used in groups:
+                self.nis_log.append((fix.t_s, name, nis))
+                if self._gate_open[name] != used:
+                    self.events.append({"t_s": round(truth.t_s, 3), "unit": "gnss",
+                                        "kind": "reconfigured" if used else "detected",
+                                        "stage": "innovation_gate",
+                                        "reason": f"{name} {'accepted again' if used else 'rejected'}"})
+                self._gate_open[name] = used
+            if any(u for _, _, u in groups):
+                errs.reset(flt.take_feedback())
+                comp = errs.computer_position(truth)
+                ref = errs.computer_angles(truth)
+                self._buffer[-1] = (truth.t_s, comp)
+        self._prev = (truth, comp, ref)
+        return self.solution(truth, comp, ref)
+
+    def solution(self, truth: AircraftState, comp: tuple, ref: tuple) -> NavSolution:
+        """The computer's output and angles (the reference's minus c) minus the filter's
+        estimates, with the logged columns (module docstring)."""
+        x, P = self.filter.x, self.filter.P
+        est = self.errors.c_rad + x[6:9]         # estimate of the reference's errors, rad
+        lat0, lon0, h0, v0 = comp
+        rm, rn = radii_m(lat0)
+        lat = lat0 - x[1] / (rm + h0)
+        lon = lon0 - x[0] / ((rn + h0) * math.cos(lat0))
+        alt = h0 - x[2]
+        v = np.asarray(v0, float) - x[3:6]
+        roll, pitch = ref[0] - x[6], ref[1] - x[7]
+        hdg = (ref[2] - x[8]) % (2 * math.pi)
+        rmt, rnt = radii_m(truth.lat_rad)
+        injected = self.errors.angle_errors_rad()
+        errors = {"anp_m": horizontal_radius(P[0, 0], P[1, 1], P[0, 1]),
+                  "nse_east_m": (lon - truth.lon_rad) * (rnt + truth.alt_m)
+                  * math.cos(truth.lat_rad),
+                  "nse_north_m": (lat - truth.lat_rad) * (rmt + truth.alt_m),
+                  "nse_up_m": alt - truth.alt_m}
+        for i, a in enumerate(ANGLES):
+            errors[f"att_ref_err_{a}_deg"] = math.degrees(injected[i])
+            errors[f"att_ref_est_{a}_deg"] = math.degrees(est[i])
+            errors[f"att_ref_sigma_{a}_deg"] = math.degrees(math.sqrt(max(P[6 + i, 6 + i], 0.0)))
+        return NavSolution(truth.t_s, lat, lon, alt, v, roll, pitch, hdg, errors,
+                           pos_cov_enu_m2=P[:3, :3].copy())
+
+
+def attitude_reference_summary(df: pd.DataFrame, at_s: float = GOAL_AT_S,
+                               goal_deg: dict[str, float] | None = None) -> dict | None:
+    """The ``attitude_reference`` block of ``summary.json`` from a run's timeseries.
+
+    Per angle: the estimation error e = estimate - injected (deg) at ``at_s`` and its largest
+    magnitude from ``at_s`` on, the filter's σ at ``at_s``, the largest |e|/σ from ``at_s`` on,
+    ``meets_goal`` (|e| ≤ goal at every sample from ``at_s`` on; seed 004: 0.06° heading, 0.01°
+    roll, 0.02° pitch), ``inside_3sigma`` (|e| ≤ 3σ at every sample from ``at_s`` on), and
+    ``within_goal_from_s`` (the time after which |e| stays within the goal; None: it never
+    does). None when the run has no attitude-reference columns.
+
+    Parameters
+    ----------
+    df : the timeseries (``t_s``, ``att_ref_{err,est,sigma}_<angle>_deg``)
+    at_s : the time from which the goal is judged, s
+    goal_deg : goal per angle, deg (default :data:`GOAL_DEG`)
+    """
+    if "att_ref_err_roll_deg" not in df:
+        return None
+    goal = dict(GOAL_DEG if goal_deg is None else goal_deg)
+    t = df["t_s"].to_numpy(float)
+    if t[-1] < at_s:
+        return {"at_s": at_s, "goal_deg": goal, "angles": {}, "meets_goal": False,
+                "inside_3sigma": False, "reason": f"flight ended at {t[-1]:.1f} s < {at_s:g} s"}
+    k0 = int(np.searchsorted(t, at_s - 1e-9))
+    angles = {}
+    for a in ANGLES:
+        e = df[f"att_ref_est_{a}_deg"].to_numpy(float) - df[f"att_ref_err_{a}_deg"].to_numpy(float)
+        s = df[f"att_ref_sigma_{a}_deg"].to_numpy(float)
+        after, ratio = np.abs(e[k0:]), np.abs(e[k0:]) / s[k0:]
+        out = np.flatnonzero(np.abs(e) > goal[a])
+        within = (float(t[0]) if out.size == 0 else
+                  (float(t[out[-1] + 1]) if out[-1] + 1 < t.size else None))
+        angles[a] = {
+            "injected_at_s_deg": round(float(df[f"att_ref_err_{a}_deg"].iloc[k0]), 5),
+            "err_at_s_deg": round(float(e[k0]), 5),
+            "max_abs_err_after_deg": round(float(after.max()), 5),
+            "sigma_at_s_deg": round(float(s[k0]), 5),
+            "max_err_over_sigma_after": round(float(ratio.max()), 3),
+            "goal_deg": goal[a],
+            "meets_goal": bool(after.max() <= goal[a]),
+            "inside_3sigma": bool(ratio.max() <= 3.0),
+            "within_goal_from_s": None if within is None else round(within, 2)}
+    return {"at_s": at_s, "goal_deg": goal, "angles": angles,
+            "meets_goal": all(v["meets_goal"] for v in angles.values()),
+            "inside_3sigma": all(v["inside_3sigma"] for v in angles.values())}
+
+
+__all__ = ["AttitudeReferenceFilter", "AttitudeReferenceNavigation", "GOAL_AT_S", "GOAL_DEG",
+           "attitude_reference_summary", "reference_spec"]

@@ -1,0 +1,232 @@
+"""Attitude reference under flight test, the truth side: its heading/roll/pitch errors, and the
+errors of the flight-test strapdown computer that resolves accelerometers with its angles
+(seed 004, Filyashkin & Rogozhin, Fig. 1).
+
+The reference (a vertical gyro, a heading-and-attitude reference, an INS under test) outputs
+angles, indicated minus true (rad)::
+
+    δγ(t), δϑ(t), δψ(t) = θ_0 + ∫ d dt + ∫ w_θ dt,   ḋ = w_d
+
+θ_0 the constant errors, d the drift of each angle (rad/s; the "systematic gyro errors" of the
+reference, seen at its angle outputs after its own erection and slaving loops), w_θ an angle
+random walk and w_d a drift random walk (white, densities ``arw`` and ``drift_rw``). These angles
+form the direction-cosine matrix B of seed 004 that resolves a block of accurate accelerometers
+(bias b_a, white noise) into the navigation frame; position and velocity are then integrated.
+With C̃ = C(γ+δγ, ϑ+δϑ, ψ+δψ) = (I - ε×) C and ε = M(ϑ, ψ) (δγ, δϑ, δψ) (the inverse of eq. 6.10,
+:func:`~fms_testbed.sensors.sins.euler.euler_errors_to_eps`), the computer's error state (15,
+seed 004's order with the attitude errors as Euler angles)::
+
+    0:3 δp E, N, U, m   3:6 δV E, N, U, m/s   6:9 δγ, δϑ, δψ, rad   9:12 d_γ, d_ϑ, d_ψ, rad/s
+    12:15 b_a x, y, z (body), m/s²
+
+obeys ẋ = F x + w with the position/velocity rows of the project's SINS model
+(:func:`~fms_testbed.sensors.sins.model.build_F`, free vertical channel) and
+δV̇ = … + [f^N ×] M (δγ, δϑ, δψ) + C b_a. The truth side propagates this linear model at the true
+state (the project's convention for INS errors: truth ⊕ an error realisation), discretised by the
+Picard series (:func:`~fms_testbed.sensors.sins.discretize.discretize`).
+
+Closed loop: the computer resolves the accelerometers with the reference's angles minus its
+current estimate of their errors, c(t) (ċ = c_d, both updated by the filter's feedback,
+:meth:`FlightTestErrors.reset`); the angle states above are then the *residual* errors
+θ - c, d - c_d of the angles it uses, small once the filter has converged, so the linear model
+stays exact to second order in the residual (with the reference's full 0.5° errors in the
+model, the neglected ε×(ε×f) term reaches 1e-3 m/s² in a 25° turn — a 0.005° tilt). The
+reference's own error is θ = (θ - c) + c.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fms_testbed.core.earth import radii_m
+from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.state import AircraftState
+from fms_testbed.sensors.sins.discretize import discretize
+from fms_testbed.sensors.sins.euler import euler_errors_to_eps
+from fms_testbed.sensors.sins.model import build_F, dcm_body_to_enu
+from fms_testbed.sensors.sins.presets import ImuModel
+
+N_STATES = 15
+POS, VEL, ANG, DRIFT, BA = (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 15))
+ANGLES = ("roll", "pitch", "heading")
+"""Order of the reference's angle errors in the state (δγ, δϑ, δψ)."""
+
+
+@dataclass(frozen=True)
+class AttitudeReferenceSpec:
+    """Error model of the attitude reference, SI, per angle (roll, pitch, heading), 1σ.
+
+    bias_sigma_rad : σ of the constant errors θ_0, rad
+    drift_sigma_rps : σ of the drift rates d (random constants), rad/s
+    arw_rad_rs : angle random walk density, rad/√s
+    drift_rw_rps_rs : drift random walk density, rad/s/√s
+    bias_rad, drift_rps : the injected values (rad, rad/s); None: drawn from the σ by the seed
+    """
+
+    bias_sigma_rad: tuple[float, float, float]
+    drift_sigma_rps: tuple[float, float, float]
+    arw_rad_rs: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    drift_rw_rps_rs: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    bias_rad: tuple[float, float, float] | None = None
+    drift_rps: tuple[float, float, float] | None = None
+
+    def __post_init__(self):
+        for name in ("bias_sigma_rad", "drift_sigma_rps", "arw_rad_rs", "drift_rw_rps_rs"):
+            v = getattr(self, name)
+            if len(v) != 3 or not all(math.isfinite(x) and x >= 0 for x in v):
+                raise ConfigError(f"navigation.reference.{name}: three finite values >= 0 "
+                                  "(roll, pitch, heading)")
+        for name in ("bias_rad", "drift_rps"):
+            v = getattr(self, name)
+            if v is not None and (len(v) != 3 or not all(math.isfinite(x) for x in v)):
+                raise ConfigError(f"navigation.reference.{name}: three finite values")
+
+
+def euler_to_eps_matrix(pitch_rad: float, heading_rad: float) -> np.ndarray:
+    """M (3×3): ε (E, N, U, rad) = M (δγ, δϑ, δψ) — the inverse of paper eq. 6.10 as a matrix.
+
+    Parameters
+    ----------
+    pitch_rad, heading_rad : pitch ϑ and heading ψ, rad
+    """
+    cols = [euler_errors_to_eps(*np.eye(3)[j], pitch_rad, heading_rad) for j in range(3)]
+    return np.array(cols, float).T
+
+
+def system_matrix(lat_rad: float, alt_m: float, v_enu_mps, f_b_mps2, rpy_rad,
+                  ba_decay_rps) -> np.ndarray:
+    """F (15×15) of the flight-test computer's error model (module docstring).
+
+    Parameters
+    ----------
+    lat_rad, alt_m : latitude (rad) and height (m) the model is linearised at
+    v_enu_mps : (3,) velocity E, N, U, m/s
+    f_b_mps2 : (3,) specific force, body forward/right/down, m/s²
+    rpy_rad : (roll, pitch, heading), rad
+    ba_decay_rps : (3,) 1/τ of the accelerometer biases (0: random constant/walk), 1/s
+    """
+    c = dcm_body_to_enu(*rpy_rad)
+    # body rates do not enter the rows taken here (no gyro states): a zero rate is exact
+    F33 = build_F(float(lat_rad), float(alt_m), np.asarray(v_enu_mps, float),
+                  np.asarray(f_b_mps2, float), np.zeros(3), c, np.zeros(24), 0.0, 0.0)
+    F = np.zeros((N_STATES, N_STATES))
+    F[0:6, 0:6] = F33[0:6, 0:6]
+    F[VEL, ANG] = F33[3:6, 6:9] @ euler_to_eps_matrix(rpy_rad[1], rpy_rad[2])
+    F[VEL, BA] = F33[3:6, 9:12]
+    F[ANG, DRIFT] = np.eye(3)
+    F[BA, BA] = -np.diag(np.asarray(ba_decay_rps, float))
+    return F
+
+
+def noise_density(spec: AttitudeReferenceSpec, imu: ImuModel) -> np.ndarray:
+    """(15,) diagonal of the continuous white-noise density: accelerometer white noise on δV,
+    the reference's angle and drift random walks, the accelerometer bias instability
+    (state-unit²/s; the IMU's body-axis densities, isotropic, are the same in ENU)."""
+    q = np.zeros(N_STATES)
+    q[VEL] = imu.q_psd[3:6]
+    q[ANG] = np.square(spec.arw_rad_rs)
+    q[DRIFT] = np.square(spec.drift_rw_rps_rs)
+    q[BA] = imu.q_psd[9:12]
+    return q
+
+
+def initial_variance(spec: AttitudeReferenceSpec, imu: ImuModel, pos_sigma_m: float,
+                     vel_sigma_mps: float) -> np.ndarray:
+    """(15,) prior variance: the computer initialised on a GNSS fix (σ of position, velocity),
+    the reference's declared constant errors and drifts, the accelerometers' turn-on bias."""
+    p = np.zeros(N_STATES)
+    p[POS] = pos_sigma_m ** 2
+    p[VEL] = vel_sigma_mps ** 2
+    p[ANG] = np.square(spec.bias_sigma_rad)
+    p[DRIFT] = np.square(spec.drift_sigma_rps)
+    p[BA] = imu.p0_var[9:12]
+    return p
+
+
+def _sample_factor(Q: np.ndarray) -> np.ndarray:
+    """L with L Lᵀ = Q for a symmetric positive semidefinite Q (eigen-decomposition)."""
+    w, V = np.linalg.eigh(0.5 * (Q + Q.T))
+    return V * np.sqrt(np.clip(w, 0.0, None))
+
+
+class FlightTestErrors:
+    """The truth-side errors of the attitude reference and of the flight-test computer.
+
+    Parameters
+    ----------
+    spec : the reference's error model (and injected values, when given)
+    imu : the accelerometer block (its accelerometer bias and noise are used, not its gyros)
+    seed : seed of this realisation
+    pos_sigma_m, vel_sigma_mps : σ of the computer's initial position/velocity error, m, m/s
+    """
+
+    def __init__(self, spec: AttitudeReferenceSpec, imu: ImuModel, seed: int,
+                 pos_sigma_m: float = 1.0, vel_sigma_mps: float = 0.05):
+        self.spec, self.imu = spec, imu
+        self.rng = np.random.default_rng(seed)
+        p0 = initial_variance(spec, imu, pos_sigma_m, vel_sigma_mps)
+        self.x = np.sqrt(p0) * self.rng.standard_normal(N_STATES)
+        if spec.bias_rad is not None:
+            self.x[ANG] = spec.bias_rad
+        if spec.drift_rps is not None:
+            self.x[DRIFT] = spec.drift_rps
+        self.q = noise_density(spec, imu)
+        self._ba_decay = np.asarray(imu.decay_rps[0:3], float)
+        self._prev: AircraftState | None = None
+        self.c_rad = np.zeros(3)            # the computer's angle correction c, rad
+        self.c_rps = np.zeros(3)            # and its drift correction c_d, rad/s
+
+    def update(self, truth: AircraftState) -> None:
+        """Propagate the errors from the previous true state to ``truth.t_s`` (F at the previous
+        true state, Picard Φ_k and Q_k, one Gaussian draw of the discrete noise)."""
+        prev = self._prev
+        self._prev = truth
+        if prev is None or truth.t_s <= prev.t_s:
+            return
+        F = system_matrix(prev.lat_rad, prev.alt_m, prev.v_enu_mps, prev.f_body_mps2,
+                          (prev.roll_rad, prev.pitch_rad, prev.heading_rad), self._ba_decay)
+        dt = truth.t_s - prev.t_s
+        phi, qk = discretize(F, np.diag(self.q), dt, method="picard")
+        self.x = phi @ self.x + _sample_factor(qk) @ self.rng.standard_normal(N_STATES)
+        self.c_rad = self.c_rad + self.c_rps * dt
+
+    def angle_errors_rad(self) -> np.ndarray:
+        """(3,) the reference's current errors (δγ, δϑ, δψ), indicated minus true, rad."""
+        return self.x[ANG] + self.c_rad
+
+    def reference_angles(self, truth: AircraftState) -> tuple[float, float, float]:
+        """(roll, pitch, heading) the reference outputs, rad (heading in [0, 2π))."""
+        d = self.angle_errors_rad()
+        return (truth.roll_rad + d[0], truth.pitch_rad + d[1],
+                (truth.heading_rad + d[2]) % (2 * math.pi))
+
+    def computer_angles(self, truth: AircraftState) -> tuple[float, float, float]:
+        """(roll, pitch, heading) the computer resolves with: the reference's minus c, rad."""
+        d = self.x[ANG]
+        return (truth.roll_rad + d[0], truth.pitch_rad + d[1],
+                (truth.heading_rad + d[2]) % (2 * math.pi))
+
+    def computer_position(self, truth: AircraftState) -> tuple[float, float, float, np.ndarray]:
+        """(lat rad, lon rad, alt m, V ENU (3,) m/s) the flight-test computer outputs."""
+        rm, rn = radii_m(truth.lat_rad)
+        h = truth.alt_m
+        dp = self.x[POS]
+        return (truth.lat_rad + dp[1] / (rm + h),
+                truth.lon_rad + dp[0] / ((rn + h) * math.cos(truth.lat_rad)), h + dp[2],
+                np.asarray(truth.v_enu_mps, float) + self.x[VEL])
+
+    def reset(self, dx: np.ndarray) -> None:
+        """Feedback of an estimate (12,) of (δp, δV, angle and drift residuals): the computer
+        subtracts (δp, δV) from its position and velocity and adds the angle and drift parts to
+        its corrections c, c_d (a linear model: the same as subtracting them from the error)."""
+        dx = np.asarray(dx, float)
+        self.x[0:12] -= dx
+        self.c_rad = self.c_rad + dx[6:9]
+        self.c_rps = self.c_rps + dx[9:12]
+
+
+__all__ = ["ANGLES", "AttitudeReferenceSpec", "FlightTestErrors", "N_STATES", "euler_to_eps_matrix",
+           "initial_variance", "noise_density", "system_matrix"]

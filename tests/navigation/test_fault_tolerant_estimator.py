@@ -1,0 +1,158 @@
+"""Seed 001's decision functions on arrays and the fault-tolerant estimator: channel test,
+adaptive R with its divergence check, baro-channel exclusion, vertical-channel freezing."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fms_testbed.navigation import make_source
+from fms_testbed.navigation.fdi import (FdiTuning, adaptive_r, channel_mask, declared_sensor_noise,
+                                        frozen_states, majority, pair_flags, residual_ok)
+from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
+from fms_testbed.sensors.sins.presets import load_imu
+
+
+def test_pair_flags_and_the_majority_table_name_the_odd_unit_out():
+    y = np.zeros((3, 9))
+    sig = np.ones((3, 9))
+    assert list(pair_flags(y, sig, 6.0)) == [0, 0, 0] and majority((0, 0, 0)) is None
+    y[1, 4] = 9.0                                              # unit 2, velocity N: 9 > 6√2
+    nu = pair_flags(y, sig, 6.0)
+    assert list(nu) == [1, 0, 1] and majority(nu) == 1
+    y[1, 4] = 8.0                                              # 8 < 6√2 = 8.49
+    assert list(pair_flags(y, sig, 6.0)) == [0, 0, 0]
+
+
+def test_a_frozen_vertical_channel_is_left_out_of_the_comparison():
+    y = np.zeros((3, 9))
+    y[2, 2] = 100.0                                            # unit 3, position U
+    sig = np.ones((3, 9))
+    assert majority(pair_flags(y, sig, 6.0)) == 2
+    assert list(pair_flags(y, sig, 6.0, channel_mask(True))) == [0, 0, 0]
+    assert channel_mask(False).all() and list(np.flatnonzero(~channel_mask(True))) == [2, 5]
+
+
+def test_frozen_states_are_the_vertical_ones_that_exist():
+    assert list(np.flatnonzero(frozen_states(22, True))) == [2, 5, 21]
+    assert list(np.flatnonzero(frozen_states(21, True))) == [2, 5]
+    assert not frozen_states(22, False).any()
+
+
+def test_residual_ok_is_the_channel_test_per_component():
+    S = np.diag([4.0, 1.0, 9.0])
+    assert list(residual_ok(np.array([9.9, -5.1, 14.0]), S, 5.0)) == [True, False, True]
+
+
+def test_adaptive_r_inflates_to_the_innovation_decays_back_and_flags_divergence():
+    tune = FdiTuning()
+    R = np.diag([1.0, 1.0, 4.0])
+    hph = np.array([0.5, 0.5, 0.5])
+    scale = np.ones(3)
+    nu = np.array([0.3, 10.0, -1.0])                          # component 2: 10 > 3√1.5
+    scale, div = adaptive_r(scale, nu, np.diag(hph + np.diag(R) * scale), R, tune)
+    np.testing.assert_allclose(scale, [1.0, 100.0 - 0.5, 1.0])
+    assert not div
+    scale, div = adaptive_r(scale, np.zeros(3), np.diag(hph + np.diag(R) * scale), R, tune)
+    np.testing.assert_allclose(scale, [1.0, 0.9 * 99.5, 1.0])
+    big = np.array([0.0, 1e3, 0.0])                            # R at its cap cannot explain it
+    scale, div = adaptive_r(scale, big, np.diag(hph + np.diag(R) * scale), R, tune)
+    assert scale[1] == tune.adapt_max and div
+
+
+def test_declared_sensor_noise_is_the_presets_vrw_arw_and_scale_factor_misalignment():
+    imu = load_imu("STIM300")
+    q, sf = declared_sensor_noise([imu, imu], 0.1)
+    assert q.shape == (2, 6) and sf.shape == (2, 2)
+    assert math.isclose(math.sqrt(q[0, 3]), math.radians(0.15) / 60.0, rel_tol=1e-6)
+    assert math.isclose(math.sqrt(q[0, 0]), 0.06 / 60.0, rel_tol=1e-6)
+    assert math.isclose(sf[0, 1], (500e-6) ** 2 + 2 * 1e-3 ** 2, rel_tol=1e-6)
+
+
+@pytest.fixture(scope="module")
+def climb():
+    segs = [Segment(100.0), Segment(150.0, 0.0, 3.0), Segment(100.0)]
+    return aircraft_states(fly_profile(segs, dt_s=0.1, speed_mps=150.0))
+
+
+def test_a_stuck_baro_in_a_climb_is_excluded_and_the_vertical_stays_on_gnss(climb):
+    nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=0)
+    up = []
+    for s in climb:
+        up.append(nav.update(s).errors["nse_up_m"])
+        if abs(s.t_s - 120.0) < 1e-6:
+            nav.inject({"unit": "baro", "kind": "baro_failure"}, s.t_s)
+    exc = [e for e in nav.events if e["kind"] == "excluded" and e["unit"].startswith("baro")]
+    assert {e["unit"] for e in exc} == {"baro@ins1", "baro@ins2", "baro@ins3"}
+    assert all(120.0 < e["t_s"] < 150.0 for e in exc)
+    assert not [e for e in nav.events if e["kind"] == "excluded" and e["unit"].startswith("ins")]
+    assert np.max(np.abs(up[2000:])) < 10.0                   # GNSS keeps the vertical
+
+
+def test_no_altitude_measurement_freezes_the_vertical_channel_and_gnss_releases_it(climb):
+    nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3, "baro": None,
+                       "gnss": {"outages": [{"start_s": 150.0, "end_s": 250.0}]}}, seed=1)
+    frozen_at = {}
+    for s in climb:
+        nav.update(s)
+        if abs(s.t_s - 200.0) < 1e-6:
+            frozen_at = {i: f.frozen.copy() for i, f in enumerate(nav.filters)}
+    ev = [e for e in nav.events if e["kind"] == "reconfigured" and e["stage"] == "estimator"]
+    frz = [e for e in ev if "frozen" in e["reason"]]
+    rel = [e for e in ev if "released" in e["reason"]]
+    assert len(frz) == 3 and all(150.0 < e["t_s"] < 153.0 for e in frz)
+    assert len(rel) == 3 and all(250.0 <= e["t_s"] < 252.0 for e in rel)
+    assert all(list(np.flatnonzero(m)) == [2, 5] for m in frozen_at.values())
+    assert not any(f.frozen.any() for f in nav.filters)
+    assert not [e for e in nav.events if e["kind"] == "excluded"]
+
+
+EVENT_KINDS = {"fault_injected", "detected", "isolated", "excluded", "reconfigured", "alert"}
+
+
+@pytest.mark.slow
+def test_ins_fault_step_logs_every_step_as_an_event_and_the_columns_follow_it(tmp_path):
+    from fms_testbed.data import scenarios_dir
+    from fms_testbed.run import run_scenario
+    res = run_scenario(scenarios_dir() / "ins-fault-step.yaml", progress=False)
+    ev = res.summary["navigation"]["events"]
+    assert ev and all(set(e) == {"t_s", "unit", "kind", "stage", "reason"} for e in ev)
+    assert {e["kind"] for e in ev} <= EVENT_KINDS
+    assert [e["t_s"] for e in ev] == sorted(e["t_s"] for e in ev)
+    first = {k: next(e for e in ev if e["kind"] == k) for k in
+             ("fault_injected", "detected", "isolated", "excluded", "reconfigured")}
+    assert first["fault_injected"]["unit"] == "ins2" and first["excluded"]["unit"] == "ins2"
+    assert (first["fault_injected"]["t_s"] <= first["detected"]["t_s"]
+            <= first["isolated"]["t_s"] <= first["excluded"]["t_s"])
+    df = res.df
+    assert {"nav_mode", "ins_used", "anp_m", "rnp_alert", "ins_used_ref", "ins_used_vote",
+            "refdesc_d_ins1"} <= set(df.columns)
+    t_exc = first["excluded"]["t_s"]
+    before, after = df[df.t_s < t_exc - 0.05], df[df.t_s >= t_exc + 0.05]
+    assert set(before.ins_used) == {7.0} and set(after.ins_used) == {5.0}
+    assert set(df.nav_mode[df.t_s > 5]) == {0.0} and (df.anp_m[df.t_s > 5] > 0).all()
+    assert set(df.rnp_alert) == {0.0}
+    assert res.summary["navigation"]["nse95_m"]["output"] < 5.0
+
+
+def test_adaptive_r_rides_out_a_gnss_noise_burst_and_returns_to_nominal():
+    segs = [Segment(100.0), Segment(40.0, 3.0), Segment(160.0)]
+    states = aircraft_states(fly_profile(segs, dt_s=0.1, speed_mps=150.0))
+    out = {}
+    for adaptive in (False, True):
+        nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 1,
+                           "gnss": {"outliers": [{"start_s": 150.0, "end_s": 210.0,
+                                                  "sigma_m": 8.0}]}}, seed=4)
+        nav.ft.adaptive = adaptive
+        peak, nse = 1.0, []
+        for s in states:
+            e = nav.update(s).errors
+            peak = max(peak, float(nav.filters[0].r_scale["gnss_pos"].max()))
+            if 150.0 <= s.t_s < 215.0:
+                nse.append(math.hypot(e["nse_east_m"], e["nse_north_m"]))
+        out[adaptive] = (peak, float(np.percentile(nse, 95)),
+                         nav.filters[0].r_scale["gnss_pos"].copy(), nav.events)
+    assert out[False][0] == 1.0 and out[True][0] > 5.0
+    np.testing.assert_allclose(out[True][2], 1.0, atol=1e-3)   # back to nominal after the burst
+    assert out[True][1] < out[False][1]                        # the burst pulls it less
+    assert not [e for e in out[True][3] if e["stage"] == "adaptive_r"]
