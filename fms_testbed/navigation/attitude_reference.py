@@ -62,7 +62,8 @@ from fms_testbed.core.units import DEG_RAD, DPH_RPS
 from fms_testbed.navigation.ins_bank import derive_seeds
 from fms_testbed.navigation.ins_filter import enu_difference_m
 from fms_testbed.navigation.ins_gnss import gnss_spec
-from fms_testbed.navigation.kalman import correct, correct_delayed, innovation, predict
+from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed, innovation,
+                                          predict)
 from fms_testbed.sensors.attitude_reference import (ANGLES, N_STATES, AttitudeReferenceSpec,
                                                     FlightTestErrors, initial_variance,
                                                     noise_density, system_matrix)
@@ -104,7 +105,7 @@ class AttitudeReferenceFilter:
         self.x = np.zeros(n)
         self.P = np.diag(np.r_[p0, gnss.markov_sigma ** 2])
         self._no_freeze = np.zeros(n, np.bool_)
-        self._lag: list[tuple[float, np.ndarray, np.ndarray]] = []
+        self._lag = PredictionLag()
         self._H_pos = np.zeros((3, n))
         self._H_pos[:, 0:3], self._H_pos[:, MP] = np.eye(3), -np.eye(3)
         self._H_vel = np.zeros((3, n))
@@ -123,18 +124,10 @@ class AttitudeReferenceFilter:
         F[np.arange(15, 21), np.arange(15, 21)] = -self._decay[15:21]
         phi, qk = discretize(F, np.diag(self.q), dt_s, method="picard")
         self.x, self.P = predict(self.x, self.P, phi, qk)
-        self._lag.append((t_s, phi, qk))
-        if len(self._lag) > 64:
-            del self._lag[:-64]
+        self._lag.append(t_s, phi, qk)
 
     def _lag_since(self, t_m: float):
-        steps = [(phi, qk) for t0, phi, qk in self._lag if t0 >= t_m - 1e-9]
-        if not steps:
-            return None
-        phi_lag, q_lag = steps[0]
-        for phi, qk in steps[1:]:
-            phi_lag, q_lag = phi @ phi_lag, phi @ q_lag @ phi.T + qk
-        return phi_lag, q_lag
+        return self._lag.since(t_m)
 
     def _group(self, z, H, R, lag) -> tuple[np.ndarray, float, bool]:
         if lag is None:

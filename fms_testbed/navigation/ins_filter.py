@@ -45,7 +45,8 @@ from fms_testbed.core.earth import OMEGA_IE_RPS, radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import G0_MPS2
-from fms_testbed.navigation.kalman import correct, correct_delayed, innovation, predict
+from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed, innovation,
+                                          predict)
 from fms_testbed.navigation.sins import _c_bn
 from fms_testbed.sensors.baro import BaroReading, BaroSpec
 from fms_testbed.sensors.gnss import GnssFix, GnssSpec
@@ -243,7 +244,7 @@ class InsGnssFilter:
         # fdi.FaultTolerantEstimator) and the adaptive-R inflation per group (1: nominal R)
         self.frozen = self._no_freeze
         self.r_scale = {"gnss_pos": np.ones(3), "gnss_vel": np.ones(3), "baro": np.ones(1)}
-        self._lag: list[tuple[float, np.ndarray, np.ndarray]] = []   # (t_start_s, Φ, Q_k)
+        self._lag = PredictionLag()   # (t_start_s, Φ, Q_k) of the recent steps
         self.t_s: float | None = None
         R = np.zeros(n)
         R[:6] = gnss.white_sigma ** 2
@@ -343,22 +344,13 @@ class InsGnssFilter:
 
     def _record_step(self, t0_s: float, phi: np.ndarray, qk: np.ndarray, dt_s: float) -> None:
         """Keep a prediction step's (Φ, Q_k) for delayed measurements; advance the time."""
-        self._lag.append((t0_s, phi, qk))
-        if len(self._lag) > 64:
-            del self._lag[:-64]
+        self._lag.append(t0_s, phi, qk)
         self.t_s = t0_s + dt_s
 
     # -- measurements ----------------------------------------------------------------------
     def _lag_since(self, t_m: float):
         """(Φ(t, t_m), Q_lag) over the prediction steps since ``t_m`` (None: no step since)."""
-        steps = [(phi, qk) for t0, phi, qk in self._lag if t0 >= t_m - 1e-9]
-        if not steps:
-            return None
-        phi_lag, q_lag = steps[0]
-        for phi, qk in steps[1:]:
-            phi_lag = phi @ phi_lag
-            q_lag = phi @ q_lag @ phi.T + qk
-        return phi_lag, q_lag
+        return self._lag.since(t_m)
 
     def nominal_r(self, name: str) -> np.ndarray:
         """The declared measurement covariance of group ``name`` (before adaptive inflation)."""

@@ -115,4 +115,36 @@ def correct_delayed(x, P, z, H, R, phi_lag, q_lag, frozen):
     return x + K @ nu, 0.5 * (Pn + Pn.T), nu, S, nis
 
 
-__all__ = ["correct", "correct_delayed", "innovation", "predict"]
+class PredictionLag:
+    """The last ``keep`` prediction steps (t_start_s, Φ_k, Q_k), for measurements that arrive
+    with a latency (:func:`correct_delayed` needs Φ(t, t_m) and Q_lag over (t_m, t]).
+
+    Parameters
+    ----------
+    keep : steps kept (at 10 Hz, 64 steps = 6.4 s of latency)
+    """
+
+    def __init__(self, keep: int = 64):
+        self.keep = int(keep)
+        self.steps: list[tuple[float, np.ndarray, np.ndarray]] = []
+
+    def append(self, t0_s: float, phi: np.ndarray, qk: np.ndarray) -> None:
+        """Keep the step that starts at ``t0_s`` (s) with its Φ_k and Q_k."""
+        self.steps.append((t0_s, phi, qk))
+        if len(self.steps) > self.keep:
+            del self.steps[:-self.keep]
+
+    def since(self, t_m: float) -> tuple[np.ndarray, np.ndarray] | None:
+        """(Φ(t, t_m), Q_lag) over the kept steps that start at or after ``t_m`` (s):
+        Φ ← Φ_k Φ, Q ← Φ_k Q Φ_kᵀ + Q_k; None when no step has started since."""
+        steps = [(phi, qk) for t0, phi, qk in self.steps if t0 >= t_m - 1e-9]
+        if not steps:
+            return None
+        phi_lag, q_lag = steps[0]
+        for phi, qk in steps[1:]:
+            phi_lag = phi @ phi_lag
+            q_lag = phi @ q_lag @ phi.T + qk
+        return phi_lag, q_lag
+
+
+__all__ = ["PredictionLag", "correct", "correct_delayed", "innovation", "predict"]

@@ -15,13 +15,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
-from fms_testbed.core.atmosphere import cas_to_tas, tas_to_cas
 from fms_testbed.core.geodesy import inverse, wrap180
 from fms_testbed.core.segments import Arc, project
 from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
 from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.profile import plan_profile, sid_join_required_alt_m
+from fms_testbed.path.segmentation import planned_conditions
 
 #: Tolerances: fly-over pass, gaps (the coded-arc radius tolerances are the leg classes'
 #: ``radius_tol_m``).
@@ -91,16 +91,10 @@ def arc_conditions_text(tas_mps: float, wind_mps: float, isa_dev_c: float, alt_m
     isa_dev_c : planned ISA deviation, K; alt_m : the leg's planned altitude, m
     radius_m : the arc's radius, m; bank_deg : the planned bank, deg; g_mps2 : gravity, m/s²
     """
-    if wind_mps <= 0.05 and abs(isa_dev_c) < 0.05:
+    planned = planned_conditions(tas_mps, wind_mps, isa_dev_c, alt_m)
+    if planned is None:
         return ""
-    cond = f"{tas_mps / KT_MPS:.0f} kt TAS"
-    if wind_mps > 0.05:
-        cond += f" + {wind_mps / KT_MPS:.0f} kt tailwind"
-    if abs(isa_dev_c) >= 0.05:
-        cond += f", ISA{isa_dev_c:+.0f}"
-    v_isa = tas_mps
-    if isa_dev_c:
-        v_isa = float(cas_to_tas(tas_to_cas(tas_mps, alt_m, isa_dev_c), alt_m))
+    cond, v_isa = planned
     g_now = math.degrees(math.atan((tas_mps + wind_mps) ** 2 / (radius_m * g_mps2)))
     g_calm = math.degrees(math.atan(v_isa ** 2 / (radius_m * g_mps2)))
     forced = ": forced by the conditions" if g_calm <= bank_deg + 1e-9 else ""

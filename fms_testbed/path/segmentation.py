@@ -369,6 +369,30 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
     return out
 
 
+def planned_conditions(tas_mps: float, tailwind_mps: float, isa_dev_c: float,
+                       alt_m: float) -> tuple[str, float] | None:
+    """The planned conditions of a class-1 finding in words, and the TAS the same CAS has in
+    calm ISA air (m/s): e.g. ("245 kt TAS + 30 kt tailwind, ISA+20", 238.1 kt in m/s); None in
+    calm ISA air.
+
+    Parameters
+    ----------
+    tas_mps : planned TAS, m/s; tailwind_mps : planned wind along the turn, m/s
+    isa_dev_c : planned ISA deviation, K; alt_m : the leg's planned altitude, m
+    """
+    if tailwind_mps <= 0.05 and abs(isa_dev_c) < 0.05:
+        return None
+    cond = f"{tas_mps / KT_MPS:.0f} kt TAS"
+    if tailwind_mps > 0.05:
+        cond += f" + {tailwind_mps / KT_MPS:.0f} kt tailwind"
+    if abs(isa_dev_c) >= 0.05:
+        cond += f", ISA{isa_dev_c:+.0f}"
+    v_isa = tas_mps
+    if isa_dev_c:
+        v_isa = float(cas_to_tas(tas_to_cas(tas_mps, alt_m, isa_dev_c), alt_m))
+    return cond, v_isa
+
+
 def conditions_text(tas_mps: float, tailwind_mps: float, isa_dev_c: float, alt_m: float,
                     radius_m: float, radius_fit_m: float, bank_deg: float, g_mps2: float) -> str:
     """What the planned conditions do to a turn that does not fit, for a class-1 finding
@@ -385,16 +409,10 @@ def conditions_text(tas_mps: float, tailwind_mps: float, isa_dev_c: float, alt_m
     radius_fit_m : largest radius the legs leave room for, m; bank_deg : planned bank, deg
     g_mps2 : gravity, m/s²
     """
-    if tailwind_mps <= 0.05 and abs(isa_dev_c) < 0.05:
+    planned = planned_conditions(tas_mps, tailwind_mps, isa_dev_c, alt_m)
+    if planned is None:
         return ""
-    cond = f"{tas_mps / KT_MPS:.0f} kt TAS"
-    if tailwind_mps > 0.05:
-        cond += f" + {tailwind_mps / KT_MPS:.0f} kt tailwind"
-    if abs(isa_dev_c) >= 0.05:
-        cond += f", ISA{isa_dev_c:+.0f}"
-    v_isa = tas_mps
-    if isa_dev_c:
-        v_isa = float(cas_to_tas(tas_to_cas(tas_mps, alt_m, isa_dev_c), alt_m))
+    cond, v_isa = planned
     r_calm = turn_radius_m(v_isa, bank_deg, g_mps2)
     forced = ": forced by the conditions" if r_calm <= radius_fit_m else ""
     return (f"; turn radius {radius_m:.0f} m at {cond} ({r_calm:.0f} m in calm ISA air) "
