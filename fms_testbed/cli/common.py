@@ -105,9 +105,11 @@ def add_override_options(p, aircraft_default: str | None = None) -> None:
                                                         " (overrides the scenario's)"))
     p.add_argument("--wind", help=WIND_HELP)
     p.add_argument("--isa-dev-c", metavar="DEG_C", help=ISA_DEV_HELP)
-    p.add_argument("--nav", choices=("truth", "sins", "ins_gnss"),
-                   help="navigation source guidance flies on")
-    p.add_argument("--imu", help="IMU preset of the INS (with --nav sins or ins_gnss)")
+    p.add_argument("--nav", metavar="SOURCE",
+                   help="navigation source guidance flies on: truth, or one of the registered "
+                        "sources with an IMU (sins, ins_gnss, attitude_reference; an unknown "
+                        "name lists them)")
+    p.add_argument("--imu", help="IMU preset of the INS (with a --nav source other than truth)")
     p.add_argument("--rnp", type=float, help="RNP, NM, where the procedure's records code none")
     p.add_argument("--allow-degraded", action="store_true",
                    help="fly a procedure with a rejected or duplicated record of its own "
@@ -130,12 +132,17 @@ def overrides_from_args(args) -> dict:
     if getattr(args, "isa_dev_c", None) is not None:
         out["atmosphere"] = {"isa_dev_c": parse_isa_dev(args.isa_dev_c)}
     nav, imu = getattr(args, "nav", None), getattr(args, "imu", None)
-    if nav in ("sins", "ins_gnss"):
+    if nav is not None and nav != "truth":
+        from fms_testbed.navigation import SOURCES     # lazy: the registry imports the filters
+
+        if nav not in SOURCES:
+            raise UserError(f"--nav {nav}: unknown navigation source (available: "
+                            f"{', '.join(SOURCES)})")
         if not imu:
             raise UserError(f"--nav {nav} needs --imu PRESET")
         out["navigation"] = {"source": nav, "imu": imu}
     elif imu:
-        raise UserError("--imu is only used with --nav sins or --nav ins_gnss")
+        raise UserError("--imu is only used with a --nav source other than truth")
     elif nav == "truth":
         out["navigation"] = {"source": "truth"}
     proc: dict = {}

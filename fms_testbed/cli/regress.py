@@ -44,22 +44,27 @@ def _winds(values: list[str] | None) -> list[dict | None]:
 
 
 def _navs(values: list[str] | None, imu: str | None) -> list[dict]:
+    """Navigation blocks of ``--nav truth|SOURCE[:PRESET] ...`` (any registered source with an
+    IMU: :data:`fms_testbed.navigation.SOURCES`)."""
     if not values:
         if imu:
-            raise UserError("--imu is only used with --nav sins")
+            raise UserError("--imu is only used with a --nav source other than truth")
         return [{"source": "truth"}]
     out = []
     for v in values:
         name, _, preset = v.partition(":")
         if name == "truth" and not preset:
             out.append({"source": "truth"})
-        elif name == "sins":
-            preset = preset or imu
-            if not preset:
-                raise UserError(f"--nav {v}: give the IMU preset (sins:HG1700, or --imu PRESET)")
-            out.append({"source": "sins", "imu": preset})
-        else:
-            raise UserError(f"--nav {v!r}: expected truth, sins or sins:PRESET")
+            continue
+        from fms_testbed.navigation import SOURCES     # lazy: the registry imports the filters
+
+        if name == "truth" or name not in SOURCES:
+            raise UserError(f"--nav {v!r}: expected truth or SOURCE[:PRESET] with SOURCE one of "
+                            f"{', '.join(k for k in SOURCES if k != 'truth')}")
+        preset = preset or imu
+        if not preset:
+            raise UserError(f"--nav {v}: give the IMU preset ({name}:HG1700, or --imu PRESET)")
+        out.append({"source": name, "imu": preset})
     return out
 
 
@@ -178,7 +183,8 @@ def register(sub) -> None:
                    help="ISA temperature deviations, °C (several give several condition sets; "
                         "default 0)")
     r.add_argument("--nav", nargs="+", metavar="SOURCE",
-                   help="navigation sources: truth, sins, sins:PRESET (default truth)")
+                   help="navigation sources: truth or SOURCE[:PRESET], e.g. sins:HG1700, "
+                        "ins_gnss:STIM300 (default truth)")
     r.add_argument("--imu", help="IMU preset for --nav sins")
     r.add_argument("--conditions", metavar="FILE.yaml",
                    help="condition sets from a YAML file (instead of --wind/--isa-dev-c/--nav)")

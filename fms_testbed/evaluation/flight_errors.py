@@ -27,9 +27,13 @@ approaches). Constraint compliance: at the sample nearest each constrained fix (
 fix, nearest the middle of its fly-by arc, where the path passes it; for a leg that ends at a
 condition — altitude, DME, radial, intercept, distance — where it ended) the true altitude must
 be inside the coded window within :data:`ALT_TOL_FT` and the CAS inside the coded speed limit within :data:`SPEED_TOL_KT`.
+A circling approach's coded top below the lowest altitude guidance may descend to (the field
+elevation + 591 ft) is checked against that floor (:func:`constraint_checks`).
 """
 
 from __future__ import annotations
+
+import math
 
 import numpy as np
 import pandas as pd
@@ -107,8 +111,19 @@ def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
     return rows
 
 
-def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
-    """Altitude and speed compliance at each constrained fix (module docstring)."""
+FIX_LEFT_M = 2000.0
+"""A constrained fix is checked at its first passage: the next leg's samples count until the
+aircraft is this much farther from the fix than its closest approach so far, m."""
+
+
+def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf) -> list[dict]:
+    """Altitude and speed compliance at each constrained fix (module docstring).
+
+    ``floor_m``: the lowest altitude guidance descends to, m (a circling approach: the airport
+    elevation + ``guidance.fms.CIRCLING_FLOOR_HEIGHT_M``). A coded top below it — the CIFP
+    codes a circling MAP at the field elevation, not at an MDA — is checked against the floor
+    instead (``floor_ft`` in the row): the aircraft must not descend below the coded bottom
+    and must reach the floor, within the tolerance."""
     built = {lg.index: lg for lg in fp.path.legs}
     passing = _passing_points(fp.path)
     out = []
@@ -156,6 +171,13 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
             plat, plon = passing.get(k, (term.lat_deg, term.lon_deg))
             d = _dist_m(df["lat_deg"].to_numpy()[sel], df["lon_deg"].to_numpy()[sel],
                         plat, plon)
+            # the first passage: the next leg's samples only until the aircraft has left the
+            # fix (a hold at the fix comes back to it a circuit later, lower)
+            nxt = leg_col[sel] == k + 1
+            left = nxt & (d > np.minimum.accumulate(d) + FIX_LEFT_M)
+            if left.any():
+                cut = int(np.argmax(left))
+                sel, d = sel[:cut], d[:cut]
             j = int(np.argmin(d))
             i = int(sel[j])
             what = "the fix" if k not in passing else "the fly-by point abeam the fix"
@@ -172,6 +194,9 @@ def constraint_checks(df: pd.DataFrame, fp) -> list[dict]:
         if lo is not None or hi is not None:
             row["window_ft"] = [None if lo is None else round(lo / FT_M),
                                 None if hi is None else round(hi / FT_M)]
+            if hi is not None and hi < floor_m:
+                row["floor_ft"] = round(floor_m / FT_M)
+                hi = floor_m
             if lo is not None and alt_ft < lo / FT_M - ALT_TOL_FT:
                 ok = False
                 msgs.append(f"{lo / FT_M - alt_ft:.0f} ft below")
@@ -227,7 +252,7 @@ def flight_errors(df: pd.DataFrame, fp, guidance) -> dict:
     d = error_columns(df)
     legs = per_leg(d, fp.seq.legs)
     flown = [r for r in legs if r["samples"]]
-    cons = constraint_checks(d, fp)
+    cons = constraint_checks(d, fp, getattr(guidance, "floor_m", -math.inf))
     tse95 = _stats(d["tse_m"].to_numpy(dtype=float))["p95_m"]
     return {
         "errors": {**error_stats(d), "per_leg": legs,

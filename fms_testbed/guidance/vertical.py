@@ -180,6 +180,48 @@ def climb_targets(prof) -> list[float | None]:
     return out
 
 
+def knees_clear_of_windows(prof_s: list[float], prof_h: list[float],
+                           climb_tgt: list[float | None],
+                           windows: list[tuple[float | None, float | None]],
+                           w_m: float) -> tuple[list[float], list[float]]:
+    """The profile nodes (distances m, altitudes m) with every slope change at a constrained
+    fix of a descent moved ``w_m`` (at most half the leg it moves into) along the piece on the
+    side where its blend cannot cross the fix's window.
+
+    :func:`blended_profile` blends a corner over ±w on its outside, so at the fix the blended
+    profile is off the node's altitude by |Δγ| w / 4 (30 ft for a 3° descent that levels, at
+    250 kt with w = 6 s of flight):
+
+    - a corner the blend lies above (the descent flattens: γ_out > γ_in) at a fix with a top
+      ('at', 'at or below', 'between' planned at the top) moves back along the outgoing
+      piece, to (s − w, h − γ_out w): the blend ends at the fix, on the planned altitude;
+    - a corner the blend lies below (the descent steepens: γ_out < γ_in) at a fix with a floor
+      ('at', 'at or above') moves on along the incoming piece, to (s + w, h + γ_in w): the
+      blend starts at the fix.
+
+    The profile then passes every such fix at its planned altitude; the piece on the other
+    side of the moved corner is a little steeper or shallower."""
+    out_s, out_h = list(prof_s), list(prof_h)
+    for j in range(1, len(prof_s) - 1):
+        if j >= len(windows) or climb_tgt[j] is not None:
+            continue
+        lo, top = windows[j]
+        d_in, d_out = prof_s[j] - prof_s[j - 1], prof_s[j + 1] - prof_s[j]
+        if d_in <= 1e-6 or d_out <= 1e-6:
+            continue
+        g_in = (prof_h[j] - prof_h[j - 1]) / d_in
+        g_out = (prof_h[j + 1] - prof_h[j]) / d_out
+        if not (g_in < -1e-4 or g_out < -1e-4):
+            continue
+        if g_out > g_in + 1e-4 and top is not None and prof_h[j] >= top - 1.0:
+            d = min(w_m, 0.5 * (out_s[j] - out_s[j - 1]))
+            out_s[j], out_h[j] = prof_s[j] - d, prof_h[j] - g_out * d
+        elif g_out < g_in - 1e-4 and lo is not None and prof_h[j] <= lo + 1.0:
+            d = min(w_m, 0.5 * d_out)
+            out_s[j], out_h[j] = prof_s[j] + d, prof_h[j] + g_in * d
+    return out_s, out_h
+
+
 def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list[float | None],
                        s_path_m: float, gs_mps: float, lead_s: float, t2_s2: float,
                        top_m: float, approach: bool,
@@ -204,7 +246,10 @@ def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list
         above the lower bound of the node ahead until it is passed (the blend of a
         level-to-descent knee at an 'at or above' fix would otherwise cut below it)
     """
-    h, dh, ddh = blended_profile(prof_s, prof_h, s_path_m, gs_mps * BLEND_S, approach)
+    w_m = gs_mps * BLEND_S
+    bs, bh = (knees_clear_of_windows(prof_s, prof_h, climb_tgt, windows, w_m) if windows
+              else (prof_s, prof_h))
+    h, dh, ddh = blended_profile(bs, bh, s_path_m, w_m, approach)
     jn = bisect.bisect_right(prof_s, s_path_m)
     if windows is not None and 0 < jn < len(windows) and climb_tgt[jn] is None:
         # the blend of a knee at an 'at or above' (or 'at') fix ahead never cuts below it

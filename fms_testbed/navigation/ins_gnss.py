@@ -44,6 +44,7 @@ from fms_testbed.config.yamlfile import validation_message
 from fms_testbed.core.earth import radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
+from fms_testbed.core.units import G0_MPS2
 from fms_testbed.navigation.ins_bank import InsBank, derive_seeds
 from fms_testbed.navigation.faults import check_fault, inject
 from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
@@ -134,6 +135,10 @@ class InsGnssNavigation:
         # Zaitseva's reference-description monitor (three units; set by from_spec)
         self.refdesc: ReferenceDescriptionMonitor | None = None
         self.comparator: SensorComparator | None = None     # built at the second step (dt)
+        # each unit's declared (accelerometer, gyro) scale-factor + misalignment variance: the
+        # attitude error its filter does not model, in the comparison σ (.fdi.channel_sigmas)
+        self._unmodelled_var = [(float(a), float(g)) for a, g in
+                                declared_sensor_noise([f.imu for f in filters], 1.0)[1]]
         self.events: list[dict] = []
         self._prev_truth: AircraftState | None = None
         self._prev_ins: list[NavSolution] = []
@@ -316,7 +321,9 @@ class InsGnssNavigation:
             self.events += self.ft.set_vertical(i, truth.t_s, has_alt)
         if self.fdi is not None:
             y = self._comparison(sols)
-            sig = [channel_sigmas(f.P) for f in self.filters]
+            n_load = float(np.linalg.norm(truth.f_body_mps2)) / G0_MPS2
+            sig = [channel_sigmas(f.P, self._unmodelled_var[i], sols[i][4], sols[i][5], n_load)
+                   for i, f in enumerate(self.filters)]
             mask = self.ft.mask(self.fdi.state.used)
             self.events += self.fdi.update(truth.t_s, y, sig, self._sensor_pairs(truth), mask)
             used = [i for i, u in enumerate(self.fdi.state.used) if u]

@@ -397,7 +397,10 @@ class MonteCarlo:
             dr, dp, dh = eps_to_euler_errors(e[..., 6], e[..., 7], e[..., 8], s.pitch_rad,
                                              s.heading_rad)
             y = np.concatenate([e[..., :6], np.stack([dr, dp, dh], axis=-1)], axis=-1)
-            sig_g = np.array([channel_sigmas(Pg) for Pg in P])
+            # the units' attitude: the truth's (their errors, < 0.1°, change σ by < 1e-3)
+            n_load = float(np.linalg.norm(s.f_body_mps2)) / G0_MPS2
+            sig_g = np.array([channel_sigmas(Pg, (sf_var[0, 0], sf_var[0, 1]), s.roll_rad,
+                                             s.pitch_rad, n_load) for Pg in P])
             sig = sig_g[gidx].reshape(Rn, U, 9)
             if comparator is not None:
                 Xr = X.reshape(Rn, U, 33)

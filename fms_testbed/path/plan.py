@@ -27,6 +27,7 @@ from fms_testbed.config.procedure import ProcedureSpec, parse_procedure  # noqa:
 from fms_testbed.core.errors import ConfigError, UserError
 from fms_testbed.core.units import FT_M, NM_M
 from fms_testbed.legs.types import LEG_TYPES
+from fms_testbed.path.profile import PLAN_CLIMB_FRACTION  # noqa: F401 (re-export)
 
 
 
@@ -132,10 +133,6 @@ def merge_parts(parts: list, missed: bool = False):
                    lines=tuple(ln for p in parts for ln in p.lines))
 
 
-PLAN_CLIMB_FRACTION = 0.75
-"""The plan climbs (and, where it must descend steeply, descends) at this fraction of the
-aircraft's sustained climb (descent) rate: margin for the law to catch up after turns and
-speed changes."""
 
 
 def plan_climb_rate_mps(cfg) -> float:
@@ -213,7 +210,8 @@ def _finish(path, seq, spec, cfg, perf, params, offset: int,
                             descent_gradient_max=perf.descent_rate_max_mps / perf.tas_plan_mps,
                             descent_rate_mps=PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
                             wind=(params.wind_speed_mps, params.wind_from_deg),
-                            start_in_climb=in_missed)
+                            start_in_climb=in_missed, cas_plan_mps=cfg.limits.climb_tas_mps,
+                            isa_dev_c=params.isa_dev_c)
         if checked.proc_type == "F" and cfg.approach is not None:
             prof = replace(prof, speed=approach_speed_profile(checked, prof, cfg))
         checked = replace(checked, profile=prof)

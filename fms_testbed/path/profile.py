@@ -16,7 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from fms_testbed.core.units import FT_M
+from fms_testbed.core.units import FT_M, G0_MPS2
 from fms_testbed.legs.model import ProcedurePath
 
 
@@ -108,20 +108,28 @@ def descent_cap_margin_m(lo_m: float | None, hi_m: float) -> float:
     return min(0.25 * max(hi_m - lo_m, 0.0), DESCENT_CAP_MARGIN_M)
 
 
-def arrival_join_alt_m(path: ProcedurePath, descent_angle_deg: float = 3.0) -> float | None:
+def arrival_join_alt_m(path: ProcedurePath, descent_angle_deg: float = 3.0,
+                       cas_plan_mps: float | None = None, descent_rate_mps: float | None = None,
+                       isa_dev_c: float = 0.0) -> float | None:
     """Highest altitude an arrival (STAR, approach) should start at: the descent path planned
     back from its last constraint (the coded angles, else ``descent_angle_deg``, inside every
-    window) at its first fix, raised to that fix's own 'at or above', m (None: fewer than two
-    legs). Its first coded altitude may be an 'at or below' far above what the aircraft can
-    lose before the next fixes."""
+    window; with ``cas_plan_mps`` and ``descent_rate_mps`` within the energy budget of
+    :func:`plan_profile`) at its first fix, raised to that fix's own 'at or above', m (None:
+    fewer than two legs). Its first coded altitude may be an 'at or below' far above what the
+    aircraft can lose before the next fixes."""
     if len(path.legs) < 2:
         return None
     st0 = path.legs[0].start.alt_m
     prof = plan_profile(path, 0.0, st0, descent_angle_deg, descent_gradient_max=1e3)
     vpa = path.legs[1].record.vpa_deg
     ang = abs(vpa) if vpa else descent_angle_deg
-    back = float(prof.alt_m[2]) + math.tan(math.radians(ang)) * float(
-        prof.along_m[2] - prof.along_m[1])
+    ds = float(prof.along_m[2] - prof.along_m[1])
+    drop = math.tan(math.radians(ang)) * ds
+    if cas_plan_mps is not None and descent_rate_mps and not vpa:
+        # the second leg within the energy the aircraft can shed while it changes speed
+        v = descent_leg_tas_mps(path, prof.alt_m[1:], cas_plan_mps, isa_dev_c)
+        drop = min(drop, energy_drop_max_m(ds, v[1], v[1], v[0], descent_rate_mps))
+    back = float(prof.alt_m[2]) + drop
     r0 = path.legs[0].record
     lo, _ = window(r0.alt_desc, r0.alt1_m, r0.alt2_m)
     return max(back, lo) if lo is not None else back
@@ -145,12 +153,61 @@ def sid_join_required_alt_m(path: ProcedurePath, climb_gradient: float) -> float
     return None if need is None else min(need, cap)
 
 
+PLAN_CLIMB_FRACTION = 0.75
+"""The plan climbs (and, where it must descend steeply, descends) at this fraction of the
+aircraft's sustained climb (descent) rate: margin for the law to catch up after turns and
+speed changes."""
+
+
+def energy_drop_max_m(ds_m: float, gs_mps: float, tas_mps: float, tas_prev_mps: float,
+                      descent_rate_mps: float) -> float:
+    """Largest altitude drop over a leg within the aircraft's energy budget, m::
+
+        Δh ≤ (w_d / V_g) Δs + (V² − V_prev²) / (2 g)
+
+    ``ds_m`` the leg length (m), ``gs_mps`` its ground speed, ``tas_mps`` the TAS it is flown at
+    and ``tas_prev_mps`` the TAS of the leg before (a deceleration uses up part of the drop, an
+    acceleration adds to it), ``descent_rate_mps`` the planned descent rate w_d; never < 0."""
+    return max(descent_rate_mps / gs_mps * ds_m
+               + (tas_mps ** 2 - tas_prev_mps ** 2) / (2.0 * G0_MPS2), 0.0)
+
+
+def descent_leg_tas_mps(path: ProcedurePath, leg_alt_m: np.ndarray, cas_plan_mps: float,
+                        isa_dev_c: float = 0.0) -> np.ndarray:
+    """TAS each leg is flown at in a descent, m/s: the aircraft's planned CAS under every
+    'at' / 'at or below' speed limit coded so far (a descent's limit holds for the rest of the
+    procedure, as guidance flies it: :mod:`fms_testbed.guidance.vertical`) and above an 'at'
+    / 'at or above' limit of the leg itself, converted from CAS at ``leg_alt_m`` (each leg's
+    end altitude, m) on a day ``isa_dev_c`` K off the ISA."""
+    from fms_testbed.core.atmosphere import cas_to_tas_scalar
+    from fms_testbed.legs.model import approach_cas_caps
+
+    caps = approach_cas_caps([lg.record for lg in path.legs], path.proc_type, 0.0)
+    out = np.empty(len(path.legs))
+    carried = math.inf
+    for k, lg in enumerate(path.legs):
+        r = lg.record
+        lo = None
+        if r.speed_limit_mps:
+            if r.speed_desc in ("", "@", "-"):
+                carried = min(carried, r.speed_limit_mps)
+            if r.speed_desc in ("", "@", "+"):
+                lo = r.speed_limit_mps
+        hi = min(carried, caps[k]) if caps[k] is not None else carried
+        c = min(cas_plan_mps, hi)
+        if lo is not None:
+            c = max(c, lo)
+        out[k] = cas_to_tas_scalar(c, float(leg_alt_m[k]), isa_dev_c)
+    return out
+
+
 def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
                  descent_angle_deg: float = 3.0, climb_top_m: float | None = None,
                  descent_gradient_max: float | None = None,
                  descent_rate_mps: float | None = None,
                  wind: tuple[float, float] | None = None,
-                 start_in_climb: bool = False) -> VerticalProfile:
+                 start_in_climb: bool = False, cas_plan_mps: float | None = None,
+                 isa_dev_c: float = 0.0) -> VerticalProfile:
     """Plan the vertical profile of a built path.
 
     Parameters
@@ -171,6 +228,9 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     wind : (speed m/s, from deg true) the path is planned for; None: calm
     start_in_climb : the path is the rest of a missed approach (rebuilt in flight): a climb
         phase from its start
+    cas_plan_mps, isa_dev_c : with ``descent_rate_mps``, the aircraft's planned CAS (m/s) and
+        the day's ISA deviation (K): descents are planned within the energy the aircraft can
+        shed (below)
 
     Notes
     -----
@@ -179,6 +239,17 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     coded altitude — so the final approach lies on its coded path angle to the runway. Where
     the path starts above that geometric path, the aircraft descends from its start at up to
     ``descent_gradient_max`` until it meets it (it does not stay high and dive at the end).
+
+    Energy (Danilin: the path from the aircraft's performance, speeds included): with
+    ``cas_plan_mps`` a leg without a coded angle drops no more than the aircraft can at its
+    descent rate while it also changes speed (:func:`descent_leg_tas_mps`)::
+
+        Δh_k ≤ (w_d / V_g,k) Δs_k + (V_k² − V_k-1²) / (2 g)
+
+    (w_d = ``descent_rate_mps``, V_g the ground speed, V TAS; a deceleration uses up part of
+    the drop). A 737 slowing from 280 to 230 kt CAS near FL180 sheds the energy of ~1,600 ft:
+    planned at 3° regardless, the aircraft levelled to slow down and crossed the 'at or below'
+    fix after it 551 ft high (KTMB BNFSH2). The fix before such a leg is planned lower instead.
     """
     g_desc = descent_gradient_max if descent_gradient_max is not None else \
         2.5 * math.tan(math.radians(descent_angle_deg))
@@ -207,8 +278,26 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     desc_idx = [k for k in range(1, n + 1) if not climb[k]]
     coded = [v for w in windows for v in (w.lo_m, w.hi_m) if v is not None]
     ceiling = max([start_alt_m] + coded)   # never plan above the start or any coded altitude
-    if desc_idx:
-        last = desc_idx[-1]
+    def ground_speed(k: int, v: float) -> float:
+        """Planned ground speed on leg k at TAS v (a tailwind: the same descent rate is a
+        shallower path; class 1: wind), m/s."""
+        lg = path.legs[k]
+        if v and wind is not None and lg.end.track_deg is not None:
+            v = max(v + wind[0] * math.cos(math.radians(wind[1] + 180.0 - lg.end.track_deg)),
+                    0.3 * v)
+        return v
+
+    energy = cas_plan_mps is not None and descent_rate_mps is not None
+
+    def max_drop(k: int, v_leg: np.ndarray | None) -> float:
+        """Largest drop over leg k within the energy budget, m (inf without one)."""
+        if v_leg is None:
+            return math.inf
+        v_prev = v_leg[k - 1] if k > 0 else v_leg[0]
+        return energy_drop_max_m(along[k + 1] - along[k], ground_speed(k, v_leg[k]), v_leg[k],
+                                 v_prev, descent_rate_mps)
+
+    def backward(v_leg: np.ndarray | None) -> None:
         h = next((lo_at[k] if lo_at[k] is not None else hi_at[k]
                   for k in reversed(desc_idx) if lo_at[k] is not None or hi_at[k] is not None),
                  start_alt_m)
@@ -218,8 +307,10 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
             vpa = path.legs[k].record.vpa_deg if k < n else None
             if vpa:
                 ang = abs(vpa)
-            h = alt[k + 1] + math.tan(math.radians(ang)) * (along[k + 1] - along[k])
-            h = min(h, ceiling)
+            drop = math.tan(math.radians(ang)) * (along[k + 1] - along[k])
+            if not vpa and not climb[k + 1]:
+                drop = min(drop, max_drop(k, v_leg))
+            h = min(alt[k + 1] + drop, ceiling)
             if hi_at[k] is not None:
                 # a descent capped by a window's top aims a margin inside it: the aircraft
                 # tracks a descending path a little high (:func:`descent_cap_margin_m`)
@@ -227,19 +318,41 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
             if lo_at[k] is not None:
                 h = max(h, lo_at[k])
             alt[k] = h if k > 0 else start_alt_m
+        # two constraints at one point (a transition ending at the fix a final segment's IF
+        # codes again, e.g. KRST I31-Z MINGO: 'at or above' 2,900 then 2,800 ft): the later
+        # node keeps the earlier one's altitude where its own window allows — no step down
+        # at the fix that the blend would fly below the first window
+        for k in range(1, last):
+            if along[k + 1] - along[k] < 1.0:
+                a = alt[k]
+                if hi_at[k + 1] is not None:
+                    a = min(a, hi_at[k + 1])
+                if lo_at[k + 1] is not None:
+                    a = max(a, lo_at[k + 1])
+                alt[k + 1] = a
+
+    v_leg = None
+    if desc_idx:
+        last = desc_idx[-1]
+        backward(None)
+        if energy:
+            # the speeds at the altitudes of the geometric plan, then the plan within the
+            # energy budget (one refinement: TAS changes ~2 %/1,000 ft)
+            v_leg = descent_leg_tas_mps(path, alt[1:], cas_plan_mps, isa_dev_c)
+            backward(v_leg)
         # forward pass: from a start above the geometric path, descend no steeper than the
         # aircraft can until the path is met
         for k in range(1, last + 1):
             lg = path.legs[k - 1]
-            v = lg.speed_mps
-            if v and wind is not None and lg.end.track_deg is not None:
-                # a tailwind makes the same descent rate a shallower path (class 1: wind)
-                v = max(v + wind[0] * math.cos(math.radians(wind[1] + 180.0
-                                                             - lg.end.track_deg)), 0.3 * v)
+            v = ground_speed(k - 1, lg.speed_mps)
             # the descent rate over the leg's planned ground speed (fast and high in a STAR,
-            # the same rate is a shallower path), else the given gradient
+            # the same rate is a shallower path), else the given gradient; within the energy
+            # budget when there is one
             g_k = descent_rate_mps / v if descent_rate_mps and v else g_desc
-            floor = alt[k - 1] - g_k * (along[k] - along[k - 1])
+            drop = g_k * (along[k] - along[k - 1])
+            if v_leg is not None and not climb[k]:
+                drop = min(drop, max_drop(k - 1, v_leg))
+            floor = alt[k - 1] - drop
             if floor > alt[k]:
                 alt[k] = floor if hi_at[k] is None else min(floor, max(hi_at[k], alt[k]))
         # a descent phase never climbs: after the last constraint (e.g. a STAR ending in vectors)

@@ -25,7 +25,7 @@ from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
-from fms_testbed.path.profile import arrival_join_alt_m, window
+from fms_testbed.path.profile import PLAN_CLIMB_FRACTION, arrival_join_alt_m, window
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
@@ -252,7 +252,9 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
         # an arrival starts on the descent path planned back from its last constraint, not
         # above it at its first coded altitude (an 'at or below' far above the next fixes)
-        alt = arrival_join_alt_m(out, params.descent_angle_deg)
+        alt = arrival_join_alt_m(out, params.descent_angle_deg, perf.tas_plan_mps,
+                                 PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
+                                 params.isa_dev_c)
         if alt is not None and alt < state0.alt_m - 30.0:
             again = build_sequence(db, seq, perf, params, start=replace(state0, alt_m=alt))
             return replace(again, start_kind=kind)

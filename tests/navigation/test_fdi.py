@@ -9,7 +9,7 @@ import pytest
 from fms_testbed.config.scenario import parse_scenario
 from fms_testbed.core.errors import ConfigError, UserError
 from fms_testbed.navigation import make_source
-from fms_testbed.navigation.fdi import MAJORITY, FdiTuning, SensorComparator
+from fms_testbed.navigation.fdi import MAJORITY, FdiTuning, SensorComparator, channel_sigmas
 from fms_testbed.run import run_scenario
 from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
 
@@ -40,6 +40,20 @@ def _first(nav, kind, unit_prefix="ins"):
 
 def test_majority_table_is_seed_001s():
     assert MAJORITY == {(1, 1, 0): 0, (1, 0, 1): 1, (0, 1, 1): 2}
+
+
+def test_channel_sigmas_carry_the_unmodelled_attitude_error():
+    """Tilt σ² = P + var_a n² + var_g (φ² + θ²), heading σ² = P + var_g (φ² + θ²); position and
+    velocity σ are the filter's; without the declared variances nothing is added."""
+    P = np.diag(np.arange(1.0, 16.0)) * 1e-8
+    base = channel_sigmas(P)
+    assert base[6] == base[7] == pytest.approx(math.sqrt(8e-8))
+    var_a, var_g, roll, pitch, n = 2.3e-6, 2.25e-6, math.radians(30), math.radians(5), 1.15
+    d = channel_sigmas(P, (var_a, var_g), roll, pitch, n)
+    np.testing.assert_array_equal(d[:6], base[:6])
+    rot2 = var_g * (roll ** 2 + pitch ** 2)
+    assert d[6] == d[7] == pytest.approx(math.sqrt(8e-8 + var_a * n ** 2 + rot2), rel=1e-12)
+    assert d[8] == pytest.approx(math.sqrt(9e-8 + rot2), rel=1e-12)
 
 
 def test_sensor_comparator_flags_the_pairs_of_the_stepped_unit_and_nothing_when_healthy():

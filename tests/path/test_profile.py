@@ -3,6 +3,8 @@ descents at the coded angle, never above the start or the highest coded altitude
 
 import math
 
+import numpy as np
+
 import pytest
 
 from fms_testbed.path.profile import window
@@ -98,3 +100,64 @@ def test_a_flight_climb_top_replaces_the_transition_altitude_level_off():
     assert all(b >= a - 1e-9 for a, b in zip(flight.alt_m, flight.alt_m[1:]))   # climbs only
     assert fp.path.profile is not None and max(fp.path.profile.alt_m) == pytest.approx(
         spec.climb_top_ft * FT)
+
+
+def _decel_star(tmp_path):
+    """A STAR that slows from 280 to 230 kt CAS on its last leg: FL200 at WA (@280 kt), 15 NM
+    to WB (no constraint), 15 NM to WC ('at or below' 14,000 ft, @230 kt)."""
+    w = world()
+    a = offset(*w["WB"], 270.0, 15.0)
+    c = offset(*w["WB"], 90.0, 15.0)
+    star = dict(proc_type="E", transition="RW09", route_type="6")
+    return build(tmp_path, [L("XTST", "TSTR2", "IF", 10, fix="WA2", alt_desc=" ", alt1_ft=20000,
+                              speed_kt=280, **star),
+                            L("XTST", "TSTR2", "TF", 20, fix="WB", **star),
+                            L("XTST", "TSTR2", "TF", 30, fix="WC2", alt_desc="-",
+                              alt1_ft=14000, speed_kt=230, **star)],
+                 extra=[waypoint_record("WA2", *a), waypoint_record("WC2", *c)])
+
+
+def test_a_descent_that_slows_down_is_planned_within_the_energy_the_aircraft_can_shed(tmp_path):
+    """Δh ≤ (w_d / V) Δs + (V_k² − V_k-1²) / 2g on each leg without a coded angle (Danilin: the
+    path from the aircraft's performance; KTMB BNFSH2 crossed an 'at or below' fix 551 ft high
+    after slowing 280 → 230 kt on a 3° path). Without the budget the same path is planned
+    steeper than that on the slowing leg; with it the fix before is planned lower."""
+    from fms_testbed.core.atmosphere import cas_to_tas_scalar
+    from fms_testbed.core.units import G0_MPS2, KT_MPS
+    from fms_testbed.path.profile import plan_profile
+
+    p = _decel_star(tmp_path)
+    rate = 0.75 * PERF.descent_rate_max_mps
+    kw = dict(climb_gradient=0.08, start_alt_m=20000 * FT, descent_gradient_max=0.1,
+              descent_rate_mps=rate)
+    geo = plan_profile(p, **kw)
+    en = plan_profile(p, **kw, cas_plan_mps=280 * KT_MPS)     # a STAR flown at 280 kt
+
+    def budget(prof, k):          # leg k (node k → k+1) at its flown TAS
+        cas = [280 * KT_MPS, 280 * KT_MPS, 230 * KT_MPS]
+        v = [cas_to_tas_scalar(c, h) for c, h in zip(cas, prof.alt_m[1:])]
+        ds = prof.along_m[k + 1] - prof.along_m[k]
+        return rate / v[k] * ds + (v[k] ** 2 - v[k - 1] ** 2) / (2 * G0_MPS2)
+
+    drop = lambda prof, k: prof.alt_m[k] - prof.alt_m[k + 1]  # noqa: E731
+    assert drop(geo, 2) > budget(geo, 2) + 100 * FT        # 3° regardless: beyond the budget
+    assert drop(en, 2) <= budget(en, 2) + 1.0               # within it
+    assert en.alt_m[2] < geo.alt_m[2] - 300 * FT            # WB planned lower
+    assert en.alt_m[3] == pytest.approx(geo.alt_m[3])       # WC still aimed the same
+    assert en.alt_m[3] <= 14000 * FT
+
+
+def test_speed_of_each_descent_leg_follows_the_coded_limits(tmp_path):
+    from fms_testbed.core.atmosphere import cas_to_tas_scalar
+    from fms_testbed.core.units import KT_MPS
+    from fms_testbed.path.profile import descent_leg_tas_mps
+
+    p = _decel_star(tmp_path)
+    alt = np.array([20000, 17000, 14000]) * FT
+    v = descent_leg_tas_mps(p, alt, 250 * KT_MPS)
+    # @280 raises the first leg above the planned 250 kt, WB keeps the 280 'at' as a cap
+    # (250 kt planned, as guidance flies it), the last leg is capped at 230 kt
+    assert v[0] == pytest.approx(cas_to_tas_scalar(280 * KT_MPS, alt[0]))
+    assert v[1] == pytest.approx(cas_to_tas_scalar(250 * KT_MPS, alt[1]))
+    assert v[2] == pytest.approx(cas_to_tas_scalar(230 * KT_MPS, alt[2]))
+

@@ -82,7 +82,12 @@ def test_cli_refuses_contradicting_options(capsys):
     assert main(["fly", "--scenario", str(SCEN / "demo-sid.yaml"), "--airport", "KSEA"]) == 2
     assert "not used with it" in capsys.readouterr().err
     assert main(["run", str(SCEN / "demo.yaml"), "--imu", "STIM300"]) == 2
-    assert "--imu is only used with --nav sins" in capsys.readouterr().err
+    assert "--imu is only used with a --nav source other than truth" in capsys.readouterr().err
+    assert main(["run", str(SCEN / "demo.yaml"), "--nav", "gps"]) == 2
+    err = capsys.readouterr().err
+    assert "unknown navigation source" in err and "attitude_reference" in err
+    assert main(["run", str(SCEN / "demo.yaml"), "--nav", "attitude_reference"]) == 2
+    assert "--nav attitude_reference needs --imu PRESET" in capsys.readouterr().err
 
 
 def test_relative_paths_in_a_scenario_resolve_against_its_folder(tmp_path, monkeypatch):

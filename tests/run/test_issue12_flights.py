@@ -206,3 +206,46 @@ def test_cf_from_a_fix_just_off_its_course_turns_onto_it_as_a_fly_by(cifp):
     assert e["max_m"] < 50.0, e
     assert not [f for f in fp.path.findings if "does not fit" in f.message]
     assert res.summary["status"] == "ok", res.summary["reason"]
+
+
+@pytest.mark.parametrize("airport, procedure, transition, runway", [
+    ("KTMB", "BNFSH2", "HOAGG", None),     # slows 280 → 230 kt after GELDE: ENRGY was 551 ft high
+    ("KDEN", "FLATI3", "MJANE", "RW25"),   # slows to @210 kt for CAPTJ 'at' 11,000: 59 ft high
+    ("KDCA", "TRUPS4", "BKW", "RW01"),     # WEEDU 521 ft high; TRUPS 'at' in a steeper descent
+    ("KBOI", "KOURT4", "DERSO", "RW10B"),  # KOLKE 'at or below' 60 ft high (the blend)
+])
+def test_star_constraints_met_when_it_slows_down_and_at_knees(cifp, airport, procedure,
+                                                              transition, runway):
+    """STAR descents planned within the energy the aircraft can shed while it slows down
+    (path/profile.plan_profile) and blended profiles that pass each constrained fix at its
+    planned altitude (guidance/vertical.knees_clear_of_windows): every coded constraint met."""
+    res, _ = fly(cifp, airport, procedure, transition, runway)
+    s = res.summary
+    missed = [c for c in s["constraints"] if c.get("ok") is False]
+    assert not missed, missed
+    assert s["status"] == "ok", s["reason"]
+
+
+def test_circling_map_coded_at_the_field_elevation_is_checked_at_the_circling_floor(cifp):
+    """KBIS VOR-A: the MAP WINFY is coded 'at' 1,661 ft, the field elevation; the flight levels
+    at the circling floor (field + 591 ft) and is checked there, not reported 583 ft high."""
+    from fms_testbed.evaluation.flight_errors import constraint_checks, error_columns
+
+    res, fp = fly(cifp, "KBIS", "VOR-A", "BIS")
+    row = next(c for c in res.summary["constraints"] if c["fix"] == "WINFY")
+    elev_ft = cifp.airports["KBIS"].elev_m / FT
+    assert row["floor_ft"] == pytest.approx(elev_ft + 591, abs=1)
+    assert row["ok"] is True and abs(row["alt_ft"] - row["floor_ft"]) <= 50
+    plain = next(c for c in constraint_checks(error_columns(res.df), fp) if c["fix"] == "WINFY")
+    assert plain["ok"] is False and "floor_ft" not in plain
+
+
+def test_fix_followed_by_a_hold_at_it_is_checked_at_its_first_passage(cifp):
+    """KRST I31-Z RST: TF MINGO 'at or above' 2,900 ft, then the hold-in-lieu HF at MINGO
+    descending to 2,800 ft. The check used to take the sample nearest MINGO among the legs
+    around it — the hold's return a circuit later, at 2,799 ft — and report 101 ft below."""
+    res, _ = fly(cifp, "KRST", "I31-Z", "RST")
+    rows = [c for c in res.summary["constraints"] if c["fix"] == "MINGO"]
+    assert [c["code"] for c in rows] == ["TF", "HF"]
+    assert rows[0]["ok"] is True and rows[0]["alt_ft"] >= 2900 - 50, rows[0]
+    assert rows[1]["ok"] is True, rows[1]
