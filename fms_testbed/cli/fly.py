@@ -1,13 +1,15 @@
 """``fms-testbed fly``: fly a real ARINC-424 procedure (from the command line or a scenario file).
 
     fms-testbed fly --db FILE --airport KSEA --procedure ISBRG1 --runway 34R --aircraft 737 \\
-        [--transition T] [--wind 270/20] [--nav sins --imu PRESET] [--seed N] --out DIR
+        [--transition T] [--wind 270/20] [--nav sins --imu PRESET] [--seed N] [--takeoff] --out DIR
     fms-testbed fly --scenario scenarios/demo-sid.yaml [--out DIR]
 
 Prints one line per result group (status, errors, RNP, constraints, sequencing) and writes
 ``timeseries.parquet``, ``summary.json``, the plots (NM, ft, kt) and, for Google Earth/QGIS,
 ``track.geojson`` and ``track.kml`` (the designed path leg by leg, the flown 3-D track, the
-navigation track where it differs) into ``--out``. Exit code 0 when the
+navigation track where it differs) into ``--out``. ``--takeoff`` starts a SID at rest on its
+runway's threshold with a takeoff roll (``procedure.start: takeoff``) instead of airborne over
+the departure end. Exit code 0 when the
 procedure was flown to its end, 1 otherwise, 2 on a user error.
 """
 
@@ -51,11 +53,33 @@ def cmd_fly(args) -> int:
     from fms_testbed.evaluation.outcome import EXIT_CODES
     from fms_testbed.run.api import run_scenario
 
-    res = run_scenario(scenario, seed=args.seed, overrides=overrides_from_args(args),
-                       progress=None)
+    overrides = overrides_from_args(args)
+    if args.takeoff:
+        overrides.setdefault("procedure", {})["start"] = "takeoff"
+    res = run_scenario(scenario, seed=args.seed, overrides=overrides, progress=None)
     res.save(out, csv=args.csv, plots=not args.no_plots, overwrite=args.overwrite)
     print_results(res)
+    if res.summary.get("takeoff"):
+        print(takeoff_line(res.summary["takeoff"]))
     return EXIT_CODES[res.summary["status"]]
+
+
+def takeoff_line(to: dict) -> str:
+    """One line on a takeoff start (the summary's ``takeoff`` block; m, kt and ft at this edge)."""
+    from fms_testbed.core.units import FT_M, KT_MPS
+
+    t, ev = to["times_s"], to["events"]
+    parts = [f"takeoff {to['runway']}: VR {to['vr_cas_mps'] / KT_MPS:.0f} kt, "
+             f"V2 {to['v2_cas_mps'] / KT_MPS:.0f} kt"]
+    if "ground_roll_m" in to:
+        parts.append(f"ground roll {to['ground_roll_m']:.0f} m, lift-off at {t['liftoff']:.1f} s")
+    if "time_to_v2_s" in to:
+        parts.append(f"V2 at {to['time_to_v2_s']:.1f} s")
+    if "handover_s" in to:
+        parts.append(f"handover at {to['handover_s']:.1f} s, "
+                     f"{ev['handover']['height_m'] / FT_M:.0f} ft above the runway")
+    parts.append(f"centreline within {to['max_centreline_dev_ground_m']:.1f} m on the ground")
+    return "  " + ", ".join(parts)
 
 
 def register(sub) -> None:
@@ -68,6 +92,9 @@ def register(sub) -> None:
     p.add_argument("--transition", help="en-route (SID/STAR) or approach transition")
     p.add_argument("--runway", help="runway, e.g. 34R (SID/STAR runway transition)")
     add_override_options(p)
+    p.add_argument("--takeoff", action="store_true",
+                   help="SIDs: start at rest on the runway threshold with a takeoff roll "
+                        "(procedure.start: takeoff; default: airborne over the runway end)")
     p.add_argument("--out", help="output folder (default results/<airport>-<procedure>)")
     p.add_argument("--csv", action="store_true", help="also write timeseries.csv")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")

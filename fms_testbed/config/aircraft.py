@@ -17,6 +17,7 @@ from typing import Annotated
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.units import KT_MPS
 from fms_testbed.data import aircraft_dir
 from fms_testbed.config.yamlfile import read_mapping, validation_message
 
@@ -221,6 +222,48 @@ class ApproachSettings(_Frozen):
         return self.vapp_cas_mps * (mass_kg / self.mass_ref_kg) ** 0.5
 
 
+class TakeoffSettings(_Frozen):
+    """How the aircraft takes off when a SID starts on the runway (``procedure.start:
+    takeoff``): flap setting, rotation and takeoff-safety speeds (CAS at ``mass_ref_kg``,
+    scaled with the square root of the mass ratio like Vapp), the pitch it rotates to and the
+    most it pitches up to hold the climb-out speed ``v2_cas_mps + climb_add_cas_mps``.
+    ``source`` says where the numbers come from."""
+
+    flaps_norm: Annotated[float, Field(ge=0, le=1)] = Field(
+        description="takeoff flap setting, JSBSim fcs/flap-cmd-norm")
+    vr_cas_mps: Pos = Field(description="rotation speed VR at mass_ref_kg, m/s CAS")
+    v2_cas_mps: Pos = Field(description="takeoff safety speed V2 at mass_ref_kg, m/s CAS")
+    pitch_deg: Annotated[float, Field(gt=0, le=25)] = Field(
+        description="pitch attitude rotated to at VR, deg")
+    pitch_max_deg: Annotated[float, Field(gt=0, le=30)] = Field(
+        20.0, description="highest pitch flown to hold the climb-out speed, deg")
+    climb_add_cas_mps: NonNeg = Field(
+        10.0 * KT_MPS, description="climb out at V2 plus this (default 10 kt), m/s")
+    thrust_norm: Annotated[float, Field(gt=0, le=1)] = Field(
+        1.0, description="takeoff throttle (normalised)")
+    mass_ref_kg: Pos = Field(description="mass the speeds are given at, kg")
+    pitch_rate_kp: Pos = Field(
+        8.0, description="elevator (normalised) per rad/s of pitch-rate error, at the design "
+                         "point's dynamic pressure (scaled with q_ref/q like the inner loops)")
+    pitch_rate_ki: NonNeg = Field(
+        8.0, description="elevator per rad of integrated pitch-rate error (per rad/s per s)")
+    source: str = Field(description="where the numbers come from")
+
+    @model_validator(mode="after")
+    def _order(self):
+        if self.vr_cas_mps > self.v2_cas_mps:
+            raise ValueError("vr_cas_mps must not be above v2_cas_mps")
+        if self.pitch_deg > self.pitch_max_deg:
+            raise ValueError("pitch_deg must not be above pitch_max_deg")
+        return self
+
+    def speeds_cas_mps(self, mass_kg: float | None) -> tuple[float, float]:
+        """(VR, V2) at mass ``mass_kg`` (kg; None: the reference mass), m/s CAS:
+        ``V · sqrt(mass_kg / mass_ref_kg)``."""
+        k = 1.0 if mass_kg is None or not mass_kg > 0 else (mass_kg / self.mass_ref_kg) ** 0.5
+        return self.vr_cas_mps * k, self.v2_cas_mps * k
+
+
 class AircraftConfig(_Frozen):
     """One aircraft: the JSBSim model plus everything the testbed needs to fly it."""
 
@@ -239,6 +282,8 @@ class AircraftConfig(_Frozen):
     approach: ApproachSettings | None = Field(
         None, description="approach speeds and configuration (None: flown clean at the "
                           "planned approach speed)")
+    takeoff: TakeoffSettings | None = Field(
+        None, description="takeoff settings (None: a SID cannot start with a takeoff roll)")
     source_file: str = ""
 
 

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, StrictBool, ValidationError
 
@@ -44,6 +44,10 @@ class ProcedureSpec(BaseModel):
     start_alt_ft: Annotated[float, Field(ge=-1000, le=45000)] | None = Field(
         None, description="start altitude, ft (default: the build's planned start; a SID "
                           "that starts at a fix starts at that fix's 'at or above' altitude)")
+    start: Literal["airborne", "takeoff"] = Field(
+        "airborne", description="SIDs: 'airborne' at the departure end of the runway (35 ft), "
+                                "or 'takeoff' from rest on the runway threshold (the aircraft "
+                                "file's takeoff settings)")
 
 
 def parse_procedure(raw, source: str = "<scenario>") -> ProcedureSpec:

@@ -60,6 +60,9 @@ class ActivePath:
     """Per profile node, the coded altitude window (lo, hi), m (None: unbounded)."""
     piece_legs: list[int] = field(default_factory=list)
     """Per piece, its whole-procedure leg index."""
+    coded_angle: list[bool] = field(default_factory=list)
+    """Per profile node, True when the profile piece ending there lies on a coded vertical
+    angle (a final approach path: its corners are not moved, :func:`.vertical.knees_clear_of_windows`)."""
 
 
 def smooth_connectors(segs) -> list:
@@ -141,4 +144,5 @@ def activate(fp: FlyablePath, s_base_m: float, tas_mps: float,
     return ActivePath(fp, segs, pieces, cum, pde, _straight_runs_m(geoms),
                       [float(x) + lead_m for x in prof.along_m],
                       [float(x) for x in prof.alt_m], climb_targets(prof), s_base_m, last,
-                      wins, [fp.leg_offset + segs[p.seg_index].leg_index for p in pieces])
+                      wins, [fp.leg_offset + segs[p.seg_index].leg_index for p in pieces],
+                      [False] + [bool(lg.record.vpa_deg) for lg in fp.path.legs])

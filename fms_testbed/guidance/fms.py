@@ -40,7 +40,7 @@ from fms_testbed.guidance.steering import steer_bank_rad
 from fms_testbed.guidance.step_log import log_row
 from fms_testbed.guidance.vertical import (altitude_command_m, altitude_lead_s,
                                           planned_limits)
-from fms_testbed.legs.model import BuiltLeg, PathSegment
+from fms_testbed.legs.model import CEILING_MARGIN_M, BuiltLeg, PathSegment
 from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.plan import FlyablePath
 from fms_testbed.procedures.records import Fix
@@ -118,6 +118,7 @@ class ProcedureGuidance:
         self.lead_s = altitude_lead_s(cfg)
         self.heading_kp = cfg.inner_loops.heading_kp
         top = spec.climb_top_ft * FT_M if spec is not None else DEFAULT_CLIMB_TOP_M
+        top = min(top, cfg.limits.alt_max_m - CEILING_MARGIN_M)   # below the ceiling
         los = [w.lo_m for w in (fp.path.profile.windows if fp.path.profile else ())
                if w.lo_m is not None]
         self.top_m = max([top] + los)
@@ -214,15 +215,16 @@ class ProcedureGuidance:
             bank = self._lateral(w, nav, hold)
             s_path = self._s_path_m(w)
             a = self.act
-            ps, ph, ct, win = a.prof_s, a.prof_h, a.climb_tgt, a.windows
+            ps, ph, ct, win, va = a.prof_s, a.prof_h, a.climb_tgt, a.windows, a.coded_angle
             if self.go_around_leg is not None and not self.go_around_active:
                 # before the go-around the final approach path goes on through the MAP (no
                 # blend into the missed-approach climb before it): the profile up to the MAP
                 j = self.go_around_leg - a.fp.leg_offset + 1
                 if 1 < j < len(ps):
-                    ps, ph, ct, win = ps[:j], ph[:j], ct[:j], win[:j]
+                    ps, ph, ct, win, va = ps[:j], ph[:j], ct[:j], win[:j], va[:j]
             alt_cmd = max(altitude_command_m(ps, ph, ct, s_path, w.gs_mps, self.lead_s,
-                                             self.t2_s2, self.top_m, self.approach, win),
+                                             self.t2_s2, self.top_m, self.approach, win, va,
+                                             getattr(truth, "tas_mps", None)),
                           self.floor_m)
             prof = self.act.fp.path.profile
             sched = getattr(prof, "speed", None)

@@ -183,7 +183,8 @@ def climb_targets(prof) -> list[float | None]:
 def knees_clear_of_windows(prof_s: list[float], prof_h: list[float],
                            climb_tgt: list[float | None],
                            windows: list[tuple[float | None, float | None]],
-                           w_m: float) -> tuple[list[float], list[float]]:
+                           w_m: float, coded_angle: list[bool] | None = None
+                           ) -> tuple[list[float], list[float]]:
     """The profile nodes (distances m, altitudes m) with every slope change at a constrained
     fix of a descent moved ``w_m`` (at most half the leg it moves into) along the piece on the
     side where its blend cannot cross the fix's window.
@@ -200,7 +201,10 @@ def knees_clear_of_windows(prof_s: list[float], prof_h: list[float],
       blend starts at the fix.
 
     The profile then passes every such fix at its planned altitude; the piece on the other
-    side of the moved corner is a little steeper or shallower."""
+    side of the moved corner is a little steeper or shallower — never a piece on a coded
+    vertical angle (``coded_angle[j]``: the piece ending at node j; a final approach path keeps
+    its angle to the runway, and its FAF the plain blend)."""
+    fixed = coded_angle if coded_angle is not None else [False] * len(prof_s)
     out_s, out_h = list(prof_s), list(prof_h)
     for j in range(1, len(prof_s) - 1):
         if j >= len(windows) or climb_tgt[j] is not None:
@@ -213,10 +217,12 @@ def knees_clear_of_windows(prof_s: list[float], prof_h: list[float],
         g_out = (prof_h[j + 1] - prof_h[j]) / d_out
         if not (g_in < -1e-4 or g_out < -1e-4):
             continue
-        if g_out > g_in + 1e-4 and top is not None and prof_h[j] >= top - 1.0:
+        if g_out > g_in + 1e-4 and top is not None and prof_h[j] >= top - 1.0 \
+                and not fixed[j]:
             d = min(w_m, 0.5 * (out_s[j] - out_s[j - 1]))
             out_s[j], out_h[j] = prof_s[j] - d, prof_h[j] - g_out * d
-        elif g_out < g_in - 1e-4 and lo is not None and prof_h[j] <= lo + 1.0:
+        elif g_out < g_in - 1e-4 and lo is not None and prof_h[j] <= lo + 1.0 \
+                and not fixed[j + 1]:
             d = min(w_m, 0.5 * d_out)
             out_s[j], out_h[j] = prof_s[j] + d, prof_h[j] + g_in * d
     return out_s, out_h
@@ -225,8 +231,9 @@ def knees_clear_of_windows(prof_s: list[float], prof_h: list[float],
 def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list[float | None],
                        s_path_m: float, gs_mps: float, lead_s: float, t2_s2: float,
                        top_m: float, approach: bool,
-                       windows: list[tuple[float | None, float | None]] | None = None
-                       ) -> float:
+                       windows: list[tuple[float | None, float | None]] | None = None,
+                       coded_angle: list[bool] | None = None,
+                       lead_speed_mps: float | None = None) -> float:
     """Altitude command at path distance ``s_path_m``, m.
 
     Along the blended planned profile (:func:`blended_profile`, blend ±``gs BLEND_S``) the
@@ -241,14 +248,22 @@ def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list
     climb_tgt : climb target per node, m (None outside climbs)
     s_path_m : distance along the active path, m; gs_mps : ground speed, m/s
     lead_s : read-ahead time 2 ξ_H T_H, s (:func:`altitude_lead_s`); t2_s2 : T_H², s²
+    lead_speed_mps : the speed of the lead term, m/s (None: ``gs_mps``). Guidance gives the
+        TAS: the coupled law's ramp lag, measured, is 2 ξ_H T_H V_TAS dh/ds — air-relative.
+        With the ground speed instead, a 737 on a 3.4° final crossed the threshold 45 ft low
+        in a 30 kt tailwind and 48 ft high in a 30 kt headwind (KCHA S33); with the TAS at
+        the TCH in both (−0 ft)
     top_m : the flight's climb top, m; approach : the last slope continues to the runway
     windows : coded (lo, hi) window per node, m: outside climbs the blended profile stays
         above the lower bound of the node ahead until it is passed (the blend of a
-        level-to-descent knee at an 'at or above' fix would otherwise cut below it)
+        level-to-descent knee at an 'at or above' fix would otherwise cut below it), and its
+        corners at constrained fixes are moved clear of their windows
+        (:func:`knees_clear_of_windows`; ``coded_angle``: per node, the piece ending there is
+        on a coded vertical angle and keeps it)
     """
     w_m = gs_mps * BLEND_S
-    bs, bh = (knees_clear_of_windows(prof_s, prof_h, climb_tgt, windows, w_m) if windows
-              else (prof_s, prof_h))
+    bs, bh = (knees_clear_of_windows(prof_s, prof_h, climb_tgt, windows, w_m, coded_angle)
+              if windows else (prof_s, prof_h))
     h, dh, ddh = blended_profile(bs, bh, s_path_m, w_m, approach)
     jn = bisect.bisect_right(prof_s, s_path_m)
     if windows is not None and 0 < jn < len(windows) and climb_tgt[jn] is None:
@@ -256,7 +271,8 @@ def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list
         lo = windows[jn][0]
         if lo is not None and h < lo:
             h, dh, ddh = lo, 0.0, 0.0
-    alt_cmd = h + lead_s * gs_mps * dh + t2_s2 * gs_mps * gs_mps * ddh
+    v_lead = gs_mps if lead_speed_mps is None else lead_speed_mps
+    alt_cmd = h + lead_s * v_lead * dh + t2_s2 * gs_mps * gs_mps * ddh
     if 0 < jn < len(prof_s) and climb_tgt[jn] is not None:
         # climb: to the target of the node ahead at the law's rate — never above it, so an
         # 'at or below' cap holds until its fix is passed (the profile's read-ahead and blend

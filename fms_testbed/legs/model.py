@@ -14,7 +14,7 @@ from dataclasses import dataclass, replace
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.wind import WindProfile
-from fms_testbed.core.units import KT_MPS, NM_M
+from fms_testbed.core.units import FT_M, KT_MPS, NM_M
 from fms_testbed.legs.coded import CodedPath
 from fms_testbed.procedures.legrecord import LegRecord
 
@@ -81,13 +81,19 @@ class BuildParams:
         return replace(self, wind_speed_mps=spd, wind_from_deg=frm)
 
 
+CEILING_MARGIN_M = 500 * FT_M
+"""The planner's own choices (climb top, an uncoded arrival start) stay this far below the
+service ceiling, m (a C172P SID climbing to the default 15,000 ft top, or a STAR started at
+field + 10,000 ft at a 5,841 ft airport, left its 13,500 ft ceiling: envelope_exceeded)."""
+
+
 @dataclass(frozen=True, slots=True)
 class Performance:
     """Aircraft performance the builder uses (from ``aircraft.limits``), SI.
 
     tas_plan_mps: planned TAS; tas_min_mps: lowest acceptable TAS for a correction;
     climb_gradient_max: rise over run at ``tas_plan_mps``; climb_rate_max_mps;
-    descent_rate_max_mps; bank_max_deg.
+    descent_rate_max_mps; bank_max_deg; alt_max_m: the service ceiling, m (inf: none given).
     """
 
     tas_plan_mps: float
@@ -96,6 +102,13 @@ class Performance:
     climb_rate_max_mps: float
     descent_rate_max_mps: float
     bank_max_deg: float
+    alt_max_m: float = math.inf
+
+    @property
+    def alt_plan_max_m(self) -> float:
+        """Highest altitude the planner chooses on its own (a climb top, an uncoded start), m:
+        :data:`CEILING_MARGIN_M` below the service ceiling."""
+        return self.alt_max_m - CEILING_MARGIN_M
 
     @classmethod
     def from_aircraft(cls, ac) -> "Performance":
@@ -104,7 +117,8 @@ class Performance:
         return cls(tas_plan_mps=lim.climb_tas_mps, tas_min_mps=lim.cas_min_mps,
                    climb_gradient_max=lim.climb_gradient_max,
                    climb_rate_max_mps=lim.climb_rate_max_mps,
-                   descent_rate_max_mps=lim.descent_rate_max_mps, bank_max_deg=lim.bank_max_deg)
+                   descent_rate_max_mps=lim.descent_rate_max_mps, bank_max_deg=lim.bank_max_deg,
+                   alt_max_m=lim.alt_max_m)
 
     def climb_gradient_at(self, tas_mps: float) -> float:
         """Climb gradient capability at a TAS, rise over run: the climb rate is taken as

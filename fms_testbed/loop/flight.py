@@ -86,12 +86,19 @@ class Flight:
         ap = cfg.approach if procedure is not None else None
         k0 = flap_index_for_cas(ap, float(tas_to_cas(tas0, ini.altitude_m))) \
             if ap is not None else 0
-        ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
-                lon_deg=ini.lon_deg, terrain_elev_m=terrain,
-                flap_cmd_norm=ap.flaps[k0].cmd_norm if ap is not None else 0.0)
+        # a SID from the runway: at rest on its threshold instead (loop/takeoff.py)
+        self.takeoff = procedure.takeoff_start(cfg) if procedure is not None else None
+        if self.takeoff is not None:
+            self.takeoff.start(ac)
+        else:
+            ac.trim(ini.altitude_m, tas0, heading_deg=ini.heading_deg, lat_deg=ini.lat_deg,
+                    lon_deg=ini.lon_deg, terrain_elev_m=terrain,
+                    flap_cmd_norm=ap.flaps[k0].cmd_norm if ap is not None else 0.0)
         self.config_step = None
         if ap is not None and guidance is not None:
-            self.config_step = ConfigStep(ap, ac, k0, False, getattr(guidance, "events", None))
+            if self.takeoff is None:      # a takeoff builds its own (loop/takeoff.py)
+                self.config_step = ConfigStep(ap, ac, k0, False,
+                                              getattr(guidance, "events", None))
             if hasattr(guidance, "set_mass"):
                 guidance.set_mass(float(ac.fdm["inertia/mass-slugs"]) * SLUG_KG)
         if scn.turbulence is not None:  # after trim: JSBSim cannot trim in turbulence
@@ -165,6 +172,8 @@ class Flight:
         """The outer loop as a generator, one ``yield`` per outer step, calling the named steps of
         :mod:`fms_testbed.loop.steps` in order: read → check → wind → navigate → events → guide
         → lateral → vertical/command → log (the steps are bound to locals: the loop is hot)."""
+        if self.takeoff is not None and not (yield from self.takeoff.fly(self)):
+            return                            # the takeoff failed (status and reason set)
         scn, ac, guide = self.scn, self.aircraft, self.guidance
         rows, extra_rows, raw_log, bar = self.rows, self.extra_rows, self.raw_log, self._bar
         no_errors: dict = {}
@@ -273,6 +282,8 @@ class Flight:
                      "throttle": round(trim.throttle, 4), "elevator": round(trim.elevator, 4)},
             "metrics": _metrics(df),
         }
+        if self.takeoff is not None:
+            summary["takeoff"] = self.takeoff.summary()
         return df, summary
 
 

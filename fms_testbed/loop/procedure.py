@@ -1,8 +1,8 @@
 """Fly a real ARINC-424 procedure in JSBSim: build it, start the aircraft on it, fly the closed
 loop with :class:`~fms_testbed.guidance.fms.ProcedureGuidance`, then measure the flight errors.
 
-Start condition (stated plainly, it is a simplification): JSBSim cannot take off here in a
-useful way, so a SID starts **airborne at the departure end of the runway (DER)** at the
+Start condition (stated plainly, it is a simplification): by default a SID starts
+**airborne at the departure end of the runway (DER)** at the
 builder's planned start altitude (35 ft above the runway), trimmed straight and level at the
 aircraft's planned climb TAS on the runway heading; the profile then climbs it. STARs and
 approaches start at their first fix at the first coded altitude, on the first segment's
@@ -14,7 +14,9 @@ speed limit. An approach ends at the runway/MAP unless the missed approach is fl
 holding circuit). JSBSim's terrain is set to the procedure's airport
 (:func:`fms_testbed.path.runway.terrain_elevation_m`: an approach's runway threshold, else the
 airport reference elevation, never above a SID's start), so height above ground is height
-above the runway and ground contact ends a flight that gets there.
+above the runway and ground contact ends a flight that gets there. With ``procedure.start:
+takeoff`` a SID starts instead at rest on its runway's threshold and takes off
+(:mod:`fms_testbed.loop.takeoff`; terrain at the threshold elevation).
 """
 
 from __future__ import annotations
@@ -40,6 +42,7 @@ from fms_testbed.guidance.vertical import cas_band, planned_limits, tas_target_m
 from fms_testbed.guidance.lateral import LateralGains, anticipation_m
 from fms_testbed.core.geodesy import direct
 from fms_testbed.core.units import G0_MPS2
+from fms_testbed.loop.takeoff import TakeoffStart, check_takeoff, departure_runway
 
 OUTER_RATE_HZ = 10.0
 """Rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS runs
@@ -98,6 +101,8 @@ class PreparedProcedure:
         from fms_testbed.core.units import FT_M
         from fms_testbed.path.runway import terrain_elevation_m
 
+        if self.spec.start == "takeoff":
+            return departure_runway(self.db, self.path.seq).elev_m
         h = terrain_elevation_m(self.db, self.path.seq)
         p = self.path.path
         if p.proc_type == "D" and p.legs:   # a SID starts 35 ft above its runway's end
@@ -111,6 +116,13 @@ class PreparedProcedure:
         from fms_testbed.path.runway import approach_runway
 
         return approach_runway(self.db, self.path.seq) if self.db is not None else None
+
+    def takeoff_start(self, cfg) -> TakeoffStart | None:
+        """The takeoff phase of a SID flown from the runway (``procedure.start: takeoff``),
+        None for an airborne start."""
+        if self.spec.start != "takeoff":
+            return None
+        return TakeoffStart(departure_runway(self.db, self.path.seq), cfg)
 
     def guidance(self, scn: Scenario, cfg) -> tuple[ProcedureGuidance, Any]:
         """The procedure guidance and the vertical law (None: the scenario's) for a flight."""
@@ -169,6 +181,8 @@ def prepare(raw: dict, source: str = "<scenario>", db=None
         db = load_db(spec.db, base)
     wind, isa_dev_c = planned_conditions(raw)
     fp = build_procedure(db, spec, cfg, wind=wind, isa_dev_c=isa_dev_c)
+    if spec.start == "takeoff":
+        check_takeoff(source, fp.seq.proc_type, departure_runway(db, fp.seq), cfg)
     raw.setdefault("initial", initial_from_path(fp, cfg))
     actual = _wind_or_none(raw.get("wind"))
     w_max = max(wind.max_speed_mps if wind else 0.0, actual.max_speed_mps if actual else 0.0)

@@ -180,7 +180,7 @@ def _perf_params(cfg, spec: ProcedureSpec, wind=None, isa_dev_c: float = 0.0):
                          bank_limit_deg=min(25.0, cfg.limits.bank_max_deg),
                          wind_speed_mps=float(w_mps), wind_from_deg=float(w_from),
                          wind_profile=prof, isa_dev_c=float(isa_dev_c),
-                         climb_top_m=spec.climb_top_ft * FT_M)
+                         climb_top_m=min(spec.climb_top_ft * FT_M, perf.alt_plan_max_m))
     return perf, params
 
 
@@ -204,7 +204,8 @@ def _finish(path, seq, spec, cfg, perf, params, offset: int,
         # a missed approach climbs to its own coded altitudes (the highest of them), not to
         # the SID climb top
         missed = in_missed or any(r.missed_approach_start for r in seq.legs)
-        top = None if checked.proc_type == "F" and missed else spec.climb_top_ft * FT_M
+        top = None if checked.proc_type == "F" and missed else min(spec.climb_top_ft * FT_M,
+                                                                   perf.alt_plan_max_m)
         prof = plan_profile(checked, grad, checked.legs[0].start.alt_m,
                             params.descent_angle_deg, climb_top_m=top,
                             descent_gradient_max=perf.descent_rate_max_mps / perf.tas_plan_mps,

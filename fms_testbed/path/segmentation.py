@@ -64,7 +64,7 @@ def runway_part(transition: str) -> str:
     return next((t for t in transition.split("+") if t.startswith("RW")), "")
 
 
-def _runway(db: Database, airport: str, transition: str):
+def runway_record(db: Database, airport: str, transition: str):
     """The runway threshold record (PG) of the runway part of ``transition`` (``RWxxB``: the
     first of its L/R/C runways), or None."""
     transition = runway_part(transition)
@@ -115,12 +115,13 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
     (threshold + length along the runway's true bearing, 35 ft above the threshold); a SID
     joined at its first fix starts there at :func:`sid_join_alt_m`; other transitions start at
     their first fix (STAR/approach altitude: the first coded altitude, else airport elevation
-    + 10,000 ft / 3,000 ft); a SID without either starts over the airport."""
+    + 10,000 ft / 3,000 ft, no higher than ``perf.alt_plan_max_m``); a SID without either
+    starts over the airport."""
     apt = db.airports.get(seq.airport)
     elev = (apt.elev_m if apt and apt.elev_m is not None else 0.0)
     first = legs[0]
     if seq.proc_type == "D":
-        rwy = _runway(db, seq.airport, seq.transition)
+        rwy = runway_record(db, seq.airport, seq.transition)
         if rwy is not None and not LEG_TYPES[first.pt].initial:
             brg = wrap360((rwy.bearing_deg or 0.0) + (apt.magvar_deg if apt else 0.0))
             lat, lon, az = direct(rwy.lat_deg, rwy.lon_deg, brg, rwy.length_m or 0.0)
@@ -133,6 +134,8 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
         alt = next((_descent_target(lg) for lg in legs if lg.rec.alt1_m is not None), None)
         if alt is None:
             alt = elev + (10000 if seq.proc_type == "E" else 3000) * FT_M
+            if perf is not None:            # never above the aircraft's ceiling (less margin)
+                alt = min(alt, perf.alt_plan_max_m)
     if first.fix is not None:
         return FlightState(first.fix.lat_deg, first.fix.lon_deg, None, alt,
                            fix_ident=first.fix.ident)
@@ -263,7 +266,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
     if st.track_deg is not None and seq.proc_type == "D" and not LEG_TYPES[legs[0].pt].initial \
-            and _runway(db, seq.airport, seq.transition):
+            and runway_record(db, seq.airport, seq.transition):
         return "runway"
     return "fix" if legs[0].fix is not None else "airport"
 

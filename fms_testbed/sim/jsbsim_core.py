@@ -418,11 +418,18 @@ class JSBSimAircraft:
         if not (c.inner_loops.throttle_min - 1e-6 <= thr <= c.inner_loops.throttle_max + 1e-6):
             raise TrimError(f"trim failed for {cond}: throttle {thr:.2f} outside "
                             f"[{c.inner_loops.throttle_min}, {c.inner_loops.throttle_max}]")
+        return self.hold_trim(res)
+
+    def hold_trim(self, res: TrimResult) -> TrimResult:
+        """Make ``res`` the state the inner loops start from: its control positions as their
+        trim offsets, its throttle as the command, wings level at 1 g, the loops engaged; and
+        the start condition the flight summary reports (:meth:`trim_result`)."""
+        fdm = self.fdm
         fdm["fms/trim/elevator"] = res.elevator
         fdm["fms/trim/aileron"] = res.aileron
         fdm["fms/trim/rudder"] = res.rudder
-        fdm["fms/trim/throttle"] = thr
-        fdm["fms/cmd/throttle"] = thr
+        fdm["fms/trim/throttle"] = res.throttle
+        fdm["fms/cmd/throttle"] = res.throttle
         fdm["fms/cmd/bank-rad"] = 0.0
         fdm["fms/cmd/ny"] = 1.0
         fdm["fms/cmd/nx"] = 0.0

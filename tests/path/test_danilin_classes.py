@@ -4,7 +4,6 @@ names the condition; (2) a leg combination the geometry has to bridge; (3) the c
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import pytest
 
@@ -12,20 +11,12 @@ from fms_testbed.core.units import KT_MPS
 from fms_testbed.legs.model import BuildParams
 from fms_testbed.path.monitor import check_path
 from fms_testbed.path.segmentation import build_sequence
-from fms_testbed.procedures.database import load_database
 from fms_testbed.procedures.synth import leg_record as L
 from fms_testbed.procedures.synth import offset, waypoint_record
 from tests.path.test_world import APT, PERF, build
 
-CIFP = Path(__file__).resolve().parents[3] / "shared" / "data" / "cifp" / "FAACIFP18_230126"
 WINDY_HOT = BuildParams(wind_speed_mps=40 * KT_MPS, wind_from_deg=270.0, isa_dev_c=20.0)
 
-
-@pytest.fixture(scope="module")
-def cifp():
-    if not CIFP.exists():
-        pytest.skip(f"the FAA CIFP is not at {CIFP}")
-    return load_database(CIFP)
 
 
 def _seq(db, airport, name):

@@ -8,7 +8,6 @@ repository); the synthetic records come from :mod:`fms_testbed.procedures.synth`
 from __future__ import annotations
 
 import math
-from pathlib import Path
 
 import pytest
 
@@ -21,7 +20,7 @@ from fms_testbed.core.units import KT_MPS
 from fms_testbed.core.units import NM_M as NM
 from fms_testbed.guidance.active_path import smooth_connectors
 from fms_testbed.guidance.pde import path_pde_m, segment_pde_m
-from fms_testbed.legs.construct import _foot, centre_through
+from fms_testbed.legs.construct import centre_through
 from fms_testbed.legs.model import BuildParams, max_tailwind_mps, turn_radius_m
 from fms_testbed.path.monitor import check_path
 from fms_testbed.path.plan import _perf_params, build_procedure, merge_parts, select_parts
@@ -32,14 +31,7 @@ from fms_testbed.procedures.synth import leg_record as L
 from fms_testbed.procedures.synth import offset, waypoint_record
 from tests.path.test_world import APT, PARAMS, PERF, build, world
 
-CIFP = Path(__file__).resolve().parents[3] / "shared" / "data" / "cifp" / "FAACIFP18_230126"
 
-
-@pytest.fixture(scope="module")
-def cifp():
-    if not CIFP.exists():
-        pytest.skip(f"the FAA CIFP is not at {CIFP}")
-    return load_database(CIFP)
 
 
 @pytest.fixture(scope="module")

@@ -8,7 +8,6 @@ issue's: FTE95 ≤ 150 m and max FTE ≤ 185 m, coded constraints within 50 ft /
 
 from __future__ import annotations
 
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -22,16 +21,9 @@ from fms_testbed.procedures.synth import offset, waypoint_record, write_file
 from fms_testbed.run import fly_procedure
 from tests.path.test_world import base_records, world
 
-CIFP = Path(__file__).resolve().parents[3] / "shared" / "data" / "cifp" / "FAACIFP18_230126"
 FTE95_GOAL_M = 150.0
 FTE_MAX_GOAL_M = 0.1 * NM
 
-
-@pytest.fixture(scope="module")
-def cifp():
-    if not CIFP.exists():
-        pytest.skip(f"the FAA CIFP is not at {CIFP}")
-    return load_database(CIFP)
 
 
 _CACHE: dict = {}
@@ -249,3 +241,37 @@ def test_fix_followed_by_a_hold_at_it_is_checked_at_its_first_passage(cifp):
     assert [c["code"] for c in rows] == ["TF", "HF"]
     assert rows[0]["ok"] is True and rows[0]["alt_ft"] >= 2900 - 50, rows[0]
     assert rows[1]["ok"] is True, rows[1]
+
+
+@pytest.mark.parametrize("wind_from_deg", [330.0, 165.0])
+def test_final_approach_in_along_track_wind_crosses_at_the_tch(cifp, wind_from_deg):
+    """KCHA S33 (VPA 3.43°, TCH 47 ft) in a 30 kt headwind and tailwind: the altitude lead is
+    on the TAS (the law's lag is air-relative); with the ground speed the tailwind flight
+    crossed 45 ft low and touched down at the threshold (``diverged``)."""
+    proc = {"airport": "KCHA", "procedure": "S33"}
+    raw = {"aircraft": "737", "procedure": proc,
+           "wind": {"from_deg": wind_from_deg, "speed_kt": 30.0}}
+    scn, spec, fp, d = prepare(raw, db=cifp)
+    res = fly_procedure(scn, spec, fp, d, progress=False, plots=False)
+    s = res.summary
+    assert s["status"] == "ok", s["reason"]
+    thr = s["procedure"].get("threshold") or s.get("threshold")
+    assert thr is not None, list(s)
+    assert abs(thr["height_ft"] - thr["tch_ft"]) <= 10, thr
+
+
+@pytest.mark.parametrize("airport, procedure, transition, runway", [
+    ("KMFR", "GNATS7", "HANDY", "RW14"),   # SID: the default 15,000 ft climb top
+    ("KAEG", "CURLY3", "GUP", None),       # STAR without altitudes: field + 10,000 ft start
+])
+def test_planner_choices_stay_below_the_ceiling(cifp, airport, procedure, transition, runway):
+    """The C172P (13,500 ft ceiling): a climb top and an uncoded arrival start chosen by the
+    planner stay CEILING_MARGIN_M below it (both flights were envelope_exceeded)."""
+    from fms_testbed.config.aircraft import load_aircraft
+    from fms_testbed.legs.model import CEILING_MARGIN_M
+
+    res, fp = fly(cifp, airport, procedure, transition, runway, aircraft="c172p")
+    s = res.summary
+    assert s["status"] == "ok", s["reason"]
+    ceiling_m = load_aircraft("c172p").limits.alt_max_m
+    assert res.df["alt_m"].max() <= ceiling_m - CEILING_MARGIN_M + 30.0
