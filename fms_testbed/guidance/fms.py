@@ -56,6 +56,17 @@ DEFAULT_CLIMB_TOP_M = 15000 * FT_M
 """Climb top when no procedure spec gives one, m."""
 
 
+def measured_wind_mps(nav, truth) -> float:
+    """The wind speed the FMS measures, m/s: |ground velocity − TAS along the heading| from
+    the navigation solution and the air data (the TAS, sideslip neglected); 0 without them."""
+    tas = getattr(truth, "tas_mps", None)
+    v = getattr(nav, "v_enu_mps", None)
+    if tas is None or v is None:
+        return 0.0
+    h = nav.heading_rad
+    return math.hypot(float(v[0]) - tas * math.sin(h), float(v[1]) - tas * math.cos(h))
+
+
 @dataclass(frozen=True, slots=True)
 class _Where:
     """Step 1's answer: the piece flown (of segment ``seg``, of built leg ``built``) and the
@@ -232,7 +243,8 @@ class ProcedureGuidance:
                 if sched is not None else None
             tas_cmd = self.speed.update(nav.t_s, nav.alt_m, w.leg, self.act.pieces, self.i,
                                         w.along_m, w.gs_mps, self.gains.bank_max_deg,
-                                        self.act.piece_legs, sched, s_sched)
+                                        self.act.piece_legs, sched, s_sched,
+                                        measured_wind_mps(nav, truth))
             return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=tas_cmd,
                                   log=self._log_due(w, truth, s_path))
         return GuidanceOutput(done=True)

@@ -56,9 +56,11 @@ class GoAround:
 
 
 def arc_speed_cap_mps(pieces: list[LocalPiece], i: int, along_m: float, v_mps: float,
-                      bank_max_deg: float) -> float:
+                      bank_max_deg: float, wind_mps: float = 0.0) -> float:
     """Highest TAS at which every arc within the deceleration distance ahead can be flown with
-    ARC_BANK_MARGIN_DEG to spare below the bank limit, m/s (inf when none): v = sqrt(R g tan γ).
+    ARC_BANK_MARGIN_DEG to spare below the bank limit, m/s (inf when none): the ground speed
+    sqrt(R g tan γ) less ``wind_mps`` (the measured wind speed, m/s: the tailwind at the arc's
+    worst point, whatever its tracks), never below half of it.
 
     Parameters
     ----------
@@ -66,13 +68,17 @@ def arc_speed_cap_mps(pieces: list[LocalPiece], i: int, along_m: float, v_mps: f
     v_mps : present speed, m/s (deceleration distance (V² − v²) / (2 a) + DECEL_EXTRA_S V,
         a = DECEL_MPS2)
     bank_max_deg : the aircraft's bank limit, deg
+    wind_mps : measured wind speed, m/s (0: calm). Without it a 737 slowed for a fly-by
+        planned for 167 kt in a 30 kt tailwind (KSBY L32) only to its calm-air speed and flew
+        the arc 309 m wide at the bank limit.
     """
     g_tan = G0_MPS2 * math.tan(math.radians(bank_max_deg - ARC_BANK_MARGIN_DEG))
     cap = math.inf
     dist = -along_m
     for p in pieces[i:]:
         if p.is_arc:
-            v = math.sqrt(p.radius_m * g_tan)
+            vg = math.sqrt(p.radius_m * g_tan)
+            v = max(vg - wind_mps, 0.5 * vg)
             if dist <= max(v_mps * v_mps - v * v, 0.0) / (2 * DECEL_MPS2) + DECEL_EXTRA_S * v_mps:
                 cap = min(cap, v)
         dist += p.length_m
@@ -152,21 +158,23 @@ class SpeedPlan:
     def update(self, t_s: float, alt_m: float, leg: int, pieces: list[LocalPiece], i: int,
                along_m: float, gs_mps: float, bank_max_deg: float,
                piece_legs: list[int] | None = None, schedule=None,
-               s_sched_m: float | None = None) -> float:
+               s_sched_m: float | None = None, wind_mps: float = 0.0) -> float:
         """The TAS target at time ``t_s`` (s), altitude (m), on leg ``leg`` (whole-procedure
         index), piece ``i`` at ``along_m`` (m), ground speed (m/s), m/s; ``piece_legs``: the
         whole-procedure leg of each piece (speed limits of fixes ahead planned before them);
         ``schedule``: the approach's planned speeds (``SpeedProfile``) and ``s_sched_m`` the
-        aircraft's distance along the path they were planned on, m."""
+        aircraft's distance along the path they were planned on, m; ``wind_mps``: the
+        measured wind speed, m/s (:func:`arc_speed_cap_mps`)."""
         if t_s >= self.next_t_s:
             ga = self.go_around
             if ga is not None and leg >= ga.first_leg:
                 return self._go_around_update(t_s, alt_m, leg, pieces, i, along_m, gs_mps,
-                                              bank_max_deg, ga)
+                                              bank_max_deg, ga, wind_mps)
             lim = self.limits[leg] if leg < len(self.limits) else None
             lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
             plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
-                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg))
+                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg,
+                                         wind_mps))
             if piece_legs is not None:
                 plan = min(plan, self.limit_ahead_cap_mps(alt_m, leg, pieces, i, along_m,
                                                           self.tas_cmd_mps, piece_legs))
@@ -182,7 +190,7 @@ class SpeedPlan:
         return self.tas_cmd_mps
 
     def _go_around_update(self, t_s, alt_m, leg, pieces, i, along_m, gs_mps, bank_max_deg,
-                          ga: GoAround) -> float:
+                          ga: GoAround, wind_mps: float = 0.0) -> float:
         """The missed approach's TAS target (:class:`GoAround`), m/s: Vapp + the increment up
         to the acceleration height above the runway, then the planned speed in the leg's coded
         band."""
@@ -192,7 +200,8 @@ class SpeedPlan:
         lo, hi = cas_band(lim, None)
         if self.accelerated:
             plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
-                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg))
+                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg,
+                                         wind_mps))
         else:
             plan = cas_to_tas_scalar(ga.vapp_cas_mps + ga.add_cas_mps, alt_m, self.isa_dev_c)
             lo = hi = None

@@ -58,3 +58,4 @@ def test_altitude_command_reaches_the_at_fix_altitude_at_the_fix():
     assert cmd == pytest.approx(11000 * FT, abs=0.5)
     cmd_plain = altitude_command_m(S, H, ct, S[1] - 1e-3, gs, 0.0, 0.0, 20000.0, False, None)
     assert cmd_plain > 11000 * FT + 10 * FT
+

@@ -275,3 +275,21 @@ def test_planner_choices_stay_below_the_ceiling(cifp, airport, procedure, transi
     assert s["status"] == "ok", s["reason"]
     ceiling_m = load_aircraft("c172p").limits.alt_max_m
     assert res.df["alt_m"].max() <= ceiling_m - CEILING_MARGIN_M + 30.0
+
+
+@pytest.mark.parametrize("airport, procedure, transition, wind_from_deg", [
+    ("KSBY", "L32", "SWL", 204.0),     # FC → CF FRYER: fly-by planned for 167 kt in the wind
+    ("KSUS", "L08R", "FTZ", 308.9),
+])
+def test_fly_by_slowed_for_in_a_tailwind_is_flown_within_the_goal(cifp, airport, procedure,
+                                                                  transition, wind_from_deg):
+    """A fly-by the monitor slowed down for its tailwind (speed correction): guidance caps the
+    TAS ahead of the arc at its ground-speed limit less the measured wind
+    (speed_plan.arc_speed_cap_mps). With the calm-air cap the 737 flew the KSBY arc at the bank
+    limit 309 m wide (FTE95 202 m); KSUS L08R 243 m."""
+    proc = {"airport": airport, "procedure": procedure, "transition": transition}
+    raw = {"aircraft": "737", "procedure": proc,
+           "wind": {"from_deg": wind_from_deg, "speed_kt": 30.0}}
+    scn, spec, fp, d = prepare(raw, db=cifp)
+    res = fly_procedure(scn, spec, fp, d, progress=False, plots=False)
+    within_goals(res)
