@@ -56,15 +56,16 @@ DEFAULT_CLIMB_TOP_M = 15000 * FT_M
 """Climb top when no procedure spec gives one, m."""
 
 
-def measured_wind_mps(nav, truth) -> float:
-    """The wind speed the FMS measures, m/s: |ground velocity − TAS along the heading| from
-    the navigation solution and the air data (the TAS, sideslip neglected); 0 without them."""
-    tas = getattr(truth, "tas_mps", None)
-    v = getattr(nav, "v_enu_mps", None)
-    if tas is None or v is None:
+def planned_wind_mps(fp: FlyablePath, alt_m: float) -> float:
+    """The wind speed the path was planned for at ``alt_m`` (m), m/s: the plan's profile there,
+    else its constant wind; 0 in calm or without planning parameters. A measured wind that
+    differs makes :mod:`.replan` rebuild the path for it, so this is the flight's best wind."""
+    p = fp.params
+    if p is None:
         return 0.0
-    h = nav.heading_rad
-    return math.hypot(float(v[0]) - tas * math.sin(h), float(v[1]) - tas * math.cos(h))
+    if p.wind_profile is not None:
+        return float(p.wind_profile.at(alt_m)[0])
+    return float(p.wind_speed_mps)
 
 
 @dataclass(frozen=True, slots=True)
@@ -244,7 +245,7 @@ class ProcedureGuidance:
             tas_cmd = self.speed.update(nav.t_s, nav.alt_m, w.leg, self.act.pieces, self.i,
                                         w.along_m, w.gs_mps, self.gains.bank_max_deg,
                                         self.act.piece_legs, sched, s_sched,
-                                        measured_wind_mps(nav, truth))
+                                        planned_wind_mps(self.act.fp, nav.alt_m))
             return GuidanceOutput(bank_rad=bank, alt_m=alt_cmd, tas_mps=tas_cmd,
                                   log=self._log_due(w, truth, s_path))
         return GuidanceOutput(done=True)

@@ -59,8 +59,8 @@ def arc_speed_cap_mps(pieces: list[LocalPiece], i: int, along_m: float, v_mps: f
                       bank_max_deg: float, wind_mps: float = 0.0) -> float:
     """Highest TAS at which every arc within the deceleration distance ahead can be flown with
     ARC_BANK_MARGIN_DEG to spare below the bank limit, m/s (inf when none): the ground speed
-    sqrt(R g tan γ) less ``wind_mps`` (the measured wind speed, m/s: the tailwind at the arc's
-    worst point, whatever its tracks), never below half of it.
+    sqrt(R g tan γ) less ``wind_mps`` (the wind speed the path is planned for, m/s: the
+    tailwind at the arc's worst point, whatever its tracks), never below half of it.
 
     Parameters
     ----------
@@ -68,7 +68,7 @@ def arc_speed_cap_mps(pieces: list[LocalPiece], i: int, along_m: float, v_mps: f
     v_mps : present speed, m/s (deceleration distance (V² − v²) / (2 a) + DECEL_EXTRA_S V,
         a = DECEL_MPS2)
     bank_max_deg : the aircraft's bank limit, deg
-    wind_mps : measured wind speed, m/s (0: calm). Without it a 737 slowed for a fly-by
+    wind_mps : planned wind speed, m/s (0: calm). Without it a 737 slowed for a fly-by
         planned for 167 kt in a 30 kt tailwind (KSBY L32) only to its calm-air speed and flew
         the arc 309 m wide at the bank limit.
     """
@@ -164,7 +164,7 @@ class SpeedPlan:
         whole-procedure leg of each piece (speed limits of fixes ahead planned before them);
         ``schedule``: the approach's planned speeds (``SpeedProfile``) and ``s_sched_m`` the
         aircraft's distance along the path they were planned on, m; ``wind_mps``: the
-        measured wind speed, m/s (:func:`arc_speed_cap_mps`)."""
+        wind speed planned for, m/s (:func:`arc_speed_cap_mps`)."""
         if t_s >= self.next_t_s:
             ga = self.go_around
             if ga is not None and leg >= ga.first_leg:

@@ -99,6 +99,11 @@ class Flight:
             if self.takeoff is None:      # a takeoff builds its own (loop/takeoff.py)
                 self.config_step = ConfigStep(ap, ac, k0, False,
                                               getattr(guidance, "events", None))
+                if procedure.path.path.proc_type == "D":
+                    # a SID started airborne after its takeoff: clean, and only ever
+                    # retracting (the approach schedule put the gear down at 35 ft above the
+                    # runway and flaps out when the climb slowed the aircraft)
+                    self.config_step.departure()
             if hasattr(guidance, "set_mass"):
                 guidance.set_mass(float(ac.fdm["inertia/mass-slugs"]) * SLUG_KG)
         if scn.turbulence is not None:  # after trim: JSBSim cannot trim in turbulence

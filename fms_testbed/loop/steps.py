@@ -283,6 +283,11 @@ class ConfigStep:
         self.k_land, self.k_ga = ap.index(ap.landing_flap), ap.index(ap.go_around_flap)
         self.k_gear = None if ap.fixed_gear else ap.index(ap.gear_with_flap)
 
+    def departure(self) -> None:
+        """Fly a departure: the retract-only schedule of the go-around from here on (no
+        extension, no event: the aircraft is already clean or in its takeoff setting)."""
+        self.go_around = True
+
     def _event(self, t_s: float, detail: str) -> None:
         self.events.append({"t_s": round(t_s, 2), "kind": "config", "detail": detail})
 
