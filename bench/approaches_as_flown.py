@@ -9,7 +9,7 @@ it has none. The first ``--n`` candidates that build are flown (those refused at
 counted and listed); ``--missed K`` flies the first K of them again with ``procedure.missed``.
 
     python bench/approaches_as_flown.py [--db FILE] [--seed 3] [--n 24] [--missed 4]
-                                        [--md docs/results/approaches.md]
+                                        [--md approaches.md]
 
 Goals (issue 12): threshold crossed at Vapp ± 5 kt, configured (landing flaps, gear down), on
 the coded path angle ± 0.2° (mean over the last NM), at the TCH (± 25 ft here).
@@ -153,7 +153,7 @@ def main(argv=None) -> int:
     ap.add_argument("--seed", type=int, default=3)
     ap.add_argument("--n", type=int, default=24)
     ap.add_argument("--missed", type=int, default=4)
-    ap.add_argument("--md", default=str(ROOT / "docs/results/approaches.md"))
+    ap.add_argument("--md", default="approaches.md", help="report in docs/results/ ('' none)")
     ap.add_argument("--json", default=None, help="also write every row as JSON here")
     a = ap.parse_args(argv)
     from fms_testbed.path.plan import load_db
@@ -179,13 +179,10 @@ def main(argv=None) -> int:
         v = [abs(r["threshold"][key]) for r in crossed if r["threshold"].get(key) is not None]
         return (sum(x <= tol for x in v), len(v), max(v) if v else None)
 
-    lines = ["# Approaches as flown (737)", "",
-             "Written by `bench/approaches_as_flown.py` "
-             f"(`python bench/approaches_as_flown.py --seed {a.seed} --n {a.n} "
-             f"--missed {a.missed}`) on the FAA CIFP `{Path(a.db).name}`: candidates ranked by "
-             "SHA-256 of `seed:airport:procedure`, the first that build flown by the 737 in "
-             "calm air, truth navigation (seed 0).", "",
-             f"- flown: {len(rows)}, refused at build time: {len(refused)}, threshold crossed: "
+    note = (f"On the FAA CIFP `{Path(a.db).name}`: candidates ranked by SHA-256 of "
+            "`seed:airport:procedure`, the first that build flown by the 737 in calm air, truth "
+            "navigation (seed 0).")
+    lines = [f"- flown: {len(rows)}, refused at build time: {len(refused)}, threshold crossed: "
              f"{len(crossed)} (the others end at a MAP before the threshold or have no runway)"]
     for key, tol, lab in (("cas_minus_vapp_kt", 5.0, "CAS within 5 kt of Vapp"),
                           ("path_angle_minus_vpa_deg", 0.2, "path angle within 0.2° of the VPA"),
@@ -228,11 +225,14 @@ def main(argv=None) -> int:
         lines += [f"- {r['airport']} {r['procedure']} {r['transition'] or ''}: {r['refused']}"
                   for r in refused]
         lines.append("")
-    Path(a.md).write_text("\n".join(lines))
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import report
+
+    report.write(a.md, "\n".join(lines), note=note)
     if a.json:
         Path(a.json).write_text(json.dumps({"rows": rows, "missed": missed,
                                             "refused": refused}, indent=1, default=str))
-    print("\n".join(lines[:12]))
+    print("\n".join(lines[:10]))
     return 0
 
 

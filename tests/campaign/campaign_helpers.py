@@ -4,8 +4,8 @@ from __future__ import annotations
 
 from fms_testbed.cli import main
 
-SMALL = ["--airports", "KDLS", "--wind", "calm", "270/30"]
-"""The small case set of the embedded excerpt: 6 flyable sequences × 2 condition sets (12 cases,
+SMALL = ["--airports", "KENV", "--wind", "calm", "270/30"]
+"""The small case set of the embedded excerpt: 10 flyable sequences × 2 condition sets (20 cases,
 class 1 and class 2 failures among them)."""
 
 

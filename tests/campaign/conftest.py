@@ -1,5 +1,5 @@
 """Shared campaign fixtures: a private database-index cache for the session, and one small run
-(KDLS from the embedded excerpt, calm and a 30 kt west wind: 12 cases, about 3 s on two workers)
+(KENV from the embedded excerpt, calm and a 30 kt west wind: 20 cases, about 5 s on two workers)
 that the diff, report and determinism tests read."""
 
 from __future__ import annotations

@@ -23,7 +23,7 @@ def test_a_run_against_itself_is_clean(small_run, capsys, tmp_path):
     md = tmp_path / "diff.md"
     assert regress("diff", str(small_run), str(small_run), "--markdown", str(md)) == 0
     out = capsys.readouterr().out
-    assert "12 cases matched: 0 changed beyond tolerance" in out
+    assert "20 cases matched: 0 changed beyond tolerance" in out
     assert "verdict: no change" in md.read_text()
 
 

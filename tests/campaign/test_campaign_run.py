@@ -31,7 +31,7 @@ def test_small_run_has_one_row_per_case(small_run):
     df = read_flights(small_run)
     info = json.loads((small_run / "run.json").read_text())
     assert list(df.columns) == list(COLUMNS)
-    assert len(df) == info["cases"]["count"] == 12 and df["case_id"].is_unique
+    assert len(df) == info["cases"]["count"] == 20 and df["case_id"].is_unique
     assert info["status"] == "complete" and info["counts"] == df["status"].value_counts().to_dict()
     assert info["database"]["sha256"] == load_index(None).sha256
     flown = df[df["status"] != "impossible"]
@@ -56,7 +56,7 @@ def test_same_command_resumes_without_flying(small_run, tmp_path, capsys):
     shutil.copytree(small_run, out)
     parts = part_files(out)
     assert regress("run", *SMALL, "--workers", "2", "--no-progress", "--out", str(out)) == 0
-    assert "0 flown now, 12 already done" in capsys.readouterr().out
+    assert "0 flown now, 20 already done" in capsys.readouterr().out
     assert part_files(out) == parts
     info = json.loads((out / "run.json").read_text())
     assert len(info["sessions"]) == 2 and info["status"] == "complete"
