@@ -36,7 +36,7 @@ from fms_testbed.guidance.replan import (ConditionMonitor, measured_params, pass
                                          rebuild_rest, rebuildable_here)
 from fms_testbed.guidance.sequencing import OVERRUN_MAX_M, ConditionWatch, hold_exit_reached
 from fms_testbed.guidance.speed_plan import GoAround, SpeedPlan
-from fms_testbed.guidance.steering import steer_bank_rad
+from fms_testbed.guidance.steering import flies_heading, steer_bank_rad
 from fms_testbed.guidance.step_log import log_row
 from fms_testbed.guidance.vertical import (altitude_command_m, altitude_lead_s,
                                           planned_limits)
@@ -45,6 +45,11 @@ from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.plan import FlyablePath
 from fms_testbed.procedures.records import Fix
 
+HEADING_DRIFT_REBUILD_M = 100.0
+"""A heading leg is rebuilt from the present position once the aircraft is this far off the
+track its planned drift predicted, m (:meth:`ProcedureGuidance._heading_drifted`)."""
+HEADING_DRIFT_REBUILD_S = 30.0
+"""At most one such rebuild in this time, s."""
 XTK_ABORT_M = 5 * NM_M
 """Cross-track beyond which the flight is declared off the procedure, m."""
 CIRCLING_FLOOR_HEIGHT_M = 180.0
@@ -151,6 +156,8 @@ class ProcedureGuidance:
         self.rebuilt: list[FlyablePath] = []
         self.conditions = ConditionMonitor()
         """Measured vs planned wind and temperature (:mod:`.replan`): a rebuild when they differ."""
+        self._drift_rebuilt_s = -math.inf
+        """When a heading leg was last rebuilt for its drift, s."""
 
     def _circling_floor_m(self, fp: FlyablePath, db) -> float:
         """Lowest altitude command, m: for a circling approach the airport elevation plus
@@ -324,9 +331,46 @@ class ProcedureGuidance:
         a rebuilt path is active."""
         why = self.conditions.update(nav.t_s, nav, truth, self.act.fp.params)
         if not why or not rebuildable_here(w.seg, w.built) or self.db is None:
-            return False
+            return self._heading_drifted(w, nav)
         (wn, we), dev = self.conditions.measured
         params = measured_params(self.act.fp.params, nav.alt_m, (wn, we), dev)
+        self.conditions.rebuilt(nav.t_s)
+        if not self._rebuild_rest(w, nav, params):
+            self._event(nav.t_s, "condition", w.leg, f"conditions changed ({why}); the rest "
+                                                     "could not be rebuilt: the plan is kept")
+            return False
+        self.speed.isa_dev_c = params.isa_dev_c
+        self._event(nav.t_s, "rebuild", w.leg, f"conditions changed: {why}; rest of the "
+                                               f"procedure rebuilt from the present position "
+                                               f"({len(self.act.fp.path.segments)} segments)")
+        return True
+
+    def _heading_drifted(self, w: _Where, nav) -> bool:
+        """Step 2c: on the straight part of a heading leg (V*) the aircraft is more than
+        :data:`HEADING_DRIFT_REBUILD_M` off the track its planned drift predicted (the wind
+        ramped in after a still-air trim, a TAS or wind a little off the plan): the rest of
+        the procedure, the heading leg included, is rebuilt from the present position, so the
+        intercept or turn at the leg's end starts where the aircraft is — as an FMS computes a
+        heading leg's intercept from the present position. At most once every
+        :data:`HEADING_DRIFT_REBUILD_S`. True when a rebuilt path is active."""
+        if (self.db is None or not flies_heading(w.seg, w.p)
+                or abs(w.xtk_m) < HEADING_DRIFT_REBUILD_M
+                or not rebuildable_here(w.seg, w.built)
+                or nav.t_s - self._drift_rebuilt_s < HEADING_DRIFT_REBUILD_S):
+            return False
+        self._drift_rebuilt_s = nav.t_s
+        off = w.xtk_m
+        if not self._rebuild_rest(w, nav, self.act.fp.params):
+            return False
+        self._event(nav.t_s, "rebuild", w.leg, f"heading leg {off:+.0f} m off its predicted "
+                                               f"track; rest of the procedure rebuilt from the "
+                                               f"present position "
+                                               f"({len(self.act.fp.path.segments)} segments)")
+        return True
+
+    def _rebuild_rest(self, w: _Where, nav, params) -> bool:
+        """Rebuild the rest of the procedure, the present leg included, from the present
+        position for ``params`` and make it the active path; False when it cannot be built."""
         k = w.leg
         prev = None
         if k > 0:
@@ -339,10 +383,7 @@ class ProcedureGuidance:
         fp = rebuild_rest(self.db, self.whole, self.spec, self.cfg, self.gains, k,
                           nav.lat_rad, nav.lon_rad, w.trk_rad, nav.alt_m, gs, nav.roll_rad,
                           params=params, prev_fix=prev)
-        self.conditions.rebuilt(nav.t_s)
         if fp is None:
-            self._event(nav.t_s, "condition", k, f"conditions changed ({why}); the rest could "
-                                                 "not be rebuilt: the plan is kept")
             return False
         a = self.act
         s_now = a.s_base_m + a.seg_cum_m[w.p.seg_index] + w.p.s0_m + w.along_m
@@ -350,10 +391,6 @@ class ProcedureGuidance:
                             lead_from=(math.degrees(nav.lat_rad), math.degrees(nav.lon_rad)))
         self.rebuilt.append(fp)
         self.i = 0
-        self.speed.isa_dev_c = params.isa_dev_c
-        self._event(nav.t_s, "rebuild", k, f"conditions changed: {why}; rest of the procedure "
-                                           f"rebuilt from the present position "
-                                           f"({len(fp.path.segments)} segments)")
         return True
 
     def _past_leg(self, w: _Where):

@@ -293,3 +293,26 @@ def test_fly_by_slowed_for_in_a_tailwind_is_flown_within_the_goal(cifp, airport,
     scn, spec, fp, d = prepare(raw, db=cifp)
     res = fly_procedure(scn, spec, fp, d, progress=False, plots=False)
     within_goals(res)
+
+
+@pytest.mark.parametrize("airport, procedure, transition, runway, wind_from_deg", [
+    ("KPHX", "BALDY3", "CNX", "RW07L", 272.4),   # VI: drift 0.9° off the prediction, 2.3 km
+    ("KDHN", "I14", "SKIPO", None, 136.4),       # initial VI in the wind ramp: 215 m
+])
+def test_heading_leg_that_drifts_off_its_prediction_is_rebuilt_in_flight(
+        cifp, airport, procedure, transition, runway, wind_from_deg):
+    """A heading leg more than HEADING_DRIFT_REBUILD_M off the track its planned drift
+    predicted is rebuilt from the present position, so its intercept starts where the aircraft
+    is (guidance.fms.ProcedureGuidance._heading_drifted): KPHX BALDY3 was not_contained (max FTE
+    2,311 m at the VI's intercept), KDHN I14 215 m."""
+    proc = {"airport": airport, "procedure": procedure, "transition": transition}
+    if runway:
+        proc["runway"] = runway
+    raw = {"aircraft": "737", "procedure": proc,
+           "wind": {"from_deg": wind_from_deg, "speed_kt": 30.0}}
+    scn, spec, fp, d = prepare(raw, db=cifp)
+    res = fly_procedure(scn, spec, fp, d, progress=False, plots=False)
+    within_goals(res)
+    assert res.summary["status"] == "ok", res.summary["reason"]
+    assert any(e["kind"] == "rebuild" and "heading leg" in e.get("detail", "")
+               for e in res.summary["guidance_events"])
