@@ -64,9 +64,16 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+_terminated: list[int] = []
+"""The SIGTERM received, if any (its number)."""
+
+
 def _exit_on_sigterm(signum, frame) -> None:  # pragma: no cover - exercised in a subprocess
     """SIGTERM ends the process through ``sys.exit`` so atexit handlers run (the JSBSim sandbox
-    folder in the temporary folder is removed)."""
+    folder in the temporary folder is removed). Raised while a numba kernel is loaded, compiled
+    or called, the exit surfaces as another exception (a SystemError from the dispatcher); the
+    record lets :func:`main` end with the signal's exit code all the same."""
+    _terminated.append(signum)
     raise SystemExit(128 + signum)
 
 
@@ -106,6 +113,9 @@ def main(argv: list[str] | None = None) -> int:
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
     except Exception:
+        if _terminated:                # SIGTERM, surfacing through compiled code
+            print("fms-testbed: terminated", file=sys.stderr)
+            return 128 + _terminated[0]
         if _interrupted.is_set():      # the interrupt, surfacing through compiled code
             print("fms-testbed: interrupted", file=sys.stderr)
             return 130

@@ -10,6 +10,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "sins-stim300.yaml"
 
 
@@ -21,7 +23,7 @@ def _long_scenario(tmp_path) -> Path:
     return p
 
 
-def _start(tmp_path):
+def _start(tmp_path, settle_s: float = 1.0):
     env = {**os.environ, "TMPDIR": str(tmp_path / "tmp")}
     (tmp_path / "tmp").mkdir()
     p = subprocess.Popen([sys.executable, "-m", "fms_testbed", "run", str(_long_scenario(tmp_path)),
@@ -31,7 +33,7 @@ def _start(tmp_path):
     while time.time() < deadline and not list((tmp_path / "tmp").glob("fms-testbed-jsbsim-*")):
         time.sleep(0.05)
     assert list((tmp_path / "tmp").glob("fms-testbed-jsbsim-*")), "the flight never started"
-    time.sleep(1.0)                 # inside the closed loop (SINS kernels in numba)
+    time.sleep(settle_s)            # 1 s: inside the closed loop (SINS kernels in numba)
     return p
 
 
@@ -45,8 +47,12 @@ def test_sigint_exits_130_with_one_line(tmp_path):
     assert not (tmp_path / "out").exists()          # nothing that looks like a finished run
 
 
-def test_sigterm_removes_the_jsbsim_sandbox(tmp_path):
-    p = _start(tmp_path)
+@pytest.mark.parametrize("settle_s", [0.0, 0.3, 1.0])
+def test_sigterm_removes_the_jsbsim_sandbox(tmp_path, settle_s):
+    """SIGTERM at the JSBSim load, while the numba kernels load, and in the closed loop: exit
+    128 + 15, one line, no traceback (a SIGTERM inside a numba dispatcher call used to surface
+    as a SystemError traceback and exit 1)."""
+    p = _start(tmp_path, settle_s)
     p.send_signal(signal.SIGTERM)
     out, err = p.communicate(timeout=60)
     assert p.returncode == 128 + signal.SIGTERM, err[-2000:]
