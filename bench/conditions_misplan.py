@@ -1,10 +1,8 @@
 """Actual ISA+20 (or -20), path planned for the ISA (forecast isa_dev_c 0): rebuild off vs on.
 737, truth navigation, calm air. Usage: python bench/conditions_misplan.py"""
 from report import CIFP  # noqa: E402  (bench/report.py)
-import fms_testbed.guidance.fms as gfms
-from fms_testbed.guidance.replan import ConditionMonitor, ConditionThresholds
-from fms_testbed.loop.procedure import prepare
-from fms_testbed.run import fly_procedure
+from rebuild_switch import fly  # noqa: E402  (bench/rebuild_switch.py)
+from fms_testbed.core.units import KT_MPS
 from fms_testbed.procedures.database import load_database
 cifp = load_database(str(CIFP))
 emb = load_database()
@@ -14,20 +12,13 @@ for db, p, code in ((emb, {"airport": "KENV", "procedure": "R26", "transition": 
         for rebuild in (False, True):
             raw = {"aircraft": "737", "procedure": p, "atmosphere": {"isa_dev_c": dev},
                    "forecast": {"isa_dev_c": 0}}
-            scn, spec, fp, d = prepare(raw, db=db)
-            th = ConditionThresholds() if rebuild else ConditionThresholds(wind_err_mps=1e9, isa_dev_err_c=1e9)
-            orig = gfms.ConditionMonitor
-            gfms.ConditionMonitor = lambda: ConditionMonitor(th)
-            try:
-                res = fly_procedure(scn, spec, fp, d, progress=False, plots=False)
-            finally:
-                gfms.ConditionMonitor = orig
+            res, _ = fly(raw, db, rebuild)
             df = res.df
             on = df[(df.leg_code == code) & (df.seg_role.isin(["hold", "turn"])) & (df.curvature_1pm.abs() > 0)]
             e = res.summary["errors"]["fte"]["all"]
             ev = [x for x in res.summary["guidance_events"] if x["kind"] == "rebuild"]
             print(f"| {p['airport']} {p['procedure']} {code} | ISA{dev:+d} planned ISA | {'on' if rebuild else 'off'} | "
-                  f"{on.tas_mps.median() / 0.514444:.1f} | {on.cas_mps.median() / 0.514444:.1f} | "
+                  f"{on.tas_mps.median() / KT_MPS:.1f} | {on.cas_mps.median() / KT_MPS:.1f} | "
                   f"{on.roll_deg.abs().quantile(0.5):.1f} / {on.roll_deg.abs().max():.1f} | "
                   f"{on.fte_m.abs().quantile(0.95):.1f} / {on.fte_m.abs().max():.1f} | {e['p95_m']} / {e['max_m']} | {len(ev)} |", flush=True)
             for x in ev:

@@ -6,10 +6,8 @@ constant wind (forecast), rebuilds off; (d) as (c) with rebuilds on (default thr
 Usage: python bench/conditions_wind.py [cifp]"""
 from report import CIFP  # noqa: E402  (bench/report.py)
 import sys
-import fms_testbed.guidance.fms as gfms
-from fms_testbed.guidance.replan import ConditionMonitor, ConditionThresholds
+from rebuild_switch import fly  # noqa: E402  (bench/rebuild_switch.py)
 from fms_testbed.loop.procedure import prepare
-from fms_testbed.run import fly_procedure
 from fms_testbed.procedures.database import load_database
 from fms_testbed.core.wind import WindProfile
 from fms_testbed.core.units import FT_M, KT_MPS
@@ -27,15 +25,7 @@ def run(db, proc, wind, forecast=None, rebuild=True):
     raw = {"aircraft": "737", "procedure": proc, "wind": wind}
     if forecast is not None:
         raw["forecast"] = {"wind": forecast}
-    scn, spec, fp, d = prepare(raw, db=db)
-    th = ConditionThresholds() if rebuild else ConditionThresholds(wind_err_mps=1e9, isa_dev_err_c=1e9)
-    orig = gfms.ConditionMonitor
-    gfms.ConditionMonitor = lambda: ConditionMonitor(th)
-    try:
-        res = fly_procedure(scn, spec, fp, d, progress=False, plots=False)
-    finally:
-        gfms.ConditionMonitor = orig
-    return res, fp
+    return fly(raw, db, rebuild)
 
 
 for dbn, apt, proc, extra in CASES:

@@ -306,22 +306,11 @@ class ProcedureGuidance:
             self._event(t_s, "condition", k, "DF fix already passed when the previous leg ended")
             self._enter_leg(t_s, k)
             nxt = k + 1
-        if nxt >= len(self.whole.seq.legs):
+        if nxt >= len(self.whole.seq.legs) or not self._rebuild_rest(w, nav, self.act.fp.params,
+                                                                     leg=nxt):
             return False
-        gs = math.hypot(float(nav.v_enu_mps[0]), float(nav.v_enu_mps[1]))
-        fp = rebuild_rest(self.db, self.whole, self.spec, self.cfg, self.gains, nxt,
-                          nav.lat_rad, nav.lon_rad, w.trk_rad, nav.alt_m, gs, nav.roll_rad,
-                          params=self.act.fp.params)
-        if fp is None:
-            return False
-        a = self.act
-        s_now = a.s_base_m + a.seg_cum_m[w.p.seg_index] + w.p.s0_m + w.along_m
-        self.act = activate(fp, s_now, v, lead_from=(math.degrees(nav.lat_rad),
-                                                     math.degrees(nav.lon_rad)))
-        self.rebuilt.append(fp)
-        self.i = 0
         self._event(t_s, "rebuild", nxt, f"rest of the procedure rebuilt from the aircraft "
-                                          f"state ({len(fp.path.segments)} segments)")
+                                          f"state ({len(self.act.fp.path.segments)} segments)")
         return True
 
     def _conditions_changed(self, w: _Where, nav, truth) -> bool:
@@ -368,12 +357,13 @@ class ProcedureGuidance:
                                                f"({len(self.act.fp.path.segments)} segments)")
         return True
 
-    def _rebuild_rest(self, w: _Where, nav, params) -> bool:
-        """Rebuild the rest of the procedure, the present leg included, from the present
-        position for ``params`` and make it the active path; False when it cannot be built."""
-        k = w.leg
+    def _rebuild_rest(self, w: _Where, nav, params, leg: int | None = None) -> bool:
+        """Rebuild the rest of the procedure from the present position for ``params`` and make
+        it the active path: from the present leg (its previous fix kept as the leg's origin),
+        or from ``leg`` on (a conditional leg that ended); False when it cannot be built."""
+        k = w.leg if leg is None else leg
         prev = None
-        if k > 0:
+        if leg is None and k > 0:
             t = self.whole.path.legs[k - 1].termination
             if t.kind == "fix" and t.lat_deg is not None:
                 prev = Fix(ident=t.fix_ident, region="", section="", lat_deg=t.lat_deg,

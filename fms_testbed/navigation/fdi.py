@@ -152,10 +152,17 @@ def declared_sensor_noise(imus: list, dt_s: float) -> tuple[np.ndarray, np.ndarr
     of :class:`SensorComparator`
     """
     q = np.array([np.r_[imu.q_psd[3:6], imu.q_psd[6:9]] for imu in imus])
-    sf = np.array([(float(imu.p0_var[15:18].mean() + 2.0 * imu.p0_var[21:27].mean()),
-                    float(imu.p0_var[18:21].mean() + 2.0 * imu.p0_var[27:33].mean()))
-                   for imu in imus])
+    sf = np.array([unmodelled_variances(imu) for imu in imus])
     return q, sf
+
+
+def unmodelled_variances(imu) -> tuple[float, float]:
+    """(accelerometer, gyro) scale-factor + 2 × misalignment variance per axis of a declared
+    :class:`~fms_testbed.sensors.sins.presets.ImuModel`, dimensionless / rad²: the 33-state
+    errors the filters do not carry."""
+    p = imu.p0_var
+    return (float(p[15:18].mean() + 2.0 * p[21:27].mean()),
+            float(p[18:21].mean() + 2.0 * p[27:33].mean()))
 
 
 def channel_mask(vertical_frozen: bool) -> np.ndarray:
@@ -543,4 +550,5 @@ class FaultTolerantEstimator:
 
 __all__ = ["FaultTolerantEstimator", "FdiTuning", "MAJORITY", "SensorComparator", "TwoStageFdi",
            "VERTICAL_CHANNELS", "VERTICAL_STATES", "adaptive_r", "channel_mask", "channel_sigmas",
+           "unmodelled_variances",
            "declared_sensor_noise", "frozen_states", "majority", "pair_flags", "residual_ok"]

@@ -45,6 +45,7 @@ from fms_testbed.core.earth import OMEGA_IE_RPS, radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import G0_MPS2
+from fms_testbed.navigation.fdi import unmodelled_variances
 from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed, innovation,
                                           predict)
 from fms_testbed.navigation.sins import _c_bn
@@ -109,13 +110,6 @@ def enu_difference_m(a_lat_rad, a_lon_rad, a_alt_m, b_lat_rad, b_lon_rad, b_alt_
     rm, rn = radii_m(a_lat_rad)
     return np.array([(a_lon_rad - b_lon_rad) * (rn + a_alt_m) * math.cos(a_lat_rad),
                      (a_lat_rad - b_lat_rad) * (rm + a_alt_m), a_alt_m - b_alt_m])
-
-
-def _unmodelled_variances(imu: ImuModel) -> tuple[float, float]:
-    """(accelerometer, gyro) scale-factor + misalignment variance per axis, dimensionless/rad²."""
-    p = imu.p0_var
-    return (float(p[15:18].mean() + 2.0 * p[21:27].mean()),
-            float(p[18:21].mean() + 2.0 * p[27:33].mean()))
 
 
 @njit(cache=True)
@@ -235,7 +229,7 @@ class InsGnssFilter:
             decay[BARO] = 1.0 / baro.markov_tau_s
             q[BARO] = 2.0 * baro.markov_sigma_m ** 2 / baro.markov_tau_s
         self.decay, self.q = decay, q
-        self._var_acc, self._var_gyro = _unmodelled_variances(imu)
+        self._var_acc, self._var_gyro = unmodelled_variances(imu)
         self.x = np.zeros(n)
         self.P = np.zeros((n, n))
         self._decay24 = np.ascontiguousarray(imu.decay_rps, float)

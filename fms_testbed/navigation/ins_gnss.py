@@ -50,8 +50,7 @@ from fms_testbed.navigation.faults import check_fault, inject
 from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
                                         TwoStageFdi,
                                         channel_sigmas, declared_sensor_noise)
-from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter,
-                                               _unmodelled_variances, enu_difference_m,
+from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter, enu_difference_m,
                                                predict_filters)
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
 from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor

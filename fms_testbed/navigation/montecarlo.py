@@ -48,9 +48,9 @@ from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import DPH_RPS, G0_MPS2
 from fms_testbed.navigation.array_fdi import ArrayFdi, ArraySensorComparator
-from fms_testbed.navigation.fdi import FdiTuning, channel_sigmas
+from fms_testbed.navigation.fdi import FdiTuning, channel_sigmas, unmodelled_variances
 from fms_testbed.navigation.ins_filter import (N_INS, FilterTuning, InsGnssFilter,
-                                               _filter_phi_q, _unmodelled_variances)
+                                               _filter_phi_q)
 from fms_testbed.navigation.sins import _sins_step
 from fms_testbed.sensors.baro import BaroSpec
 from fms_testbed.sensors.gnss import GnssSpec
@@ -295,7 +295,7 @@ class MonteCarlo:
         o_samples = o_nse = o_anp = 0
         groups_max = 1
         q_w = imu.q_psd[3:9]
-        sf_var = np.array([_unmodelled_variances(imu)] * U)
+        sf_var = np.array([unmodelled_variances(imu)] * U)
         noise = None
         fault_done = fault is None
         NL = 33
