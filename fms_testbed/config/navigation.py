@@ -50,6 +50,9 @@ class SinsBlock(BaseModel):
                                   "or independent")
     matrices_dt_s: Annotated[float, Field(ge=0, le=60)] = Field(
         0.0, description="reuse Φ_k, S_k this long before rebuilding F, s (0: every step)")
+    matrices_rotation_deg: Annotated[float, Field(gt=0)] = Field(
+        1e9, description="... and only while the body has turned less than this since they "
+                         "were built, deg (default: no limit)")
 
 
 class IntervalBlock(BaseModel):
@@ -137,6 +140,12 @@ class FilterBlock(BaseModel):
         20.0, description="correlation time of the noise standing in for the scale factors "
                            "and misalignments the filter does not carry, s")
     method: Literal["picard", "vanloan"] = Field("picard", description="discretisation")
+    predict_interval_s: Annotated[float, Field(ge=0, le=10)] = Field(
+        1.0, description="longest interval the covariance is propagated over at once (F "
+                         "averaged over it), s; a measurement or a GNSS epoch ends one too; "
+                         "0: every navigation step")
+    predict_rotation_deg: Annotated[float, Field(gt=0, le=90)] = Field(
+        1.0, description="an interval also ends once the body has turned this much in it, deg")
 
 
 class InsGnssBlock(BaseModel):
@@ -155,6 +164,12 @@ class InsGnssBlock(BaseModel):
     baro: BaroBlock | None = Field(default_factory=BaroBlock,
                                    description="baro altimeter (null: none)")
     filter: FilterBlock = Field(default_factory=FilterBlock, description="filter settings")
+    matrices_dt_s: Annotated[float, Field(ge=0, le=10)] = Field(
+        1.0, description="the INS units' error model (truth side) reuses its Φ_k, S_k this long, "
+                         "s (0: every step) ...")
+    matrices_rotation_deg: Annotated[float, Field(gt=0, le=90)] = Field(
+        1.0, description="... while the body has turned less than this since they were built, "
+                         "deg")
     alert_delay_s: Annotated[float, Field(ge=0, le=30)] | None = Field(
         None, description="ANP > RNP must persist this long before the RNP alert, s (default: "
                           "2 s, within the 10 s time to alert of terminal/approach)")

@@ -23,6 +23,10 @@ one unit fails it.
 Majority voting (the baseline, Zaitseva's foil): the mean of the units the majority table does
 not flag at this instant — no persistence, no estimator check, no memory; a unit that stays
 inside the pairwise thresholds is averaged in however wrong its sensors are.
+
+The per-step parts (the pair test, :func:`channel_sigmas`, the sensor comparator's running
+sums and z test) are compiled with numba and take the numpy statement's operations in its order,
+so their numbers are bitwise those of the numpy code they replace.
 """
 
 from __future__ import annotations
@@ -31,12 +35,20 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
+from numba import njit
 from scipy.stats import chi2
 
 MAJORITY = {(1, 1, 0): 0, (1, 0, 1): 1, (0, 1, 1): 2}
 """Seed 001's table for three units: (ν12, ν13, ν23) → index of the failed unit."""
 
 PAIRS = ((0, 1), (0, 2), (1, 2))
+
+_F8 = np.dtype(np.float64)
+_TWO_PI = 2 * math.pi
+_BITS = tuple((b & 1, (b >> 1) & 1, (b >> 2) & 1) for b in range(8))   # bit k: ν of PAIRS[k]
+_BAD = tuple(MAJORITY.get(nu) for nu in _BITS)
+_VOTE = tuple(tuple(i for i in range(3) if i != bad) for bad in _BAD)
+_ALL9 = np.ones(9, bool)
 
 
 @dataclass(frozen=True)
@@ -120,13 +132,46 @@ def channel_sigmas(P: np.ndarray, unmodelled_var: tuple[float, float] = (0.0, 0.
     by 4-5 filter σ in roll in level flight, and 3 of 1,000 fault-free one-hour Monte-Carlo runs
     excluded a healthy unit (``fms-testbed montecarlo --runs 1000 --outage 1800:1920``).
     """
+    var_a, var_g = unmodelled_var
+    if not (type(P) is np.ndarray and P.dtype == _F8 and P.ndim == 2
+            and P.shape[0] >= 9 and P.shape[1] >= 9):
+        return _channel_sigmas_np(P, var_a, var_g, roll_rad, pitch_rad, load_factor)
+    if var_a > 0.0 or var_g > 0.0:
+        # the same operations as _channel_sigmas_np: Python's x ** 2 is libm pow, not x * x
+        tilt2 = var_a * load_factor ** 2
+        rot2 = var_g * (roll_rad ** 2 + pitch_rad ** 2)
+        if not (tilt2 >= 0.0 and rot2 >= 0.0):     # negative variance or NaN: numpy's errors
+            return _channel_sigmas_np(P, var_a, var_g, roll_rad, pitch_rad, load_factor)
+        return _channel_sigmas_k(P, True, float(tilt2), float(rot2), 2.0)
+    return _channel_sigmas_k(P, False, 0.0, 0.0, 2.0)
+
+
+def _channel_sigmas_np(P, var_a, var_g, roll_rad, pitch_rad, load_factor) -> np.ndarray:
+    """:func:`channel_sigmas` in numpy (inputs the compiled kernel does not take)."""
     d = np.sqrt(np.maximum(P.diagonal()[:9], 0.0))
     d[6] = d[7] = max(d[6], d[7])
-    var_a, var_g = unmodelled_var
     if var_a > 0.0 or var_g > 0.0:
         rot2 = var_g * (roll_rad ** 2 + pitch_rad ** 2)
         d[6:8] = np.sqrt(d[6:8] ** 2 + var_a * load_factor ** 2 + rot2)
         d[8] = math.sqrt(d[8] ** 2 + rot2)
+    return d
+
+
+@njit(cache=True)
+def _channel_sigmas_k(P, extra, tilt2, rot2, two):
+    """:func:`channel_sigmas` compiled, operation for operation: ``d ** two`` with ``two`` = 2.0
+    passed at run time is libm pow, as numpy's scalar ``d[8] ** 2`` (a literal exponent would
+    compile to d * d, which differs from pow in the last bit for ~1 in 1,000 values)."""
+    d = np.empty(9)
+    for i in range(9):
+        p = P[i, i]
+        d[i] = np.sqrt(p if (p > 0.0 or p != p) else 0.0)       # np.maximum(p, 0.0)
+    m = d[7] if d[7] > d[6] else d[6]                             # Python's max(d6, d7)
+    if extra:
+        m = np.sqrt(m * m + tilt2 + rot2)
+        d[8] = np.sqrt(d[8] ** two + rot2)
+    d[6] = m
+    d[7] = m
     return d
 
 
@@ -168,10 +213,11 @@ def unmodelled_variances(imu) -> tuple[float, float]:
 def channel_mask(vertical_frozen: bool) -> np.ndarray:
     """(9,) bool: the comparison channels in use — all, or all but the vertical ones when the
     vertical channel is frozen (seed 001: no altitude → the vertical channel is excluded)."""
-    m = np.ones(9, bool)
-    if vertical_frozen:
-        m[list(VERTICAL_CHANNELS)] = False
-    return m
+    return (_MASK_VERTICAL if vertical_frozen else _ALL9).copy()
+
+
+_MASK_VERTICAL = np.ones(9, bool)
+_MASK_VERTICAL[list(VERTICAL_CHANNELS)] = False
 
 
 def pair_flags(y: np.ndarray, sig: np.ndarray, k: float,
@@ -190,6 +236,17 @@ def pair_flags(y: np.ndarray, sig: np.ndarray, k: float,
     (3,) int, 0 for a pair with a unit beyond ``n``
     """
     y, sig = np.asarray(y, float), np.asarray(sig, float)
+    m = _ALL9 if mask is None else np.asarray(mask, bool)
+    if y.ndim == 2 and y.shape[1] == 9 and sig.shape == y.shape and m.shape == (9,):
+        bits = _flags_rows(y, sig, m, float(k))
+        if bits >= 0:
+            return np.array(_BITS[bits])
+    return _pair_flags_np(y, sig, k, mask)
+
+
+def _pair_flags_np(y, sig, k, mask) -> np.ndarray:
+    """:func:`pair_flags` in numpy (any shape; math.remainder's error on an infinite heading)."""
+    y, sig = np.asarray(y, float), np.asarray(sig, float)
     m = np.ones(y.shape[1], bool) if mask is None else np.asarray(mask, bool)
     out = np.zeros(3, int)
     for k_, (a, b) in enumerate(PAIRS):
@@ -197,6 +254,91 @@ def pair_flags(y: np.ndarray, sig: np.ndarray, k: float,
             d = _diff(y[a], y[b])
             out[k_] = int((np.abs(d) > k * np.sqrt(sig[a] ** 2 + sig[b] ** 2))[m].any())
     return out
+
+
+def _unit_flag_bits(y, sig, k: float, mask) -> int:
+    """:func:`pair_flags` of a list of 2 or 3 (9,) vectors as bits (bit k: pair k), without
+    stacking them; other inputs go through :func:`pair_flags`."""
+    n = len(y)
+    m = _ALL9 if mask is None else mask
+    if ((n == 3 or n == 2) and len(sig) == n and type(m) is np.ndarray
+            and m.dtype == np.bool_ and m.shape == (9,)):
+        y0, y1, y2 = (y[0], y[1], y[2]) if n == 3 else (y[0], y[1], y[1])
+        s0, s1, s2 = (sig[0], sig[1], sig[2]) if n == 3 else (sig[0], sig[1], sig[1])
+        if (_vec9(y0) and _vec9(y1) and _vec9(y2) and _vec9(s0) and _vec9(s1)
+                and _vec9(s2)):
+            bits = _flags_units(y0, y1, y2, s0, s1, s2, m, float(k), n)
+            if bits >= 0:
+                return bits
+    f = pair_flags(np.array(y), np.array(sig), k, mask)
+    return int(f[0]) | int(f[1]) << 1 | int(f[2]) << 2
+
+
+def _vec9(a) -> bool:
+    """A float64 vector of the 9 comparison channels (what the compiled pair test takes)."""
+    return type(a) is np.ndarray and a.dtype == _F8 and a.shape == (9,)
+
+
+@njit(cache=True)
+def _remainder_2pi(x):
+    """math.remainder(x, 2π) of a finite x, CPython's exact algorithm (fmod, then the nearer
+    multiple, ties to even)."""
+    absx = abs(x)
+    m = np.fmod(absx, _TWO_PI)
+    c = _TWO_PI - m
+    if m < c:
+        r = m
+    elif m > c:
+        r = -c
+    else:
+        r = m - 2.0 * np.fmod(0.5 * (absx - m), _TWO_PI)
+    return math.copysign(1.0, x) * r
+
+
+@njit(cache=True)
+def _pair_bad(ya, yb, sa, sb, mask, k):
+    """1 when some channel in ``mask`` of ya - yb (heading wrapped) exceeds
+    k √(sa² + sb²), else 0; -1 for an infinite heading difference (math.remainder raises)."""
+    d8 = ya[8] - yb[8]
+    if np.isinf(d8):
+        return -1
+    d8 = _remainder_2pi(d8)
+    for c in range(9):
+        d = d8 if c == 8 else ya[c] - yb[c]
+        if mask[c] and abs(d) > k * np.sqrt(sa[c] * sa[c] + sb[c] * sb[c]):
+            return 1
+    return 0
+
+
+@njit(cache=True)
+def _flags_units(y0, y1, y2, s0, s1, s2, mask, k, n):
+    """Bits of :func:`pair_flags` for units given one by one (n = 2: units 1 and 2 only)."""
+    r = _pair_bad(y0, y1, s0, s1, mask, k)
+    if r < 0 or n < 3:
+        return r
+    r2 = _pair_bad(y0, y2, s0, s2, mask, k)
+    if r2 < 0:
+        return r2
+    r3 = _pair_bad(y1, y2, s1, s2, mask, k)
+    if r3 < 0:
+        return r3
+    return r | r2 << 1 | r3 << 2
+
+
+@njit(cache=True)
+def _flags_rows(y, sig, mask, k):
+    """Bits of :func:`pair_flags` for (n, 9) arrays."""
+    n = y.shape[0]
+    bits = 0
+    for p in range(3):
+        a = 0 if p < 2 else 1
+        b = 1 if p == 0 else 2
+        if b < n:
+            r = _pair_bad(y[a], y[b], sig[a], sig[b], mask, k)
+            if r < 0:
+                return r
+            bits |= r << p
+    return bits
 
 
 def majority(nu) -> int | None:
@@ -269,13 +411,23 @@ class TwoStageFdi:
     Parameters
     ----------
     n_units : number of INS units;  tuning : thresholds
+
+    Attributes
+    ----------
+    state : :class:`FdiState`;  nu : (ν12, ν13, ν23) of the last :meth:`update`
+    flags : (ν12, ν13, ν23) of the last output comparison at that instant, over all units,
+        without persistence (:func:`pair_flags`): pass it to :meth:`vote` on the same inputs
+        instead of comparing again
     """
 
     def __init__(self, n_units: int, tuning: FdiTuning = FdiTuning()):
         self.n, self.tuning = n_units, tuning
         self.state = FdiState([True] * n_units, nis=[[] for _ in range(n_units)])
         self.nu = (0, 0, 0)
+        self.flags = (0, 0, 0)
+        self._bits = 0                                        # self.flags as bits
         self._suspect: tuple[int, float] | None = None        # (unit, since t_s)
+        self._isf: dict = {}                                  # (alpha, dof) → χ² quantile
 
     def add_innovation(self, i: int, t_s: float, nis: float, dim: int) -> None:
         """Record unit i's GNSS innovation statistic (NIS of a group of dimension ``dim``)."""
@@ -288,23 +440,31 @@ class TwoStageFdi:
         if not buf:
             return False
         total, dof = sum(b[1] for b in buf), sum(b[2] for b in buf)
-        return total > chi2.isf(self.tuning.alpha, dof)
+        key = (self.tuning.alpha, dof)
+        q = self._isf.get(key)
+        if q is None:
+            q = self._isf[key] = chi2.isf(self.tuning.alpha, dof)
+        return total > q
 
     def pairwise(self, t_s: float, y: list[np.ndarray], sig: list[np.ndarray],
                  mask: np.ndarray | None = None) -> tuple:
         """Stage 1: (ν12, ν13, ν23) with persistence (pairs with a unit out of use read 0) over
-        the channels in ``mask`` (:func:`channel_mask`)."""
+        the channels in ``mask`` (:func:`channel_mask`); sets :attr:`flags`."""
+        bits = _unit_flag_bits(y, sig, self.tuning.k_pair, mask)
+        self._bits, self.flags = bits, _BITS[bits]
+        used, since = self.state.used, self.state.since
+        if bits == 0 and not since:            # nothing flagged and no timer to reset
+            return (0, 0, 0)
         out = []
-        flags = pair_flags(np.array(y), np.array(sig), self.tuning.k_pair, mask)
         for k, (a, b) in enumerate(PAIRS):
-            if b >= self.n or not (self.state.used[a] and self.state.used[b]):
+            if b >= self.n or not (used[a] and used[b]):
                 out.append(0)
                 continue
-            if flags[k]:
-                t0 = self.state.since.setdefault((a, b), t_s)
+            if bits >> k & 1:
+                t0 = since.setdefault((a, b), t_s)
                 out.append(int(t_s - t0 >= self.tuning.persist_s - 1e-9))
             else:
-                self.state.since.pop((a, b), None)
+                since.pop((a, b), None)
                 out.append(0)
         return tuple(out)
 
@@ -324,8 +484,11 @@ class TwoStageFdi:
         (detected, isolated, excluded, reconfigured) and update :attr:`state.used`."""
         events: list[dict] = []
         nu_out = self.pairwise(t_s, y, sig, mask)
-        nu = tuple(int(a or (b and self._pair_live(k))) for k, (a, b) in
-                   enumerate(zip(nu_out, nu_sensor)))
+        if type(nu_sensor) is tuple and nu_sensor == (0, 0, 0):
+            nu = nu_out                      # what the expression below gives for no flags
+        else:
+            nu = tuple(int(a or (b and self._pair_live(k))) for k, (a, b) in
+                       enumerate(zip(nu_out, nu_sensor)))
         if any(nu) and not any(self.nu):
             where = "outputs" if any(nu_out) else "sensors"
             events.append({"t_s": round(t_s, 3), "unit": "ins", "kind": "detected",
@@ -373,32 +536,21 @@ class TwoStageFdi:
                  "stage": "estimator", "reason": "output from " + (", ".join(left) or "none")}]
 
     def vote(self, y: list[np.ndarray], sig: list[np.ndarray],
-             mask: np.ndarray | None = None) -> list[int]:
+             mask: np.ndarray | None = None, flags=None) -> list[int]:
         """Majority voting: the units the majority table of this instant's output comparison
-        (all units, no persistence, no sensor level, no estimator) does not flag."""
+        (all units, no persistence, no sensor level, no estimator) does not flag.
+
+        ``flags``: that comparison's (ν12, ν13, ν23) (:func:`pair_flags` of ``y``, ``sig``,
+        ``mask``) when already made — :attr:`flags` after :meth:`update` on the same inputs;
+        None: compared here."""
         if self.n != 3:
             return list(range(self.n))
-        bad = majority(pair_flags(np.array(y), np.array(sig), self.tuning.k_pair, mask))
+        if flags is None:
+            return list(_VOTE[_unit_flag_bits(y, sig, self.tuning.k_pair, mask)])
+        if flags is self.flags:
+            return list(_VOTE[self._bits])
+        bad = majority(flags)
         return [i for i in range(self.n) if i != bad]
-
-
-class _Ring:
-    """Running sum over the last ``n`` samples of arrays of one shape."""
-
-    def __init__(self, n: int, shape: tuple):
-        self.buf = np.zeros((n,) + shape)
-        self.sum = np.zeros(shape)
-        self.i = self.count = 0
-
-    def push(self, v: np.ndarray) -> None:
-        n = self.buf.shape[0]
-        if self.count == n:
-            self.sum -= self.buf[self.i]
-        else:
-            self.count += 1
-        self.buf[self.i] = v
-        self.sum += v
-        self.i = (self.i + 1) % n
 
 
 class SensorComparator:
@@ -433,41 +585,93 @@ class SensorComparator:
         self.var = (q[ia] + q[ib]) / dt_s                              # (pairs, 6)
         self.sf = np.repeat(sf[ia] + sf[ib], 3, axis=1)                # (pairs, 6)
         self.n_short, self.n_long = [], []
-        self.d_short, self.d_long, self.u_short, self.u_long = [], [], [], []
+        # four running-sum rings (accel short, accel long, gyro short, gyro long) of rows
+        # [pair differences (pairs × 3), u (3)], one after the other in one buffer; per ring
+        # (first row, rows, next row, count)
+        self._width = 3 * len(self.pairs) + 3
+        rings = []
         for w in (tuning.accel_window_s, tuning.gyro_window_s):        # group 0 accel, 1 gyro
             ns = max(1, int(round(w / dt_s)))
             nl = ns + max(1, int(round(tuning.reference_s / dt_s)))
             self.n_short.append(ns)
             self.n_long.append(nl)
-            self.d_short.append(_Ring(ns, (len(self.pairs), 3)))
-            self.d_long.append(_Ring(nl, (len(self.pairs), 3)))
-            self.u_short.append(_Ring(ns, (3,)))
-            self.u_long.append(_Ring(nl, (3,)))
+            rings += [ns, nl]
+        self._ring = np.zeros((4, 4), np.int64)
+        self._ring[:, 0] = np.cumsum([0] + rings[:3])
+        self._ring[:, 1] = rings
+        self._buf = np.zeros((sum(rings), self._width))
+        self._sum = np.zeros((4, self._width))
+        self._ia, self._ib = np.array(ia, np.int64), np.array(ib, np.int64)
+        self._rows = max(ib, default=-1) + 1                         # rows errs must have
+        self._out = tuple(tuple(int(bits >> self.pairs.index(p) & 1) if p in self.pairs else 0
+                                for p in PAIRS) for bits in range(1 << len(self.pairs)))
         self.last_z = np.zeros((len(self.pairs), 6))
 
     def update(self, t_s: float, errs: np.ndarray, f_mps2, w_rps) -> tuple:
         """Add the units' raw-output errors (n, 6) at ``t_s`` (s) with the measured specific
         force (3,) m/s² and rate (3,) rad/s; return (ν12, ν13, ν23)."""
-        d = errs[self.ia] - errs[self.ib]
-        bad = np.zeros(len(self.pairs), bool)
-        for g, u in enumerate((np.asarray(f_mps2, float), np.asarray(w_rps, float))):
-            cols = slice(3 * g, 3 * g + 3)
-            ds, dl, us, ul = self.d_short[g], self.d_long[g], self.u_short[g], self.u_long[g]
-            ds.push(d[:, cols])
-            dl.push(d[:, cols])
-            us.push(u)
-            ul.push(u)
-            if dl.count < self.n_long[g]:
-                continue
-            ns, nr = self.n_short[g], self.n_long[g] - self.n_short[g]
-            delta = ds.sum / ns - (dl.sum - ds.sum) / nr
-            du = us.sum / ns - (ul.sum - us.sum) / nr
-            var = self.var[:, cols] * (1.0 / ns + 1.0 / nr) + self.sf[:, cols] * float(du @ du)
-            z = delta / np.sqrt(var)
-            self.last_z[:, cols] = z
-            bad |= (np.abs(z) > self.tuning.k_sensor).any(axis=1)
-        out = dict(zip(self.pairs, bad.astype(int).tolist()))
-        return tuple(out.get(p, 0) for p in PAIRS)
+        errs = np.asarray(errs)
+        if errs.ndim != 2 or errs.shape[0] < self._rows or errs.shape[1] < 6:
+            raise ValueError(f"sensor errors of shape {errs.shape}, not ({self.n}, 6)")
+        f0, f1, f2 = f_mps2
+        w0, w1, w2 = w_rps
+        bits = _comparator_step(errs, self._ia, self._ib, float(f0), float(f1),
+                                float(f2), float(w0), float(w1), float(w2), self._buf,
+                                self._sum, self._ring, self.var, self.sf,
+                                float(self.tuning.k_sensor), self.last_z)
+        return self._out[bits]
+
+
+@njit(cache=True, error_model="numpy")
+def _comparator_step(errs, ia, ib, f0, f1, f2, w0, w1, w2, buf, sums, ring, var, sf, k,
+                     last_z):
+    """One :meth:`SensorComparator.update`: push the pair differences and u into the four
+    rings, then the step test of each group whose long ring is full; returns the flagged pairs
+    as bits. Element for element the same operations, in the same order, as numpy on whole
+    rows: sum - oldest + newest, Δ = S_s/N_s - (S_l - S_s)/N_r, z = Δ / √var."""
+    n_p = ia.size
+    width = 3 * n_p + 3
+    v = np.empty(width)
+    bits = 0
+    for g in range(2):
+        for p in range(n_p):
+            for ax in range(3):
+                v[3 * p + ax] = errs[ia[p], 3 * g + ax] - errs[ib[p], 3 * g + ax]
+        if g == 0:
+            v[3 * n_p], v[3 * n_p + 1], v[3 * n_p + 2] = f0, f1, f2
+        else:
+            v[3 * n_p], v[3 * n_p + 1], v[3 * n_p + 2] = w0, w1, w2
+        for r in (2 * g, 2 * g + 1):
+            row = ring[r, 0] + ring[r, 2]
+            full = ring[r, 3] == ring[r, 1]
+            for c in range(width):
+                if full:
+                    sums[r, c] -= buf[row, c]
+                buf[row, c] = v[c]
+                sums[r, c] += v[c]
+            if not full:
+                ring[r, 3] += 1
+            ring[r, 2] = (ring[r, 2] + 1) % ring[r, 1]
+        rs, rl = 2 * g, 2 * g + 1
+        if ring[rl, 3] < ring[rl, 1]:
+            continue
+        ns = ring[rs, 1]
+        nr = ring[rl, 1] - ns
+        du2 = 0.0
+        for ax in range(3):
+            c = 3 * n_p + ax
+            du = sums[rs, c] / ns - (sums[rl, c] - sums[rs, c]) / nr
+            du2 = du2 + du * du if ax else du * du               # float(du @ du)
+        wsum = 1.0 / ns + 1.0 / nr
+        for p in range(n_p):
+            for ax in range(3):
+                c = 3 * p + ax
+                delta = sums[rs, c] / ns - (sums[rl, c] - sums[rs, c]) / nr
+                z = delta / np.sqrt(var[p, 3 * g + ax] * wsum + sf[p, 3 * g + ax] * du2)
+                last_z[p, 3 * g + ax] = z
+                if abs(z) > k:
+                    bits |= 1 << p
+    return bits
 
 
 class FaultTolerantEstimator:

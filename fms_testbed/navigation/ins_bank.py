@@ -19,7 +19,7 @@ import numpy as np
 from numba import njit
 
 from fms_testbed.core.state import AircraftState, NavSolution
-from fms_testbed.navigation.sins import SinsNavigation
+from fms_testbed.navigation.sins import SinsNavigation, output_solution, outputs
 from fms_testbed.sensors.sins.analysis import SinsOptions
 from fms_testbed.sensors.sins.presets import ImuModel
 
@@ -28,6 +28,15 @@ from fms_testbed.sensors.sins.presets import ImuModel
 def _advance(phi, x, L, noise):
     """x_k = Φ x_{k-1} + S N_k (paper eq. 6.11), the same expression as the SINS kernel's."""
     return phi @ x + L @ noise
+
+
+@njit(cache=True)
+def _advance_many(phi, X, L, N):
+    """:func:`_advance` for k units sharing (Φ, S): X (k, 33), N (k, 33) their noise."""
+    out = np.empty_like(X)
+    for i in range(X.shape[0]):
+        out[i] = phi @ X[i] + L @ N[i]
+    return out
 
 
 @njit(cache=True)
@@ -57,6 +66,10 @@ def derive_seeds(seed: int, n: int) -> list[int]:
     return [int(c.generate_state(1)[0]) for c in np.random.SeedSequence(int(seed)).spawn(n)]
 
 
+_NOISE_BLOCK = 100
+"""Steps of raw-sensor white noise drawn at once."""
+
+
 class InsBank:
     """INS units with independent error realisations.
 
@@ -68,39 +81,82 @@ class InsBank:
     share : units with the same IMU model object share one step's (Φ_k, S_k): every unit's
         error model is built at the same true state, so the matrices are the same numbers;
         only x_k = Φ x + S N_k (own noise N_k) is per unit (False: each unit rebuilds them)
+    matrices_dt_s, matrices_rotation_deg : each unit reuses its (Φ_k, S_k) this long (s) while
+        the body turns less than this (deg) (:class:`~.sins.SinsNavigation`; 0: every step)
     """
 
     def __init__(self, imus: list[ImuModel], seeds: list[int], method: str = "picard",
-                 share: bool = True):
+                 share: bool = True, matrices_dt_s: float = 0.0,
+                 matrices_rotation_deg: float = 1e9):
         if len(imus) != len(seeds):
             raise ValueError("one seed per INS unit")
         opts = SinsOptions(method=method, vertical="free")
-        self.units = [SinsNavigation(imu, seed=s, opts=opts) for imu, s in zip(imus, seeds)]
+        self.units = [SinsNavigation(imu, seed=s, opts=opts, matrices_dt_s=matrices_dt_s,
+                                     matrices_rotation_deg=matrices_rotation_deg)
+                      for imu, s in zip(imus, seeds)]
         self.stuck: dict[int, NavSolution] = {}          # unit → its frozen output
         self.compensation = np.zeros((len(self.units), 6))  # bias compensation fed back so far
         self.fed_back = np.zeros((len(self.units), 15))      # corrections since take_fed_back
         self._rng = np.random.default_rng(np.random.SeedSequence(seeds).spawn(1)[0])
         self.share = bool(share)
+        # sensor noise drawn _NOISE_BLOCK steps at a time (numpy's Generator fills a block in
+        # the order of successive draws: the numbers of one draw per step)
+        self._noise = np.empty((0, len(self.units), 6))
+        self._noise_i = 0
+        self._sd: tuple | None = None      # (dt_s, white σ per sample, the IMU models)
 
     def __len__(self) -> int:
         return len(self.units)
 
+    def _advance_held(self, truth: AircraftState) -> bool:
+        """Advance every unit in one compiled call when they all reuse the same held (Φ_k, S_k)
+        over this step (the shared discretisation, held in straight flight); False (nothing
+        done) otherwise."""
+        u0 = self.units[0]
+        prev = u0._prev
+        if not self.share or prev is None or u0._held is None:
+            return False
+        dt = truth.t_s - prev.t_s
+        if dt <= 0:
+            return False
+        held, turned = u0.held_for(prev, dt)
+        if held is None or any(u._prev is not prev or u._held is not held
+                               for u in self.units[1:]):
+            return False
+        X = _advance_many(held[2], np.array([u.x for u in self.units]), held[3],
+                          np.array([u._next_noise() for u in self.units]))
+        for i, u in enumerate(self.units):
+            u.x = X[i]
+            u._turned_rad = turned          # the same rates: the same rotation for every unit
+            u._prev = truth
+        return True
+
     def update(self, truth: AircraftState) -> list[NavSolution]:
         """Advance every unit to ``truth.t_s`` and return their outputs (indicated solutions); a
         stuck unit repeats its frozen output (time stamp advancing)."""
+        if self._advance_held(truth):
+            O = outputs(np.array([u.x[:9] for u in self.units]), truth)
+            out = [output_solution(truth.t_s, o) for o in O]
+            for i, held in self.stuck.items():
+                out[i] = replace(held, t_s=truth.t_s)
+            return out
         out = []
         lead = None                          # a unit that just built this step's matrices
         for u in self.units:
             prev = u._prev
             lm = lead.last_matrices if lead is not None else None
             if (lm is not None and prev is lm[0] and u.imu is lead.imu and u.opts == lead.opts
-                    and u.matrices_dt_s == 0 and truth.t_s - prev.t_s == lm[1]):
+                    and u.matrices_dt_s == lead.matrices_dt_s
+                    and u.matrices_rotation_rad == lead.matrices_rotation_rad
+                    and truth.t_s - prev.t_s == lm[1]):
                 u.x = _advance(lm[2], u.x, lm[3], u._next_noise())
                 u._gains = lead._gains
+                u._held, u._turned_rad = lead._held, lead._turned_rad   # hold them alike
                 u._prev = truth
-                out.append(u.solution(truth))
+                out.append(u.solution(truth, errors=False))
                 continue
-            out.append(u.update(truth))
+            u.advance(truth)
+            out.append(u.solution(truth, errors=False))
             lm = u.last_matrices
             lead = u if (self.share and prev is not None and lm is not None and lm[0] is prev
                          ) else None
@@ -112,7 +168,7 @@ class InsBank:
         """Unit ``i``'s current output at ``truth`` (after a correction)."""
         if i in self.stuck:
             return replace(self.stuck[i], t_s=truth.t_s)
-        return self.units[i].solution(truth)
+        return self.units[i].solution(truth, errors=False)
 
     def correct(self, i: int, dx: np.ndarray) -> None:
         """Feed back a filter estimate: subtract ``dx`` (15,: δp m, δV m/s, ε rad, b_a m/s²,
@@ -141,8 +197,17 @@ class InsBank:
         n = len(self.units)
         # the sensor's bias is the error state's residual plus the compensation fed back
         X = np.array([u.x for u in self.units])
-        sd = np.array([np.sqrt(u.imu.q_psd[3:9] / dt_s) for u in self.units])
-        return _sensor_errors(X, self.compensation, f, w, sd, self._rng.standard_normal((n, 6)))
+        imus = [u.imu for u in self.units]       # a drift_scale fault replaces a model
+        if (self._sd is None or abs(self._sd[0] - dt_s) > 1e-9 * dt_s
+                or any(a is not b for a, b in zip(self._sd[2], imus))):
+            self._sd = (dt_s, np.array([np.sqrt(u.imu.q_psd[3:9] / dt_s) for u in self.units]),
+                        imus)
+        if self._noise_i >= len(self._noise):
+            self._noise = self._rng.standard_normal((_NOISE_BLOCK, n, 6))
+            self._noise_i = 0
+        noise = self._noise[self._noise_i]
+        self._noise_i += 1
+        return _sensor_errors(X, self.compensation, f, w, self._sd[1], noise)
 
     def freeze(self, i: int, last: NavSolution) -> None:
         """Unit ``i``'s output sticks at ``last`` from now on (a stuck-output fault)."""

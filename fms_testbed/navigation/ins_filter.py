@@ -46,7 +46,7 @@ from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.navigation.fdi import unmodelled_variances
-from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed, innovation,
+from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed,
                                           predict)
 from fms_testbed.navigation.sins import _c_bn
 from fms_testbed.sensors.baro import BaroReading, BaroSpec
@@ -78,11 +78,19 @@ class FilterTuning:
     unmodelled_tau_s : correlation time τ_u of the process noise standing in for the scale
         factors and misalignments the filter does not carry, s
     method : discretisation, ``picard`` or ``vanloan``
+    predict_interval_s : longest interval the covariance is propagated over at once, s
+        (:class:`PredictionInterval`; a measurement or a GNSS epoch ends an interval earlier;
+        0: every navigation step)
+    predict_rotation_deg : an interval also ends once the body has turned this much in it
+        (∫|ω| dt, deg): F follows the attitude, and a held F̄ misses the commutator terms of a
+        rotating F (2 % of the gyro-bias → velocity block of Φ over 0.9 s of a 3 °/s turn)
     """
 
     gate_sigma: float = 5.0
     unmodelled_tau_s: float = 20.0
     method: str = "picard"
+    predict_interval_s: float = 1.0
+    predict_rotation_deg: float = 1.0
 
     def __post_init__(self):
         if not self.gate_sigma > 0:
@@ -91,6 +99,10 @@ class FilterTuning:
             raise ConfigError("navigation.filter.unmodelled_tau_s: must be >= 0 s")
         if self.method not in ("picard", "vanloan"):
             raise ConfigError("navigation.filter.method: picard or vanloan")
+        if not 0 <= self.predict_interval_s <= 10:
+            raise ConfigError("navigation.filter.predict_interval_s: must be in [0, 10] s")
+        if not self.predict_rotation_deg > 0:
+            raise ConfigError("navigation.filter.predict_rotation_deg: must be > 0 deg")
 
 
 @dataclass(frozen=True)
@@ -126,20 +138,26 @@ def _predict_step(x, P, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol)
 
 
 @njit(cache=True)
-def _filter_phi_q(n, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol):
-    """(Φ, Q_k, status) of the filter's n-state model over ``dt`` at the given state (see
-    :func:`_predict_step`; status 0 ok, 1 Picard range, 2 no convergence; F returned twice when
-    status != 0)."""
+def _filter_F(n, lat, alt, v, rpy, w_eb, f_b, decay24, decay):
+    """F (n×n) of the filter's model at one state: the 33-state model's INS block (free
+    vertical) and the GNSS/baro states' decay."""
     c = _c_bn(rpy[0], rpy[1], rpy[2])
     w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(lat), OMEGA_IE_RPS * math.sin(lat)])
     w_ib = w_eb + c.T @ w_ie
     F33 = build_F(lat, alt, v, f_b, w_ib, c, decay24, 0.0, 0.0)
     F = np.zeros((n, n))
     F[:15, :15] = F33[:15, :15]
+    for i in range(15, n):
+        F[i, i] = -decay[i]
+    return F
+
+
+@njit(cache=True)
+def _phi_q_of(F, q, dt, tol):
+    """(Φ, Q_k, status) of a held F over ``dt`` by the Picard series (status 0 ok, 1 Δt/τ
+    beyond the Picard range, 2 no convergence; F returned twice when status != 0)."""
     rate = 0.0
-    for i in range(n):
-        if i >= 15:
-            F[i, i] = -decay[i]
+    for i in range(F.shape[0]):
         rate = max(rate, abs(F[i, i]))
     if rate * dt > PICARD_MAX_RATE_DT:
         return F, F, 1
@@ -150,58 +168,190 @@ def _filter_phi_q(n, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol):
 
 
 @njit(cache=True)
-def _predict_many(X, P, lat, alt, V, RPY, w_eb, f_b, decay24, decay, q, dt, tol):
-    """:func:`_predict_step` for k filters of one IMU model at once (one call instead of k):
-    X (k, n), P (k, n, n), lat/alt (k,), V/RPY (k, 3) their INS outputs; the same arithmetic per
-    filter, so the same numbers. Returns (X, P, Φ (k, n, n), Q_k (k, n, n), status (k,))."""
-    k, n = X.shape
+def _filter_phi_q(n, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol):
+    """(Φ, Q_k, status) of the filter's n-state model over ``dt`` at the given state (see
+    :func:`_predict_step`; status 0 ok, 1 Picard range, 2 no convergence; F returned twice when
+    status != 0)."""
+    return _phi_q_of(_filter_F(n, lat, alt, v, rpy, w_eb, f_b, decay24, decay), q, dt, tol)
+
+
+@njit(cache=True)
+def _predict_trapezoid(X, P, F0, F1, q_bar, dt, tol):
+    """Prediction of k filters over ``dt`` with one F̄ = (F0 + F1)/2 ((n, n) each, F at the
+    interval's start and end) and the interval-mean process-noise density q̄ (n,): Picard →
+    Φ x, Φ P Φᵀ + Q_k for each. Returns (X, P, Φ, Q_k, status)."""
+    phi, qk, st = _phi_q_of(0.5 * (F0 + F1), q_bar, dt, tol)
+    if st:
+        return X, P, phi, qk, st
     Xn, Pn = np.empty_like(X), np.empty_like(P)
-    phis, qks = np.empty_like(P), np.empty_like(P)
-    status = np.zeros(k, np.int64)
-    for i in range(k):
-        x, Pi, phi, qk, st = _predict_step(X[i], P[i], lat[i], alt[i], V[i], RPY[i], w_eb, f_b,
-                                           decay24, decay, q, dt, tol)
-        status[i] = st
-        if st == 0:
-            Xn[i], Pn[i], phis[i], qks[i] = x, Pi, phi, qk
-    return Xn, Pn, phis, qks, status
+    for i in range(X.shape[0]):
+        x, Pi = predict(X[i], P[i], phi, qk)
+        Xn[i], Pn[i] = x, Pi
+    return Xn, Pn, phi, qk, 0
 
 
-def predict_filters(filters: list["InsGnssFilter"], ins: list[NavSolution],
-                    truth: AircraftState, dt_s: float) -> None:
-    """``filters[i].predict(ins[i], truth, dt_s)`` for every filter, in one compiled call when
-    they share one IMU model, receiver, baro and tuning with the Picard method (the process noise
-    of the step, which depends only on the truth and the IMU model, is computed once); the same
-    numbers as the per-filter calls.
+def mean_state(ins: list[NavSolution]) -> tuple[float, float, np.ndarray, np.ndarray]:
+    """(lat rad, alt m, V (3,) m/s, [roll, pitch, heading] rad): the mean of INS outputs
+    (circular mean of heading) — where a group of filters builds its one F."""
+    n = len(ins)
+    if n == 1:
+        s = ins[0]
+        return s.lat_rad, s.alt_m, np.asarray(s.v_enu_mps, float), np.array(
+            [s.roll_rad, s.pitch_rad, s.heading_rad])
+    lat = alt = roll = pitch = sh = ch = 0.0
+    v = np.zeros(3)
+    for s in ins:
+        lat += s.lat_rad
+        alt += s.alt_m
+        v += s.v_enu_mps
+        roll += s.roll_rad
+        pitch += s.pitch_rad
+        sh += math.sin(s.heading_rad)
+        ch += math.cos(s.heading_rad)
+    return lat / n, alt / n, v / n, np.array([roll / n, pitch / n, math.atan2(sh, ch)])
 
-    Raises
-    ------
-    DiscretisationError : as :meth:`InsGnssFilter.predict`
+
+@njit(cache=True)
+def _scaled_r(R, sc):
+    """R with its entries scaled by √(sc_i sc_j) (adaptive-R inflation; sc all 1: R itself)."""
+    for v in sc:
+        if v != 1.0:
+            return R * np.sqrt(np.outer(sc, sc))
+    return R
+
+
+@njit(cache=True)
+def _passes(nu, S, gate):
+    """The innovation gate: every |ν_i| ≤ gate √S_ii."""
+    for i in range(nu.size):
+        if not abs(nu[i]) <= gate * math.sqrt(S[i, i]):
+            return False
+    return True
+
+
+@njit(cache=True)
+def _gated_correct(x, P, z, H, R, sc, frozen, gate):
+    """:func:`~.kalman.correct` with R scaled by the adaptive inflation ``sc`` and the
+    innovation gate; returns (x, P, ν, S, NIS, passed) — x, P corrected whether or not it
+    passed (the caller keeps them only if it did)."""
+    xn, Pn, nu, S, nis = correct(x, P, z, H, _scaled_r(R, sc), frozen)
+    return xn, Pn, nu, S, nis, _passes(nu, S, gate)
+
+
+@njit(cache=True)
+def _gated_correct_delayed(x, P, z, H, R, sc, phi_lag, q_lag, frozen, gate):
+    """:func:`_gated_correct` with :func:`~.kalman.correct_delayed`."""
+    xn, Pn, nu, S, nis = correct_delayed(x, P, z, H, _scaled_r(R, sc), phi_lag, q_lag, frozen)
+    return xn, Pn, nu, S, nis, _passes(nu, S, gate)
+
+
+class PredictionInterval:
+    """Multi-rate propagation of a group of filters (one IMU model, receiver, baro, tuning).
+
+    The INS is mechanised at every navigation step, but the filters' covariance is propagated
+    over an *interval* of steps at once (Groves 2013, §14.2.4: the system propagation may run
+    at a lower rate than the INS update, with F averaged over the interval): F and the
+    F is taken at the interval's start and end and averaged (trapezoidal rule, second order in
+    the interval); the process-noise density, whose unmodelled part follows |ω|² and |Δf|² and
+    jumps in a roll, is integrated step by step (each step's value at its start, as the per-step
+    filter) and averaged; Φ, Q_k = Picard(F̄, q̄, Δt) (Babich 2017 eq.
+    2.5-2.9), x ← Φ x, P ← Φ P Φᵀ + Q_k. The end of one interval is the start of the next.
+    Between boundaries P and x are those of the last boundary.
+
+    The group's filters share one F, built at the mean of their units' indicated states: the
+    units differ by metres and milliradians, which changes F's entries by a relative 1e-6..1e-3
+    (Coriolis and specific-force cross products) — the Monte-Carlo engine builds its filters'
+    F at the true state for the same reason (:mod:`.montecarlo`).
+
+    Parameters
+    ----------
+    filters : the group (:func:`can_share_prediction`)
     """
+
+    def __init__(self, filters: list["InsGnssFilter"]):
+        self.filters = filters
+        tn = filters[0].tuning
+        rate = float(np.max(filters[0].decay))      # the fastest decay the series must span
+        self.max_s = (tn.predict_interval_s if rate <= 0 else
+                      min(tn.predict_interval_s, 0.9 * PICARD_MAX_RATE_DT / rate))
+        """Longest interval, s: ``predict_interval_s``, within the Picard range."""
+        self.rotation_max_rad = math.radians(tn.predict_rotation_deg)
+        self.rotation_rad = 0.0     # ∫|ω| dt over the interval so far
+        self.dt_s = 0.0
+        self.t0_s: float | None = None
+        self._F0: np.ndarray | None = None
+        self._w2dt = self._df2dt = 0.0   # ∫|ω|² dt, ∫max(|f|² - 2 g |f_z| + g², 0) dt
+
+    def _F_q(self, ins: list[NavSolution], truth: AircraftState) -> tuple[np.ndarray, np.ndarray]:
+        f0 = self.filters[0]
+        lat, alt, v, rpy = mean_state(ins)
+        F = _filter_F(f0.n, lat, alt, v, rpy, np.array([truth.p_rps, truth.q_rps, truth.r_rps]),
+                      np.asarray(truth.f_body_mps2, float), f0._decay24, f0.decay)
+        return F
+
+    def start(self, ins: list[NavSolution], truth: AircraftState) -> None:
+        """Open the first interval at the INS outputs ``ins`` and the truth of its start."""
+        self._F0 = self._F_q(ins, truth)
+        self.t0_s, self.dt_s = truth.t_s, 0.0
+
+    def add(self, prev: AircraftState, dt_s: float) -> bool:
+        """One more navigation step of ``dt_s`` (s) starting at ``prev`` (its body rate and
+        specific force) in the interval; True when the interval is full (``max_s`` or the
+        rotation limit)."""
+        w2 = prev.p_rps ** 2 + prev.q_rps ** 2 + prev.r_rps ** 2
+        f = prev.f_body_mps2
+        df2 = float(f @ f) - 2.0 * G0_MPS2 * abs(float(f[2])) + G0_MPS2 ** 2
+        self.dt_s += float(dt_s)
+        self.rotation_rad += math.sqrt(w2) * dt_s
+        self._w2dt += w2 * dt_s
+        self._df2dt += max(df2, 0.0) * dt_s
+        return (self.dt_s >= self.max_s - 1e-9
+                or self.rotation_rad >= self.rotation_max_rad - 1e-12)
+
+    def ins_transition(self) -> np.ndarray:
+        """Φ (15×15) of the INS error states from the filters' time (the interval's start) to
+        now: I + A Δt + (A Δt)²/2, A the INS block of F at the start (Δt ≤ the interval; the
+        next term is below 1e-4 of the first for Δt ≤ 1 s). Feedback of an estimate made at the
+        filters' time to the INS of now goes through it."""
+        A = self._F0[:N_INS, :N_INS] * self.dt_s
+        return np.eye(N_INS) + A + 0.5 * (A @ A)
+
+    def flush(self, ins: list[NavSolution], truth: AircraftState) -> None:
+        """Close the interval at the INS outputs ``ins`` and the truth of its end: predict
+        every filter over it and open the next (nothing when it is empty).
+
+        Raises
+        ------
+        DiscretisationError : Picard asked for Δt/τ > 0.1 or did not converge (use vanloan)
+        """
+        if self.dt_s <= 0.0:
+            return
+        F1 = self._F_q(ins, truth)
+        dt = self.dt_s
+        X = np.array([f.x for f in self.filters])
+        P = np.array([f.P for f in self.filters])
+        q_bar = self.filters[0].process_noise_mean(self._df2dt / dt, self._w2dt / dt)
+        X, P, phi, qk, status = _predict_trapezoid(X, P, self._F0, F1, q_bar, dt, 1e-12)
+        if status:
+            raise DiscretisationError(
+                f"navigation.filter: Picard series unsuitable over {dt:g} s (Δt/τ > "
+                f"{PICARD_MAX_RATE_DT} or no convergence); set navigation.filter.method: vanloan"
+                " or a shorter predict_interval_s")
+        for i, f in enumerate(self.filters):
+            f.x, f.P = X[i], P[i]
+            f._record_step(self.t0_s, phi, qk, dt)
+        self._F0 = F1
+        self.t0_s, self.dt_s, self.rotation_rad = truth.t_s, 0.0, 0.0
+        self._w2dt = self._df2dt = 0.0
+
+
+def can_share_prediction(filters: list["InsGnssFilter"]) -> bool:
+    """True when the filters can be propagated together (:class:`PredictionInterval`, one
+    compiled call): one IMU model, receiver, baro and tuning, the Picard method."""
     f0 = filters[0]
-    if (len(filters) == 1 or f0.tuning.method != "picard"
-            or any(f.imu is not f0.imu or f.gnss is not f0.gnss or f.baro is not f0.baro
-                   or f.tuning != f0.tuning for f in filters[1:])):
-        for f, sol in zip(filters, ins):
-            f.predict(sol, truth, dt_s)
-        return
-    lat = np.array([s.lat_rad for s in ins])
-    alt = np.array([s.alt_m for s in ins])
-    V = np.array([s.v_enu_mps for s in ins], float)
-    RPY = np.array([(s.roll_rad, s.pitch_rad, s.heading_rad) for s in ins])
-    X = np.array([f.x for f in filters])
-    P = np.array([f.P for f in filters])
-    X, P, phis, qks, status = _predict_many(
-        X, P, lat, alt, V, RPY, np.array([truth.p_rps, truth.q_rps, truth.r_rps]),
-        np.asarray(truth.f_body_mps2, float), f0._decay24, f0.decay, f0._process_noise(truth),
-        float(dt_s), 1e-12)
-    if status.any():
-        raise DiscretisationError(
-            f"navigation.filter: Picard series unsuitable at dt = {dt_s:g} s (Δt/τ > "
-            f"{PICARD_MAX_RATE_DT} or no convergence); set navigation.filter.method: vanloan")
-    for i, f in enumerate(filters):
-        f.x, f.P = X[i], P[i]
-        f._record_step(ins[i].t_s, phis[i], qks[i], dt_s)
+    return (f0.tuning.method == "picard"
+            and all(f.imu is f0.imu and f.gnss is f0.gnss and f.baro is f0.baro
+                    and f.tuning == f0.tuning for f in filters[1:]))
 
 
 class InsGnssFilter:
@@ -298,14 +448,21 @@ class InsGnssFilter:
         return F
 
     def _process_noise(self, truth: AircraftState) -> np.ndarray:
+        f = np.asarray(truth.f_body_mps2, float)
+        df2 = float(f @ f) - 2.0 * G0_MPS2 * abs(float(f[2])) + G0_MPS2 ** 2
+        w2 = truth.p_rps ** 2 + truth.q_rps ** 2 + truth.r_rps ** 2
+        return self.process_noise_mean(max(df2, 0.0), w2)
+
+    def process_noise_mean(self, df2_mps4: float, w2_rps2: float) -> np.ndarray:
+        """Process-noise density (n,) for a specific-force departure from 1 g of mean square
+        ``df2_mps4`` ((m/s²)²) and a body rate of mean square ``w2_rps2`` ((rad/s)²): the
+        declared densities plus the unmodelled scale-factor/misalignment terms
+        2 σ² |Δf|² τ_u on δV and 2 σ² |ω|² τ_u on ε (module docstring)."""
         q = self.q.copy()
         tau = self.tuning.unmodelled_tau_s
         if tau > 0 and (self._var_acc > 0 or self._var_gyro > 0):
-            f = np.asarray(truth.f_body_mps2, float)
-            df2 = float(f @ f) - 2.0 * G0_MPS2 * abs(float(f[2])) + G0_MPS2 ** 2
-            w2 = truth.p_rps ** 2 + truth.q_rps ** 2 + truth.r_rps ** 2
-            q[VEL] += 2.0 * self._var_acc * max(df2, 0.0) * tau
-            q[ATT] += 2.0 * self._var_gyro * w2 * tau
+            q[VEL] += 2.0 * self._var_acc * df2_mps4 * tau
+            q[ATT] += 2.0 * self._var_gyro * w2_rps2 * tau
         return q
 
     def predict(self, ins: NavSolution, truth: AircraftState, dt_s: float) -> None:
@@ -352,22 +509,18 @@ class InsGnssFilter:
             else self._r_baro
 
     def _group(self, name, z, H, R, lag) -> GroupResult:
-        sc = self.r_scale[name]
-        if (sc != 1.0).any():
-            R = R * np.sqrt(np.outer(sc, sc))
+        # one correction, kept when the innovation passes the gate (the same numbers as
+        # testing the innovation first and correcting after)
         if lag is None:
-            nu, S, nis = innovation(self.x, self.P, z, H, R)
+            x, P, nu, S, nis, used = _gated_correct(self.x, self.P, z, H, R, self.r_scale[name],
+                                                    self._no_freeze, self.tuning.gate_sigma)
         else:
-            _, _, nu, S, nis = correct_delayed(self.x, self.P, z, H, R, lag[0], lag[1],
-                                               self._no_freeze)
-        used = bool(np.all(np.abs(nu) <= self.tuning.gate_sigma * np.sqrt(np.diag(S))))
+            x, P, nu, S, nis, used = _gated_correct_delayed(
+                self.x, self.P, z, H, R, self.r_scale[name], lag[0], lag[1], self._no_freeze,
+                self.tuning.gate_sigma)
         if used:
-            if lag is None:
-                self.x, self.P, _, _, _ = correct(self.x, self.P, z, H, R, self._no_freeze)
-            else:
-                self.x, self.P, _, _, _ = correct_delayed(self.x, self.P, z, H, R, lag[0],
-                                                          lag[1], self._no_freeze)
-        return GroupResult(name, nu, S, nis, used)
+            self.x, self.P = x, P
+        return GroupResult(name, nu, S, nis, bool(used))
 
     def gnss_update(self, fix: GnssFix, ins_at_fix: NavSolution) -> list[GroupResult]:
         """Use a fix (position, then velocity) against the INS output at its time of validity."""
@@ -392,5 +545,5 @@ class InsGnssFilter:
         return dx
 
 
-__all__ = ["FilterTuning", "GroupResult", "InsGnssFilter", "STATE_NAMES", "enu_difference_m",
-           "predict_filters"]
+__all__ = ["FilterTuning", "GroupResult", "InsGnssFilter", "PredictionInterval", "STATE_NAMES",
+           "can_share_prediction", "enu_difference_m"]

@@ -37,11 +37,12 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 from pydantic import ValidationError
 
 from fms_testbed.config.navigation import InsGnssBlock
 from fms_testbed.config.yamlfile import validation_message
-from fms_testbed.core.earth import radii_m
+from fms_testbed.core.earth import radii_and_derivatives, radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import G0_MPS2
@@ -50,14 +51,14 @@ from fms_testbed.navigation.faults import check_fault, inject
 from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
                                         TwoStageFdi,
                                         channel_sigmas, declared_sensor_noise)
-from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter, enu_difference_m,
-                                               predict_filters)
+from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter,
+                                               PredictionInterval, can_share_prediction,
+                                               enu_difference_m)
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
 from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor
 from fms_testbed.sensors.baro import BaroAltimeter, BaroSpec
 from fms_testbed.sensors.gnss import GnssReceiver, GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.analysis import horizontal_radius
-from fms_testbed.sensors.sins.euler import eps_to_euler_errors
 from fms_testbed.sensors.sins.presets import load_imu
 
 _BUFFER_S = 2.0          # INS outputs kept for the GNSS latency, s
@@ -86,31 +87,80 @@ def baro_spec(block) -> BaroSpec | None:
                     math.inf if block.failed_from_s is None else block.failed_from_s)
 
 
+@njit(cache=True)
+def _corrected_many(O, DX):
+    """:func:`corrected` for k units at once, and their comparison vectors.
+
+    O (k, 9): the units' outputs [lat rad, lon rad, alt m, V E N U m/s, roll, pitch, heading
+    rad]; DX (k, 9): their filters' estimated errors [δp ENU m, δV m/s, ε rad]. Returns (C, Y):
+    C (k, 9) the corrected outputs in the layout of O, Y (k, 9) the comparison vectors of
+    seed 001's stage 1 (position ENU m from unit 0's corrected position, velocity, roll, pitch,
+    heading)."""
+    k = O.shape[0]
+    C = np.empty((k, 9))
+    Y = np.empty((k, 9))
+    two_pi = 2.0 * math.pi
+    for i in range(k):
+        lat, h = O[i, 0], O[i, 2]
+        rm, rn, _, _ = radii_and_derivatives(lat)
+        sp, cp = math.sin(O[i, 8]), math.cos(O[i, 8])
+        a = DX[i, 6] * sp + DX[i, 7] * cp
+        d_roll = -a / math.cos(O[i, 7])
+        d_pitch = -DX[i, 6] * cp + DX[i, 7] * sp
+        d_head = DX[i, 8] - math.tan(O[i, 7]) * a
+        C[i, 0] = lat - DX[i, 1] / (rm + h)
+        C[i, 1] = O[i, 1] - DX[i, 0] / ((rn + h) * math.cos(lat))
+        C[i, 2] = h - DX[i, 2]
+        for j in range(3):
+            C[i, 3 + j] = O[i, 3 + j] - DX[i, 3 + j]
+        C[i, 6] = O[i, 6] - d_roll
+        C[i, 7] = O[i, 7] - d_pitch
+        C[i, 8] = (O[i, 8] - d_head) % two_pi
+    for i in range(k):
+        rm, rn, _, _ = radii_and_derivatives(C[i, 0])
+        Y[i, 0] = (C[i, 1] - C[0, 1]) * (rn + C[i, 2]) * math.cos(C[i, 0])
+        Y[i, 1] = (C[i, 0] - C[0, 0]) * (rm + C[i, 2])
+        Y[i, 2] = C[i, 2] - C[0, 2]
+        for j in range(3, 9):
+            Y[i, j] = C[i, j]
+    return C, Y
+
+
 def corrected(sol: NavSolution, dx9: np.ndarray) -> tuple[float, float, float, np.ndarray,
                                                           float, float, float]:
     """(lat rad, lon rad, alt m, V (3,) m/s, roll, pitch, heading rad): an INS output minus an
-    estimated error (δp ENU m, δV m/s, ε rad; Euler errors by paper eq. 6.10)."""
-    rm, rn = radii_m(sol.lat_rad)
-    h = sol.alt_m
-    d_roll, d_pitch, d_head = eps_to_euler_errors(dx9[6], dx9[7], dx9[8], sol.pitch_rad,
-                                                  sol.heading_rad)
-    return (sol.lat_rad - dx9[1] / (rm + h),
-            sol.lon_rad - dx9[0] / ((rn + h) * math.cos(sol.lat_rad)), h - dx9[2],
-            np.asarray(sol.v_enu_mps, float) - dx9[3:6], sol.roll_rad - float(d_roll),
-            sol.pitch_rad - float(d_pitch), (sol.heading_rad - float(d_head)) % (2 * math.pi))
+    estimated error (δp ENU m, δV m/s, ε rad; Euler errors by paper eq. 6.10, the scalar form of
+    :func:`~fms_testbed.sensors.sins.euler.eps_to_euler_errors`) — one unit of
+    :func:`_corrected_many`."""
+    O = np.array([[sol.lat_rad, sol.lon_rad, sol.alt_m, *sol.v_enu_mps, sol.roll_rad,
+                   sol.pitch_rad, sol.heading_rad]])
+    c = _corrected_many(O, np.asarray(dx9, float)[None, :9])[0][0]
+    return c[0], c[1], c[2], c[3:6], c[6], c[7], c[8]
 
 
-def _mean_solution(sols: list[tuple]) -> tuple:
-    """Mean of corrected solutions (lat, lon, alt, V, roll, pitch, heading); circular mean of
-    heading."""
-    if len(sols) == 1:
-        return sols[0]
-    a = list(zip(*sols))
-    hdg = math.atan2(sum(math.sin(h) for h in a[6]), sum(math.cos(h) for h in a[6]))
-    n = len(sols)
-    return (sum(a[0]) / n, sum(a[1]) / n, sum(a[2]) / n, sum(a[3]) / n, sum(a[4]) / n,
-            sum(a[5]) / n,
-            hdg % (2 * math.pi))
+@njit(cache=True)
+def _mean_rows(C, units):
+    """The mean of rows ``units`` of C (k, 9) corrected outputs (:func:`_corrected_many`
+    layout), heading by its circular mean."""
+    m = np.zeros(9)
+    sh = ch = 0.0
+    for i in units:
+        for j in range(8):
+            m[j] += C[i, j]
+        sh += math.sin(C[i, 8])
+        ch += math.cos(C[i, 8])
+    n = units.size
+    for j in range(8):
+        m[j] /= n
+    m[8] = math.atan2(sh, ch) % (2.0 * math.pi)
+    return m
+
+
+def _mean_solution(C: np.ndarray, units: list[int]) -> tuple:
+    """(lat rad, lon rad, alt m, V (3,) m/s, roll, pitch, heading rad): the mean of the corrected
+    outputs ``C`` (k, 9) of ``units`` (circular mean of heading; one unit: its own)."""
+    c = C[units[0]] if len(units) == 1 else _mean_rows(C, np.array(units, np.int64))
+    return c[0], c[1], c[2], c[3:6], c[6], c[7], c[8]
 
 
 class InsGnssNavigation:
@@ -147,6 +197,10 @@ class InsGnssNavigation:
         self._prev_sensor_t: float | None = None
         self.nis_log: list[tuple[float, str, float, int]] = []   # unit 0: (t_s, group, NIS, dim)
         self.fused = True        # one compiled prediction for all filters (False: one per filter)
+        self._anp_key: tuple | None = None
+        self._mean_P_cache: dict[tuple, tuple] = {}
+        self._anp = math.nan
+        self._interval: PredictionInterval | None = None      # built at the first step
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "InsGnssNavigation":
@@ -165,8 +219,11 @@ class InsGnssNavigation:
         sd = b.seed if b.seed is not None else (0 if seed is None else int(seed))
         seeds = derive_seeds(sd, b.n_ins + 2)        # [GNSS, baro, INS 1, INS 2, ...]
         g, br = gnss_spec(b.gnss), baro_spec(b.baro)
-        tuning = FilterTuning(b.filter.gate_sigma, b.filter.unmodelled_tau_s, b.filter.method)
-        bank = InsBank([imu] * b.n_ins, seeds[2:], method=b.filter.method)
+        tuning = FilterTuning(b.filter.gate_sigma, b.filter.unmodelled_tau_s, b.filter.method,
+                              b.filter.predict_interval_s, b.filter.predict_rotation_deg)
+        bank = InsBank([imu] * b.n_ins, seeds[2:], method=b.filter.method,
+                       matrices_dt_s=b.matrices_dt_s,
+                       matrices_rotation_deg=b.matrices_rotation_deg)
         filters = [InsGnssFilter(imu, g, br, tuning) for _ in range(b.n_ins)]
         baro = BaroAltimeter(br, seeds[1]) if br is not None else None
         fdi = TwoStageFdi(b.n_ins) if b.n_ins > 1 else None
@@ -209,27 +266,51 @@ class InsGnssNavigation:
                                     "stage": "innovation_gate", "reason": f"{g.name} accepted again"})
             self._gate_open[i][g.name] = g.used
 
+    def _predict(self, prev: AircraftState, truth: AircraftState, ins: list[NavSolution],
+                 boundary: bool) -> None:
+        """Propagate the filters over the step from ``prev`` to ``truth`` (``ins``: the INS
+        outputs at its end): added to the current interval
+        (:class:`~.ins_filter.PredictionInterval`), which is discretised and applied when
+        ``boundary`` (a measurement now, or a GNSS epoch: the delayed correction needs a step
+        boundary at a fix's time of validity) or when it has reached
+        ``filter.predict_interval_s``; every step and one filter at a time (F at the step's
+        start) when they cannot share the call or ``fused`` is off (the reference path)."""
+        dt_s = truth.t_s - prev.t_s
+        if not self.fused or not can_share_prediction(self.filters):
+            for i, f in enumerate(self.filters):
+                f.predict(self._prev_ins[i], prev, dt_s)
+            return
+        iv = self._interval
+        if iv is None or iv.filters is not self.filters:
+            iv = self._interval = PredictionInterval(self.filters)
+            iv.start(self._prev_ins, prev)
+        full = iv.add(prev, dt_s)
+        if boundary or full:
+            iv.flush(ins, truth)
+
     def update(self, truth: AircraftState) -> NavSolution:
         """Advance to ``truth.t_s``: INS, prediction, GNSS (feedback), baro, identification;
         return the output."""
         ins = self.bank.update(truth)
         t = truth.t_s
         prev = self._prev_truth
+        fixes = self.receiver.update(truth)
+        reading = self.baro.update(truth) if self.baro is not None else None
         if prev is None:
             for i, f in enumerate(self.filters):
                 f.initialise(ins[i])
         elif t > prev.t_s:
-            if self.fused:
-                predict_filters(self.filters, self._prev_ins, prev, t - prev.t_s)
-            else:
-                for i, f in enumerate(self.filters):
-                    f.predict(self._prev_ins[i], prev, t - prev.t_s)
+            # an interval ends where a measurement is valid: at a GNSS epoch (the fix, delivered
+            # later, is then used at the filters' time, its time of validity) and at a baro
+            # reading
+            self._predict(prev, truth, ins, reading is not None
+                          or self.receiver.last_epoch_s == t)
         for i in range(len(self.filters)):
             buf = self._buffer[i]
             buf.append(ins[i])
             while buf and buf[0].t_s < t - _BUFFER_S:
                 buf.pop(0)
-        for fix in self.receiver.update(truth):
+        for fix in fixes:
             for i, f in enumerate(self.filters):
                 at = self._ins_at(i, fix.t_s)
                 if at is None:
@@ -243,12 +324,15 @@ class InsGnssNavigation:
                     if self.fdi is not None:
                         self.fdi.add_innovation(i, t, r.nis, r.innovation.size)
                 if any(r.used for r in groups):
-                    self.bank.correct(i, f.take_feedback())
+                    dx = f.take_feedback()                 # the estimate at the filter's time
+                    iv = self._interval
+                    if iv is not None and iv.filters is self.filters and iv.dt_s > 0.0:
+                        dx = iv.ins_transition() @ dx      # ... carried to now
+                    self.bank.correct(i, dx)
                     ins[i] = self.bank.output(i, truth)
                     self._buffer[i][-1] = ins[i]
                     self._last_fix_used_s = fix.t_s
                 self._gate_events(i, t, groups)
-        reading = self.baro.update(truth) if self.baro is not None else None
         if reading is not None:
             for i, f in enumerate(self.filters):
                 if self.ft.baro_excluded[i]:
@@ -272,34 +356,53 @@ class InsGnssNavigation:
         return self.comparator.update(truth.t_s, self.bank.sensor_errors(truth, dt),
                                       truth.f_body_mps2, (truth.p_rps, truth.q_rps, truth.r_rps))
 
-    def _comparison(self, sols: list[tuple]) -> list[np.ndarray]:
-        """Comparison vectors y_i (position ENU m from unit 0's, velocity, roll, pitch, heading)."""
-        lat0, lon0, h0 = sols[0][0], sols[0][1], sols[0][2]
-        out = []
-        for s in sols:
-            y = np.empty(9)
-            y[:3] = enu_difference_m(s[0], s[1], s[2], lat0, lon0, h0)
-            y[3:6] = s[3]
-            y[6], y[7], y[8] = s[4], s[5], s[6]
-            out.append(y)
-        return out
+    def _mean_P(self, units: list[int]) -> np.ndarray:
+        """(9, 9): the mean over ``units`` of the filters' covariances of the navigation states
+        (position, velocity, attitude; one unit: its own). Kept while the filters hold the same
+        P arrays (a prediction or a correction replaces them)."""
+        Ps = tuple(self.filters[i].P for i in units)
+        c = self._mean_P_cache.get(tuple(units))
+        if c is not None and all(a is b for a, b in zip(c[0], Ps)):
+            return c[1]
+        P = Ps[0][:9, :9]
+        if len(Ps) > 1:
+            P = P.copy()
+            for Pi in Ps[1:]:
+                P += Pi[:9, :9]
+            P /= len(Ps)
+        self._mean_P_cache[tuple(units)] = (Ps, P)
+        return P
+
+    def _anp_m(self, P: np.ndarray) -> float:
+        """ANP (m): the 95 % horizontal radius of P (recomputed only when P's horizontal block
+        changed since the last call — between prediction boundaries it does not)."""
+        key = (P[0, 0], P[1, 1], P[0, 1])
+        if key != self._anp_key:
+            self._anp_key, self._anp = key, horizontal_radius(*key)
+        return self._anp
 
     def _reference_description(self, truth: AircraftState, ins: list[NavSolution],
-                               sols: list[tuple], used: list[int], extra: dict) -> list[int]:
+                               C: np.ndarray, used: list[int], extra: dict,
+                               nse: tuple, means: dict) -> list[int]:
         """Run the reference-description monitor against the integrated solution of the units
         in ``used``; log its output (``nse_ref_*``, ``ins_used_ref``, ``refdesc_d_ins*``) and
-        return the units both it and the two-stage identification keep (``used`` if none)."""
-        base = used or list(range(len(sols)))
-        P_int = sum(self.filters[i].P for i in base) / len(base)
-        self.events += self.refdesc.update(truth, ins, _mean_solution([sols[i] for i in base]),
-                                           P_int, [f.P for f in self.filters],
+        return the units both it and the two-stage identification keep (``used`` if none).
+        ``nse``: (east m per rad of longitude, north m per rad of latitude) at the truth;
+        ``means``: the mean solutions of sets of units computed this step (read and added to)."""
+        base = used or list(range(len(C)))
+        key = tuple(base)
+        if key not in means:
+            means[key] = _mean_solution(C, base)
+        self.events += self.refdesc.update(truth, ins, means[key],
+                                           self._mean_P(base), [f.P for f in self.filters],
                                            self.bank.take_fed_back())
-        ref_used = [i for i in range(len(sols)) if self.refdesc.used[i]]
-        ref = _mean_solution([sols[i] for i in ref_used])
-        rm, rn = radii_m(truth.lat_rad)
-        extra["nse_ref_east_m"] = ((ref[1] - truth.lon_rad) * (rn + truth.alt_m)
-                                   * math.cos(truth.lat_rad))
-        extra["nse_ref_north_m"] = (ref[0] - truth.lat_rad) * (rm + truth.alt_m)
+        ref_used = [i for i in range(len(C)) if self.refdesc.used[i]]
+        key = tuple(ref_used)
+        if key not in means:
+            means[key] = _mean_solution(C, ref_used)
+        ref = means[key]
+        extra["nse_ref_east_m"] = (ref[1] - truth.lon_rad) * nse[0]
+        extra["nse_ref_north_m"] = (ref[0] - truth.lat_rad) * nse[1]
         extra["ins_used_ref"] = float(sum(1 << i for i in ref_used))
         for i, d in enumerate(self.refdesc.d):
             extra[f"refdesc_d_ins{i + 1}"] = float(d)
@@ -309,48 +412,50 @@ class InsGnssNavigation:
     def solution(self, truth: AircraftState, ins: list[NavSolution]) -> NavSolution:
         """The output: the mean of the units in use (unit 0 alone without identification), the
         mean of their covariances, ANP, and the logged columns."""
-        sols = [corrected(ins[i], f.x[:9]) for i, f in enumerate(self.filters)]
-        used = list(range(len(sols)))
+        O = np.array([(s.lat_rad, s.lon_rad, s.alt_m, s.v_enu_mps[0], s.v_enu_mps[1],
+                       s.v_enu_mps[2], s.roll_rad, s.pitch_rad, s.heading_rad) for s in ins])
+        C, Y = _corrected_many(O, np.array([f.x[:9] for f in self.filters]))
+        used = list(range(len(C)))
         extra: dict[str, float] = {}
-        coasting = (math.isfinite(self._last_fix_used_s)      # not before the first fix
-                    and truth.t_s - self._last_fix_used_s > 2.0 * self.receiver.period_s
-                    + self.receiver.spec.latency_s + 1e-6)
+        means: dict[tuple, tuple] = {}           # mean solution of a set of units, this step
+        rm, rn = radii_m(truth.lat_rad)
+        nse = ((rn + truth.alt_m) * math.cos(truth.lat_rad), rm + truth.alt_m)
+        coast = (truth.t_s - self._last_fix_used_s > 2.0 * self.receiver.period_s
+                 + self.receiver.spec.latency_s + 1e-6)
+        coasting = math.isfinite(self._last_fix_used_s) and coast   # not before the first fix
         for i in range(len(self.filters)):         # no altitude measurement: vertical frozen
             has_alt = not coasting or (self.baro is not None and not self.ft.baro_excluded[i])
-            self.events += self.ft.set_vertical(i, truth.t_s, has_alt)
+            if has_alt == self.ft.vertical_frozen[i]:
+                self.events += self.ft.set_vertical(i, truth.t_s, has_alt)
         if self.fdi is not None:
-            y = self._comparison(sols)
-            n_load = float(np.linalg.norm(truth.f_body_mps2)) / G0_MPS2
-            sig = [channel_sigmas(f.P, self._unmodelled_var[i], sols[i][4], sols[i][5], n_load)
+            y = list(Y)
+            n_load = math.sqrt(float(truth.f_body_mps2 @ truth.f_body_mps2)) / G0_MPS2
+            sig = [channel_sigmas(f.P, self._unmodelled_var[i], C[i, 6], C[i, 7], n_load)
                    for i, f in enumerate(self.filters)]
             mask = self.ft.mask(self.fdi.state.used)
             self.events += self.fdi.update(truth.t_s, y, sig, self._sensor_pairs(truth), mask)
             used = [i for i, u in enumerate(self.fdi.state.used) if u]
-            voted = self.fdi.vote(y, sig, mask)
-            vote = _mean_solution([sols[i] for i in voted])
-            rm, rn = radii_m(truth.lat_rad)
+            voted = self.fdi.vote(y, sig, mask, flags=self.fdi.flags)
+            vote = means[tuple(voted)] = _mean_solution(C, voted)
             extra = {"ins_used_vote": float(sum(1 << i for i in voted)),
-                     "nse_vote_east_m": (vote[1] - truth.lon_rad) * (rn + truth.alt_m)
-                     * math.cos(truth.lat_rad),
-                     "nse_vote_north_m": (vote[0] - truth.lat_rad) * (rm + truth.alt_m),
+                     "nse_vote_east_m": (vote[1] - truth.lon_rad) * nse[0],
+                     "nse_vote_north_m": (vote[0] - truth.lat_rad) * nse[1],
                      "fdi_nu": float(self.fdi.nu[0] + 2 * self.fdi.nu[1] + 4 * self.fdi.nu[2])}
         if self.refdesc is not None:
-            used = self._reference_description(truth, ins, sols, used, extra)
+            used = self._reference_description(truth, ins, C, used, extra, nse, means)
         valid = bool(used)
         pick = used if valid else [int(np.argmin([np.trace(f.P[:3, :3]) for f in self.filters]))]
-        lat, lon, alt, v, roll, pitch, hdg = _mean_solution([sols[i] for i in pick])
-        P = (self.filters[pick[0]].P if len(pick) == 1
-             else sum(self.filters[i].P for i in pick) / len(pick))
-        anp = horizontal_radius(P[0, 0], P[1, 1], P[0, 1])
-        rm, rn = radii_m(truth.lat_rad)
-        coast = truth.t_s - self._last_fix_used_s > 2.0 * self.receiver.period_s + \
-            self.receiver.spec.latency_s + 1e-6
+        key = tuple(pick)
+        if key not in means:
+            means[key] = _mean_solution(C, pick)
+        lat, lon, alt, v, roll, pitch, hdg = means[key]
+        P = self._mean_P(pick)
         mode = 2 if not valid else (1 if coast else 0)
         errors = {
-            "anp_m": anp, "nav_mode": float(mode),
+            "anp_m": self._anp_m(P), "nav_mode": float(mode),
             "ins_used": float(sum(1 << i for i in used)),
-            "nse_east_m": (lon - truth.lon_rad) * (rn + truth.alt_m) * math.cos(truth.lat_rad),
-            "nse_north_m": (lat - truth.lat_rad) * (rm + truth.alt_m),
+            "nse_east_m": (lon - truth.lon_rad) * nse[0],
+            "nse_north_m": (lat - truth.lat_rad) * nse[1],
             "nse_up_m": alt - truth.alt_m,
             "att_err_roll_deg": math.degrees(roll - truth.roll_rad),
             "att_err_pitch_deg": math.degrees(pitch - truth.pitch_rad),

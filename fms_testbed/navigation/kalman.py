@@ -72,8 +72,10 @@ def correct(x, P, z, H, R, frozen):
     for i in range(x.size):
         if frozen[i]:
             K[i, :] = 0.0
-    A = np.eye(x.size) - K @ H
-    Pn = A @ P @ A.T + K @ R @ K.T
+    # Joseph form (I - K H) P (I - K H)ᵀ + K R Kᵀ, each product by (I - K H) taken as a rank-m
+    # update (M - K (H M)) — the terms of the dense product, O(n² m) instead of O(n³)
+    AP = P - K @ (H @ P)
+    Pn = AP - (AP @ H.T) @ K.T + K @ R @ K.T
     return x + K @ nu, 0.5 * (Pn + Pn.T), nu, S, nis
 
 

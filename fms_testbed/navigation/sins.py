@@ -12,12 +12,15 @@ Scenario block (``navigation:``)::
     tol: 1.0e-12            # adaptive Picard tolerance
     alignment: stationary   # stationary (self-alignment at the start attitude) | none
     matrices_dt_s: 0        # reuse Φ_k, S_k for this long (s) before rebuilding F; 0 = every step
+    matrices_rotation_deg: 1.0e9   # ... and only while the body has turned less than this, deg
 
 Each :meth:`SinsNavigation.update` builds F at the previous true state, discretises over the
 elapsed Δt, propagates x_k = Φ x_{k-1} + S N_k (paper eq. 6.11) and returns truth ⊕ errors.
 With ``matrices_dt_s > 0`` the last Φ_k, S_k are reused (same Δt) until that much time has
-passed: the propagation then costs two 33×33 products per step, at the price of holding F
-(attitude, specific force, rates) constant over that interval.
+passed, or the body has turned ``matrices_rotation_deg`` (∫|ω| dt) since they were built: the
+propagation then costs two 33×33 products per step, at the price of holding F (attitude,
+specific force, rates) constant over that interval — the rotation limit keeps the hold to
+straight flight, where F hardly changes.
 """
 
 from __future__ import annotations
@@ -37,7 +40,7 @@ from fms_testbed.core._numba_cache import invalidate_if_sources_changed
 invalidate_if_sources_changed(Path(__file__).parent, also_hash=(Path(_sins_pkg.__file__).parent,
                                                                  Path(_earth.__file__)))
 
-from fms_testbed.core.earth import OMEGA_IE_RPS, radii_m
+from fms_testbed.core.earth import OMEGA_IE_RPS, radii_and_derivatives, radii_m
 from fms_testbed.core.errors import ConfigError, UserError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import DPH_RPS, G0_MPS2
@@ -51,7 +54,7 @@ from fms_testbed.sensors.sins._blas import single_thread_blas
 from fms_testbed.sensors.sins.analysis import system_matrix, initial_map
 
 SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol",
-             "matrices_dt_s", "alignment"}
+             "matrices_dt_s", "matrices_rotation_deg", "alignment"}
 NOISE_BLOCK = 256   # navigation steps of process noise drawn at once
 
 
@@ -96,15 +99,57 @@ def _sins_step(x, noise, lat, alt, v, rpy, w_eb, f_b, decay, q_diag, k1, k2, dt,
     return phi @ x + L @ noise, phi, L, 0
 
 
+@njit(cache=True)
+def _outputs_many(X, lat, lon, alt, v_enu, roll, pitch, heading):
+    """Indicated outputs of k units at one true state: truth ⊕ error (X (k, ≥9): δp ENU m, δV
+    m/s, ε rad); Euler errors by paper eq. 6.10 (the scalar form of
+    euler.eps_to_euler_errors). Returns (k, 9) [lat rad, lon rad, alt m, V E N U m/s, roll,
+    pitch, heading rad]."""
+    k = X.shape[0]
+    out = np.empty((k, 9))
+    rm, rn, _, _ = radii_and_derivatives(lat)
+    sp, cp = math.sin(heading), math.cos(heading)
+    cpitch, tpitch = math.cos(pitch), math.tan(pitch)
+    cl = math.cos(lat)
+    for i in range(k):
+        a = X[i, 6] * sp + X[i, 7] * cp
+        out[i, 0] = lat + X[i, 1] / (rm + alt)
+        out[i, 1] = lon + X[i, 0] / ((rn + alt) * cl)
+        out[i, 2] = alt + X[i, 2]
+        for j in range(3):
+            out[i, 3 + j] = v_enu[j] + X[i, 3 + j]
+        out[i, 6] = roll - a / cpitch
+        out[i, 7] = pitch - X[i, 6] * cp + X[i, 7] * sp
+        out[i, 8] = (heading + X[i, 8] - tpitch * a) % (2.0 * math.pi)
+    return out
+
+
+def outputs(X: np.ndarray, truth: AircraftState) -> np.ndarray:
+    """(k, 9) indicated outputs [lat rad, lon rad, alt m, V E N U m/s, roll, pitch, heading
+    rad] of k error states X (k, ≥9) at the true state (:func:`_outputs_many`)."""
+    return _outputs_many(X, truth.lat_rad, truth.lon_rad, truth.alt_m,
+                         np.asarray(truth.v_enu_mps, float), truth.roll_rad, truth.pitch_rad,
+                         truth.heading_rad)
+
+
+def output_solution(t_s: float, o: np.ndarray, errors: dict | None = None) -> NavSolution:
+    """A :class:`NavSolution` from one row of :func:`outputs`."""
+    return NavSolution(t_s, o[0], o[1], o[2], o[3:6], o[6], o[7], o[8],
+                       {} if errors is None else errors)
+
+
 class SinsNavigation:
     """Navigation source with SINS errors; see the module docstring for the scenario keys."""
 
     def __init__(self, imu: ImuModel, seed: int = 0, opts: SinsOptions = SinsOptions(),
-                 dt_s: float = 0.1, matrices_dt_s: float = 0.0):
+                 dt_s: float = 0.1, matrices_dt_s: float = 0.0,
+                 matrices_rotation_deg: float = 1e9):
         self.imu = imu
         self.opts = opts
         self.dt_s = float(dt_s)
         self.matrices_dt_s = float(matrices_dt_s)
+        self.matrices_rotation_rad = math.radians(matrices_rotation_deg)
+        self._turned_rad = 0.0      # ∫|ω| dt since the held matrices were built
         self.seed = int(seed)
         self.rng = np.random.default_rng(self.seed)
         self._z0 = np.sqrt(imu.p0_var) * self.rng.standard_normal(imu.p0_var.size)
@@ -143,6 +188,7 @@ class SinsNavigation:
                                alignment=str(spec.get("alignment", "stationary")))
             dt_s = float(spec.get("dt_s", 0.1))
             matrices_dt_s = float(spec.get("matrices_dt_s", 0.0))
+            matrices_rotation_deg = float(spec.get("matrices_rotation_deg", 1e9))
             sd = spec.get("seed", seed)
             sd = 0 if sd is None else int(sd)
         except (TypeError, ValueError) as exc:
@@ -151,7 +197,11 @@ class SinsNavigation:
             raise ConfigError(f"navigation.dt_s: must be > 0 s, got {dt_s}")
         if matrices_dt_s < 0:
             raise ConfigError(f"navigation.matrices_dt_s: must be >= 0 s, got {matrices_dt_s}")
-        return cls(imu, seed=sd, opts=opts, dt_s=dt_s, matrices_dt_s=matrices_dt_s)
+        if not matrices_rotation_deg > 0:
+            raise ConfigError("navigation.matrices_rotation_deg: must be > 0 deg, got "
+                              f"{matrices_rotation_deg}")
+        return cls(imu, seed=sd, opts=opts, dt_s=dt_s, matrices_dt_s=matrices_dt_s,
+                   matrices_rotation_deg=matrices_rotation_deg)
 
     def _next_noise(self) -> np.ndarray:
         """This step's standard-normal process-noise vector (drawn NOISE_BLOCK steps at once)."""
@@ -162,11 +212,23 @@ class SinsNavigation:
         self._noise_i += 1
         return noise
 
+    def held_for(self, prev: AircraftState, dt: float) -> tuple[tuple | None, float]:
+        """(the held (t_built_s, Δt, Φ, S) if they serve the step of ``dt`` (s) from ``prev``,
+        else None; the rotation since they were built, rad, counting this step) — no side
+        effect."""
+        held = self._held
+        if held is None:
+            return None, 0.0
+        turned = self._turned_rad + math.sqrt(prev.p_rps ** 2 + prev.q_rps ** 2
+                                              + prev.r_rps ** 2) * dt
+        ok = (abs(held[1] - dt) <= 1e-6 * dt and prev.t_s - held[0] < self.matrices_dt_s - 1e-9
+              and turned < self.matrices_rotation_rad)
+        return (held if ok else None), turned
+
     def _propagate(self, prev: AircraftState, dt: float) -> None:
         noise = self._next_noise()
-        held = self._held
-        if (held is not None and abs(held[1] - dt) <= 1e-6 * dt
-                and prev.t_s - held[0] < self.matrices_dt_s - 1e-9):
+        held, self._turned_rad = self.held_for(prev, dt)
+        if held is not None:
             self.x = held[2] @ self.x + held[3] @ noise
             return
         o = self.opts
@@ -201,9 +263,20 @@ class SinsNavigation:
         self.last_matrices = (prev, dt, phi, L)     # for units sharing this step (ins_bank)
         if self.matrices_dt_s > 0:
             self._held = (prev.t_s, dt, phi, L)
+            self._turned_rad = 0.0
 
     def update(self, truth: AircraftState) -> NavSolution:
         """Advance the error state to ``truth.t_s`` and return truth ⊕ errors."""
+        self.advance(truth)
+        return self.solution(truth)
+
+    def advance(self, truth: AircraftState) -> None:
+        """Advance the error state to ``truth.t_s`` (the first call maps the alignment errors).
+
+        Raises
+        ------
+        UserError : time went backwards
+        """
         prev = self._prev
         if prev is None:
             rpy = (truth.roll_rad, truth.pitch_rad, truth.heading_rad)
@@ -215,29 +288,23 @@ class SinsNavigation:
             if dt > 0:
                 self._propagate(prev, dt)
         self._prev = truth
-        return self.solution(truth)
 
-    def solution(self, truth: AircraftState) -> NavSolution:
-        """Truth ⊕ the current error state (position, velocity, attitude; errors dict for logs)."""
+    def solution(self, truth: AircraftState, errors: bool = True) -> NavSolution:
+        """Truth ⊕ the current error state (position, velocity, attitude, :func:`outputs`; with
+        ``errors`` the errors dict for logs — an INS bank's units leave it empty)."""
         x = self.x
-        e, n, u, ve, vn, vu, eps_e, eps_n, eps_u, ba_x, _, _, bg_x, _, bg_z = x[:15].tolist()
-        lat0, h0 = truth.lat_rad, truth.alt_m
-        rm, rn = radii_m(lat0)
-        # paper eq. 6.10 (scalar form of euler.eps_to_euler_errors, kept in math for speed)
-        sp, cp = math.sin(truth.heading_rad), math.cos(truth.heading_rad)
-        a = eps_e * sp + eps_n * cp
-        d_roll = -a / math.cos(truth.pitch_rad)
-        d_pitch = -eps_e * cp + eps_n * sp
-        d_head = eps_u - math.tan(truth.pitch_rad) * a
-        errors = {
+        o = outputs(x[None, :], truth)[0]
+        if not errors:
+            return output_solution(truth.t_s, o)
+        e, n, u, ve, vn, vu, _, _, _, ba_x, _, _, bg_x, _, bg_z = x[:15].tolist()
+        errs = {
             "nse_east_m": e, "nse_north_m": n, "nse_up_m": u,
             "ve_err_mps": ve, "vn_err_mps": vn, "vu_err_mps": vu,
-            "att_err_roll_deg": math.degrees(d_roll), "att_err_pitch_deg": math.degrees(d_pitch),
-            "att_err_heading_deg": math.degrees(d_head),
+            "att_err_roll_deg": math.degrees(o[6] - truth.roll_rad),
+            "att_err_pitch_deg": math.degrees(o[7] - truth.pitch_rad),
+            "att_err_heading_deg": math.degrees(math.remainder(o[8] - truth.heading_rad,
+                                                               2 * math.pi)),
             "bias_accel_x_ug": ba_x / G0_MPS2 * 1e6,
             "bias_gyro_x_dph": bg_x / DPH_RPS, "bias_gyro_z_dph": bg_z / DPH_RPS,
         }
-        return NavSolution(
-            truth.t_s, lat0 + n / (rm + h0), truth.lon_rad + e / ((rn + h0) * math.cos(lat0)),
-            h0 + u, truth.v_enu_mps + x[3:6], truth.roll_rad + d_roll,
-            truth.pitch_rad + d_pitch, (truth.heading_rad + d_head) % (2 * math.pi), errors)
+        return output_solution(truth.t_s, o, errs)

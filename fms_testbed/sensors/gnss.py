@@ -154,6 +154,7 @@ class GnssReceiver:
         self._next_epoch_s: float | None = None
         self._queue: list[GnssFix] = []
         self.period_s = 1.0 / spec.rate_hz
+        self.last_epoch_s: float | None = None      # time of the last fix taken (outage or not)
 
     def available(self, t_s: float) -> bool:
         """True when a fix taken at ``t_s`` (s) would be output (no outage)."""
@@ -194,6 +195,7 @@ class GnssReceiver:
         if self._next_epoch_s is None:
             self._next_epoch_s = t
         if t >= self._next_epoch_s - 1e-9:
+            self.last_epoch_s = t
             fix = self._fix(truth)
             if self.available(t):
                 self._queue.append(fix)

@@ -1,58 +1,116 @@
-"""The navigation step's fast paths (one discretisation of the truth model shared by the INS
-units, one compiled prediction for the three filters, the compiled raw-sensor errors) give the
-numbers of the per-unit paths: a seeded three-INS run with a gyro fault, compared sample by
-sample. Tolerance: 1e-12 relative (measured: bitwise equal)."""
+"""The navigation step's fast paths against the reference paths, on a seeded three-INS run.
+
+- One discretisation of the truth model shared by the INS units (``InsBank(share=True)``) and
+  the compiled raw-sensor errors give the numbers of the per-unit paths (1e-12 relative;
+  measured bitwise equal).
+- The multi-rate prediction (``ins_filter.PredictionInterval``: one F for the three filters at
+  the mean of their units' states, intervals ending at every GNSS epoch and baro reading, after
+  ``predict_interval_s`` or ``predict_rotation_deg`` of body rotation) follows the per-step,
+  per-filter prediction: the same fixes used (each at the filters' time, its time of validity,
+  the estimate carried to the INS of the delivery), σ of the nine navigation states within a few
+  per cent (the held P between boundaries is the main difference), the output within
+  centimetres.
+"""
 
 import numpy as np
 
 from fms_testbed.navigation import make_source
 from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
 
+SPEC = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}
 
-def _run(fast: bool):
-    states = aircraft_states(fly_profile([Segment(60), Segment(40, 3), Segment(60)], dt_s=0.1))
-    nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=5)
-    nav.fused = nav.bank.share = fast
-    rows = []
+
+def _states():
+    return aircraft_states(fly_profile([Segment(60), Segment(40, 3), Segment(60),
+                                        Segment(30, -3), Segment(30)], dt_s=0.1))
+
+
+def _run(fused: bool, share: bool, states=None):
+    states = _states() if states is None else states
+    nav = make_source(SPEC, seed=5)
+    nav.fused, nav.bank.share = fused, share
+    rows, sig = [], []
     for s in states:
         sol = nav.update(s)
         if abs(s.t_s - 80.0) < 1e-6:
             nav.inject({"unit": "ins2", "kind": "gyro_bias_step", "axis": "z", "size_dph": 80.0},
                        s.t_s)
         rows.append([sol.lat_rad, sol.lon_rad, sol.alt_m, *sol.v_enu_mps, sol.heading_rad,
-                     sol.errors["anp_m"], sol.errors["ins_used"]]
+                     sol.errors["anp_m"], sol.errors["ins_used"], sol.errors["nse_east_m"],
+                     sol.errors["nse_north_m"], sol.errors["att_err_heading_deg"]]
                     + [f.P[i, i] for f in nav.filters for i in (0, 4, 8, 14)]
                     + [f.x[17] for f in nav.filters]
                     + [x for u in nav.bank.units for x in u.x[[0, 4, 8, 14, 20]]])
-    return np.array(rows), [(e["t_s"], e["kind"], e["unit"]) for e in nav.events]
+        sig.append(np.sqrt(np.diag(nav.filters[0].P)[:9]))
+    events = [(e["t_s"], e["kind"], e["unit"]) for e in nav.events]
+    return np.array(rows), np.array(sig), events, len(nav.nis_log)
 
 
-def test_fast_paths_give_the_per_unit_numbers():
-    a, ea = _run(True)
-    b, eb = _run(False)
+def test_shared_truth_discretisation_gives_the_per_unit_numbers():
+    a, _, ea, _ = _run(False, True)
+    b, _, eb, _ = _run(False, False)
     assert ea == eb
     assert any(k == "fault_injected" for _, k, _ in ea)
     np.testing.assert_allclose(a, b, rtol=1e-12, atol=0)
 
 
-def _gamma(v):
-    return np.array([[v[1], v[2], 0, 0, 0, 0], [0, 0, v[0], v[2], 0, 0], [0, 0, 0, 0, v[0], v[1]]])
+def test_multi_rate_prediction_follows_the_per_step_filter():
+    a, sa, ea, na = _run(True, True)
+    b, sb, eb, nb = _run(False, True)
+    assert na == nb                             # every fix found its step boundary
+    assert [e for e in ea if e[1] != "detected"] == [e for e in eb if e[1] != "detected"]
+    k = 100                                     # after the first 10 s
+    rel = np.abs(sa[k:] - sb[k:]) / sb[k:]
+    assert np.median(rel, axis=0).max() < 0.03
+    assert rel[:, 6:8].max() < 0.05             # tilt
+    assert rel[:, 8].max() < 0.15               # heading, while the turn makes it observable
+    assert rel[:, :6].max() < 0.3               # position/velocity: held P before a fix
+    assert np.abs(a[k:, 9:11] - b[k:, 9:11]).max() < 0.05          # NSE E, N, m
+    hdg_sigma_deg = np.degrees(sb[k:, 8])
+    assert (np.abs(a[k:, 11] - b[k:, 11]) / hdg_sigma_deg).max() < 0.5
 
 
-def test_compiled_sensor_errors_are_eq_5_1():
-    """bias + compensation + scale factor + misalignment Γ(v) m (paper eq. 5.1), the white
-    noise made negligible by a huge averaging interval."""
-    states = aircraft_states(fly_profile([Segment(20, 3)], dt_s=0.1))
-    nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=6)
-    for s in states:
+def test_intervals_end_at_gnss_epochs_and_after_the_rotation_limit():
+    nav = make_source(SPEC, seed=5)
+    flushes = []
+    iv_flush = None
+    for s in aircraft_states(fly_profile([Segment(30), Segment(30, 3)], dt_s=0.1)):
         nav.update(s)
-    s = states[-1]
-    nav.bank.compensation[:] = np.random.default_rng(1).standard_normal((3, 6)) * 1e-4
-    got = nav.bank.sensor_errors(s, 1e300)
-    f, w = s.f_body_mps2, np.array([s.p_rps, s.q_rps, s.r_rps])
-    for i, u in enumerate(nav.bank.units):
-        x, b = u.x, u.x[9:15] + nav.bank.compensation[i]
-        np.testing.assert_allclose(got[i, :3], b[:3] + x[15:18] * f + _gamma(f) @ x[21:27],
-                                   rtol=1e-12, atol=1e-18)
-        np.testing.assert_allclose(got[i, 3:], b[3:] + x[18:21] * w + _gamma(w) @ x[27:33],
-                                   rtol=1e-12, atol=1e-18)
+        if iv_flush is None and nav._interval is not None:
+            iv_flush = nav._interval.flush
+
+            def counted(ins, truth, _f=iv_flush):
+                flushes.append(truth.t_s)
+                _f(ins, truth)
+            nav._interval.flush = counted
+    t = np.array(flushes)
+    straight, turn = t[(t > 5) & (t < 29)], t[t > 35]
+    assert 0.9 <= len(straight) / 24 <= 1.1     # at each fix's epoch (and baro reading)
+    assert len(turn) / (t.max() - 35) >= 3.0    # 3 °/s and at most 1° per interval
+
+
+def test_corrected_outputs_and_comparison_vectors_are_eq_6_10_and_enu_differences():
+    """The compiled corrected outputs of three units (paper eq. 6.10 for the Euler errors) and
+    seed 001's comparison vectors against a plain statement with euler.eps_to_euler_errors and
+    ins_filter.enu_difference_m."""
+    from fms_testbed.navigation.ins_filter import enu_difference_m
+    from fms_testbed.navigation.ins_gnss import _corrected_many
+    from fms_testbed.sensors.sins.euler import eps_to_euler_errors
+    rng = np.random.default_rng(3)
+    O = np.column_stack([0.8 + 1e-5 * rng.standard_normal(3), 0.14 + 1e-5 * rng.standard_normal(3),
+                         3000 + rng.standard_normal(3), 150 + rng.standard_normal((3, 3)),
+                         0.3 * rng.standard_normal((3, 2)), [6.27, 0.01, 3.0]])
+    DX = np.column_stack([5 * rng.standard_normal((3, 3)), 0.1 * rng.standard_normal((3, 3)),
+                          1e-3 * rng.standard_normal((3, 3))])
+    C, Y = _corrected_many(O, DX)
+    from fms_testbed.core.earth import radii_m
+    for i in range(3):
+        rm, rn = radii_m(O[i, 0])
+        dr, dp, dh = eps_to_euler_errors(*DX[i, 6:9], O[i, 7], O[i, 8])
+        want = [O[i, 0] - DX[i, 1] / (rm + O[i, 2]),
+                O[i, 1] - DX[i, 0] / ((rn + O[i, 2]) * np.cos(O[i, 0])), O[i, 2] - DX[i, 2],
+                *(O[i, 3:6] - DX[i, 3:6]), O[i, 6] - dr, O[i, 7] - dp, (O[i, 8] - dh) % (2 * np.pi)]
+        np.testing.assert_allclose(C[i], want, rtol=1e-13, atol=1e-12)
+        np.testing.assert_allclose(Y[i, :3], enu_difference_m(*C[i, :3], *C[0, :3]), rtol=1e-12,
+                                   atol=1e-9)
+        np.testing.assert_array_equal(Y[i, 3:], C[i, 3:])
