@@ -63,7 +63,7 @@ def inject(source, fault: dict, t_s: float) -> dict:
             u.x[12:15] += (f - 1.0) * sigma
             q = u.imu.q_psd.copy()
             q[12:15] *= f * f
-            u.imu = replace(u.imu, q_psd=q)
+            u.replace_imu(replace(u.imu, q_psd=q))
             what = (f"gyro drift x{f:g} of declared ({(f - 1) * sigma[0] / DPH_RPS:.3g} deg/h "
                     f"excess per axis)")
         else:                                               # stuck

@@ -120,7 +120,7 @@ class InsBank:
         if dt <= 0:
             return False
         held, turned = u0.held_for(prev, dt)
-        if held is None or any(u._prev is not prev or u._held is not held
+        if held is None or any(u._prev is not prev or u._held is not held or u.imu is not u0.imu
                                for u in self.units[1:]):
             return False
         X = _advance_many(held[2], np.array([u.x for u in self.units]), held[3],

@@ -212,6 +212,12 @@ class SinsNavigation:
         self._noise_i += 1
         return noise
 
+    def replace_imu(self, imu: ImuModel) -> None:
+        """Replace the unit's IMU model from now on (a fault changing its errors); held
+        matrices built with the old model are dropped."""
+        self.imu = imu
+        self._held = None
+
     def held_for(self, prev: AircraftState, dt: float) -> tuple[tuple | None, float]:
         """(the held (t_built_s, Δt, Φ, S) if they serve the step of ``dt`` (s) from ``prev``,
         else None; the rotation since they were built, rad, counting this step) — no side

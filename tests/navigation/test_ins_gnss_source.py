@@ -36,6 +36,10 @@ def test_registry_has_one_ins_gnss_entry():
     ({"imu": "STIM300", "bogus": 1}, "navigation.bogus"),
     ({"imu": "STIM300", "gnss": {"outages": [{"start_s": 20, "end_s": 10}]}}, "outages"),
     ({}, "navigation.imu"),
+    ({"imu": "STIM300", "filter": {"predict_interval_s": -1}}, "navigation.filter.predict_interval_s"),
+    ({"imu": "STIM300", "filter": {"predict_rotation_deg": 0}}, "navigation.filter.predict_rotation_deg"),
+    ({"imu": "STIM300", "matrices_dt_s": 11}, "navigation.matrices_dt_s"),
+    ({"imu": "STIM300", "matrices_rotation_deg": 0}, "navigation.matrices_rotation_deg"),
 ])
 def test_bad_blocks_are_config_errors_naming_the_field(spec, field):
     with pytest.raises(ConfigError, match=field.replace(".", r"\.")):

@@ -114,3 +114,20 @@ def test_corrected_outputs_and_comparison_vectors_are_eq_6_10_and_enu_difference
         np.testing.assert_allclose(Y[i, :3], enu_difference_m(*C[i, :3], *C[0, :3]), rtol=1e-12,
                                    atol=1e-9)
         np.testing.assert_array_equal(Y[i, 3:], C[i, 3:])
+
+
+def test_a_drift_fault_drops_the_held_truth_matrices_of_its_unit():
+    """drift_scale replaces a unit's IMU model: from the next step that unit propagates with
+    matrices of its new model (its own S), not the others' held ones."""
+    states = aircraft_states(fly_profile([Segment(20)], dt_s=0.1))
+    nav = make_source(SPEC, seed=2)
+    for s in states[:100]:
+        nav.update(s)
+    nav.inject({"unit": "ins2", "kind": "drift_scale", "factor": 3.0}, states[99].t_s)
+    nav.update(states[100])
+    u0, u1 = nav.bank.units[0], nav.bank.units[1]
+    assert u1.imu is not u0.imu
+    assert u1._held is not u0._held
+    S0, S1 = u0._held[3], u1._held[3]
+    # the gyro-bias random-walk columns carry the factor (σ × 3), the others are unchanged
+    assert np.abs(S1).sum() > np.abs(S0).sum()
