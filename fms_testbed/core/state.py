@@ -85,6 +85,9 @@ class NavSolution:
     does not estimate it (truth, a free-running SINS without a filter)."""
     valid: bool = True
     """False when the source cannot give a usable solution (e.g. every INS excluded)."""
+    heading_sigma_rad: float | None = None
+    """1σ of the heading error the source estimates, rad (``None``: not estimated — truth, a
+    free-running SINS)."""
 
 
 @dataclass(slots=True)

@@ -134,10 +134,14 @@ class ConditionThresholds:
     wind_err_mps: magnitude of the vector difference measured − planned wind at the present
     altitude, m/s (10 kt); isa_dev_err_c: |measured − planned| ISA deviation, K (5 °C);
     tau_s: time constant of the first-order filter on the measurements, s; holdoff_s: no
-    rebuild this long after the start (the wind is ramped in over 20 s) or after a rebuild, s.
+    rebuild this long after the start (the wind is ramped in over 20 s) or after a rebuild, s;
+    nav_sigma_k: the wind threshold is at least this many σ of the wind measurement's own error
+    from the navigation's heading uncertainty, k · TAS · σ_ψ (an INS whose heading is not yet
+    observable — 2.8° before the first turn — "measures" a 10 kt crosswind that is not there).
     """
 
     wind_err_mps: float = 10.0 * KT_MPS
+    nav_sigma_k: float = 3.0
     isa_dev_err_c: float = 5.0
     tau_s: float = 15.0
     holdoff_s: float = 60.0
@@ -236,16 +240,25 @@ class ConditionMonitor:
         pn, pe = WindProfile.constant(spd, frm).ned_at(0.0)
         err = math.hypot(wn - pn, we - pe)
         why = []
-        if err > self.th.wind_err_mps:
+        if err > self.wind_threshold_mps(nav, truth):
             ms, mf = WindProfile((0.0,), (wn,), (we,)).at(0.0)
             why.append(f"wind measured {mf:03.0f}/{ms / KT_MPS:.0f} kt vs planned "
                        f"{frm:03.0f}/{spd / KT_MPS:.0f} kt at {nav.alt_m / FT_M:.0f} ft "
                        f"(vector error {err / KT_MPS:.0f} kt > "
-                       f"{self.th.wind_err_mps / KT_MPS:.0f} kt)")
+                       f"{self.wind_threshold_mps(nav, truth) / KT_MPS:.0f} kt)")
         if abs(dev - params.isa_dev_c) > self.th.isa_dev_err_c:
             why.append(f"temperature measured ISA{dev:+.1f} vs planned "
                        f"ISA{params.isa_dev_c:+.1f} (> {self.th.isa_dev_err_c:.0f} °C)")
         return "; ".join(why)
+
+    def wind_threshold_mps(self, nav, truth) -> float:
+        """The wind-change threshold, m/s: ``wind_err_mps``, or ``nav_sigma_k`` σ of the wind
+        error the navigation's heading uncertainty makes (TAS · σ_ψ across the air velocity)
+        when that is larger."""
+        sig = getattr(nav, "heading_sigma_rad", None)
+        if sig is None or not math.isfinite(sig):
+            return self.th.wind_err_mps
+        return max(self.th.wind_err_mps, self.th.nav_sigma_k * truth.tas_mps * sig)
 
     def rebuilt(self, t_s: float) -> None:
         """A rebuild was made at ``t_s`` (s): hold off the next one."""

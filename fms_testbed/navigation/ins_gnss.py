@@ -465,7 +465,8 @@ class InsGnssNavigation:
             **extra,
         }
         return NavSolution(truth.t_s, lat, lon, alt, v, roll, pitch, hdg, errors,
-                           pos_cov_enu_m2=P[:3, :3].copy(), valid=valid)
+                           pos_cov_enu_m2=P[:3, :3].copy(), valid=valid,
+                           heading_sigma_rad=math.sqrt(max(P[8, 8], 0.0)))
 
 
 __all__ = ["InsGnssNavigation", "baro_spec", "corrected", "gnss_spec"]

@@ -76,3 +76,28 @@ def test_measured_params_shift_the_planned_profile():
     assert q.wind_at(3000.0)[0] == pytest.approx(35.0)      # the profile's shape kept
     c = measured_params(BuildParams(), 0.0, meas, 0.0)       # no profile: the measured wind
     assert c.wind_profile is None and c.wind_at(9000.0) == pytest.approx((25.0, 270.0))
+
+
+def test_a_heading_error_the_navigation_declares_is_not_taken_for_a_wind_change():
+    """An INS/GNSS solution whose heading is 2.6° off with σ 2.8° (not yet observable before a
+    turn) makes a still air look like a 12 kt crosswind at 130 m/s: no rebuild while that is
+    within 3 σ of the heading's own wind error; the same error with the σ not declared (or a
+    heading known to 0.1°) does trigger — and so does a real wind change beyond the 3 σ."""
+    planned = BuildParams(wind_speed_mps=0.0, wind_from_deg=0.0, isa_dev_c=0.0)
+
+    def run(sigma_rad, true_wind=(0.0, 0.0)):
+        m = ConditionMonitor(ConditionThresholds())
+        for k in range(1500):
+            nav, truth = _sample(0.1 * k, true_wind, 0.0)
+            nav.heading_rad += math.radians(2.6)        # the navigation's heading error
+            nav.heading_sigma_rad = sigma_rad
+            why = m.update(0.1 * k, nav, truth, planned)
+            if why:
+                return why
+        return ""
+
+    assert run(math.radians(2.8)) == ""
+    assert "wind measured" in run(None)
+    assert "wind measured" in run(math.radians(0.1))
+    w = WindProfile.constant(45 * KT_MPS, 150.0).ned_at(0.0)   # beyond 3 × 130 m/s × 2.8°
+    assert "wind measured" in run(math.radians(2.8), w)
