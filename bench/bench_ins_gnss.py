@@ -79,9 +79,9 @@ def faults(n_seeds: int) -> None:
                 if s.t_s >= 200.0:
                     nse.append(np.hypot(sol.errors["nse_east_m"], sol.errors["nse_north_m"]))
             det = [e["t_s"] - 200 for e in nav.events
-                   if e["kind"] == "detected" and e["unit"].startswith("ins")]
+                   if e["kind"] == "detected" and e["unit"].startswith("ins") and e["t_s"] >= 200]
             exc = [(round(e["t_s"] - 200, 1), e["unit"]) for e in nav.events
-                   if e["kind"] == "excluded"]
+                   if e["kind"] == "excluded" and e["t_s"] >= 200]
             print(f"{fault['kind']} {fault.get('axis', '')} {fault.get('size_dph', fault.get('size_ug', fault.get('factor', '')))}"
                   f" seed {seed}: detected {det[:1]}, excluded {exc[:1]}, NSE max after "
                   f"{max(nse):.2f} m")

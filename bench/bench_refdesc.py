@@ -72,7 +72,7 @@ def steps(n_seeds: int, extra_s: float = 0.0, only: str = "") -> None:
             d = [e["t_s"] - 200 for e in nav.events if e["kind"] == "detected"
                  and e["unit"].startswith("ins") and e["t_s"] >= 200]
             i = [e["t_s"] - 200 for e in nav.events if e["kind"] in ("isolated", "excluded")
-                 and e["unit"] == "ins2"]
+                 and e["unit"] == "ins2" and e["t_s"] >= 200]
             wrong += any(e["kind"] == "excluded" and e["unit"] in ("ins1", "ins3")
                          for e in nav.events)
             det.append(round(d[0], 1) if d else None)

@@ -151,11 +151,11 @@ def test_one_compiled_epoch_equals_the_numpy_chain(truth, imus):
     s_long = s.copy()
     s_long[19] = 1e5                     # Δt/τ beyond the Picard range: refused, nothing touched
     assert rd._epoch(P, D, X, PC, slots, s_long, ins, mon._decay, mon._q_psd, mon._model,
-                     FREE.tol, excluded, since, detected, 4.0, 10.0)[0] == 1
+                     FREE.tol, excluded, since, detected, 4.0, 10.0, 10.0)[0] == 1
     np.testing.assert_array_equal(P, want["P"])
     status, d, used, exc, since_n, rank, notify, all_out = rd._epoch(
         P, D, X, PC, slots, s, ins, mon._decay, mon._q_psd, mon._model, FREE.tol, excluded,
-        since, detected, 4.0, 10.0)
+        since, detected, 4.0, 10.0, 10.0)
     assert status == 0
     r = mon._r(P_out)
     out = (s[0], s[1], s[2], s[3:6])
@@ -167,7 +167,8 @@ def test_one_compiled_epoch_equals_the_numpy_chain(truth, imus):
             phi, qk = _phi_qk(truth, imu, dt)
             Pi, Di = propagate(want["P"][w][i:i + 1], want["D"][w][i:i + 1], phi, qk)
             want["P"][w][i], want["D"][w][i] = Pi[0], Di[0]
-        q = np.maximum((want["P"][w][:, [3, 4], [3, 4]] - v0) / dt, 1e-10)
+        vv = want["P"][w][:, [3, 4], [3, 4]]
+        q = np.maximum(np.maximum((vv - v0) / dt, vv / 10.0), 1e-10)
         want["X"][w], want["PC"][w] = channel_filter_step(
             want["X"][w], want["PC"][w], mon._measure(want["D"][w], sols, out), r, q, dt)
     for k, got in (("P", P), ("D", D), ("X", X), ("PC", PC)):
