@@ -324,9 +324,23 @@ class ProcedureGuidance:
         (wn, we), dev = self.conditions.measured
         params = measured_params(self.act.fp.params, nav.alt_m, (wn, we), dev)
         self.conditions.rebuilt(nav.t_s)
+        kept = (self.act, self.i, len(self.rebuilt))
         if not self._rebuild_rest(w, nav, params):
             self._event(nav.t_s, "condition", w.leg, f"conditions changed ({why}); the rest "
                                                      "could not be rebuilt: the plan is kept")
+            return False
+        broken = [f for f in self.act.fp.path.findings
+                  if f.category in ("discontinuity", "loop", "no-intercept")]
+        if broken:
+            # a rebuilt rest that is not continuous is worse than the plan for the old
+            # conditions (KBFI H14RZ from mid-TF in a 12 kt wind: the RF joined 127° off its
+            # tangent and flown as two 360° loops): keep the plan
+            self.act, self.i = kept[0], kept[1]
+            del self.rebuilt[kept[2]:]
+            self._event(nav.t_s, "condition", w.leg,
+                        f"conditions changed ({why}); the rebuilt rest is not continuous "
+                        f"(leg {broken[0].leg_index + w.leg}: {broken[0].message}): the plan "
+                        "is kept")
             return False
         self.speed.isa_dev_c = params.isa_dev_c
         self._event(nav.t_s, "rebuild", w.leg, f"conditions changed: {why}; rest of the "
