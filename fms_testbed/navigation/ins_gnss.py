@@ -59,6 +59,7 @@ from fms_testbed.navigation.reference_description import ReferenceDescriptionMon
 from fms_testbed.sensors.baro import BaroAltimeter, BaroSpec
 from fms_testbed.sensors.gnss import GnssReceiver, GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.analysis import horizontal_radius
+from fms_testbed.sensors.sins.euler import eps_to_euler_errors_scalar
 from fms_testbed.sensors.sins.presets import load_imu
 
 _BUFFER_S = 2.0          # INS outputs kept for the GNSS latency, s
@@ -103,11 +104,8 @@ def _corrected_many(O, DX):
     for i in range(k):
         lat, h = O[i, 0], O[i, 2]
         rm, rn, _, _ = radii_and_derivatives(lat)
-        sp, cp = math.sin(O[i, 8]), math.cos(O[i, 8])
-        a = DX[i, 6] * sp + DX[i, 7] * cp
-        d_roll = -a / math.cos(O[i, 7])
-        d_pitch = -DX[i, 6] * cp + DX[i, 7] * sp
-        d_head = DX[i, 8] - math.tan(O[i, 7]) * a
+        d_roll, d_pitch, d_head = eps_to_euler_errors_scalar(DX[i, 6], DX[i, 7], DX[i, 8],
+                                                             O[i, 7], O[i, 8])
         C[i, 0] = lat - DX[i, 1] / (rm + h)
         C[i, 1] = O[i, 1] - DX[i, 0] / ((rn + h) * math.cos(lat))
         C[i, 2] = h - DX[i, 2]

@@ -232,6 +232,19 @@ def reference_decision(d: np.ndarray, excluded: np.ndarray, outside_since: np.nd
 _N_NAV = 9     # navigation states of the 33-state model; the 24 sensor states have diagonal Φ
 
 
+@njit(cache=True)
+def _sensor_nonzeros(M, nn, nz, cnt):
+    """For each sensor row i of M (rows and columns from ``nn`` on): the columns of its non-zero
+    sensor entries in nz[i, :cnt[i]] (nz, cnt overwritten)."""
+    m = M.shape[0] - nn
+    for i in range(m):
+        cnt[i] = 0
+        for j in range(m):
+            if M[nn + i, nn + j] != 0.0:
+                nz[i, cnt[i]] = nn + j
+                cnt[i] += 1
+
+
 @njit(cache=True, fastmath={"contract"})
 def _propagate_blocks(P, D, phi, qk):
     """:func:`propagate` for one unit in place, on the blocks of Φ = [[Φ11, Φ12], [0, diag φ22]]
@@ -247,11 +260,7 @@ def _propagate_blocks(P, D, phi, qk):
     m = n - nn
     nz = np.empty((m, m), np.int64)            # sensor rows of P: their non-zero sensor columns
     cnt = np.zeros(m, np.int64)
-    for i in range(m):
-        for j in range(m):
-            if P[nn + i, nn + j] != 0.0:
-                nz[i, cnt[i]] = nn + j
-                cnt[i] += 1
+    _sensor_nonzeros(P, nn, nz, cnt)
     C = np.zeros((n, n))
     for r in range(nn):
         for p in range(n):
@@ -272,12 +281,7 @@ def _propagate_blocks(P, D, phi, qk):
         for c in range(n):
             C[r, c] = a * P[r, c]
     Ct = C.T.copy()                            # C Φᵀ with the outputs of one k in a row
-    for i in range(m):                         # sensor columns of C: their non-zero sensor rows
-        cnt[i] = 0
-        for j in range(m):
-            if Ct[nn + i, nn + j] != 0.0:
-                nz[i, cnt[i]] = nn + j
-                cnt[i] += 1
+    _sensor_nonzeros(Ct, nn, nz, cnt)          # sensor columns of C: their non-zero sensor rows
     U = np.zeros((nn, n))
     for c in range(nn):
         for p in range(n):

@@ -45,6 +45,7 @@ from fms_testbed.core.errors import ConfigError, UserError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import DPH_RPS, G0_MPS2
 from fms_testbed.sensors.sins.analysis import SinsOptions
+from fms_testbed.sensors.sins.euler import eps_to_euler_errors_scalar
 from fms_testbed.sensors.sins.discretize import (PICARD_MAX_ORDER, PICARD_MAX_RATE_DT, DiscretisationError,
                          _picard_sins, discretize)
 from fms_testbed.sensors.sins.model import baro_gains, build_F
@@ -108,19 +109,18 @@ def _outputs_many(X, lat, lon, alt, v_enu, roll, pitch, heading):
     k = X.shape[0]
     out = np.empty((k, 9))
     rm, rn, _, _ = radii_and_derivatives(lat)
-    sp, cp = math.sin(heading), math.cos(heading)
-    cpitch, tpitch = math.cos(pitch), math.tan(pitch)
     cl = math.cos(lat)
     for i in range(k):
-        a = X[i, 6] * sp + X[i, 7] * cp
+        d_roll, d_pitch, d_head = eps_to_euler_errors_scalar(X[i, 6], X[i, 7], X[i, 8], pitch,
+                                                             heading)
         out[i, 0] = lat + X[i, 1] / (rm + alt)
         out[i, 1] = lon + X[i, 0] / ((rn + alt) * cl)
         out[i, 2] = alt + X[i, 2]
         for j in range(3):
             out[i, 3 + j] = v_enu[j] + X[i, 3 + j]
-        out[i, 6] = roll - a / cpitch
-        out[i, 7] = pitch - X[i, 6] * cp + X[i, 7] * sp
-        out[i, 8] = (heading + X[i, 8] - tpitch * a) % (2.0 * math.pi)
+        out[i, 6] = roll + d_roll
+        out[i, 7] = pitch + d_pitch
+        out[i, 8] = (heading + d_head) % (2.0 * math.pi)
     return out
 
 

@@ -8,7 +8,10 @@ Both functions take scalars or arrays of equal shape (vectorised over samples).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 
 def eps_to_euler_errors(eps_e_rad, eps_n_rad, eps_u_rad, pitch_rad, heading_rad):
@@ -32,6 +35,21 @@ def eps_to_euler_errors(eps_e_rad, eps_n_rad, eps_u_rad, pitch_rad, heading_rad)
     d_pitch = -eps_e_rad * cp + eps_n_rad * sp
     d_head = eps_u_rad - np.tan(pitch_rad) * a
     return d_roll, d_pitch, d_head
+
+
+@njit(cache=True)
+def eps_to_euler_errors_scalar(eps_e_rad, eps_n_rad, eps_u_rad, pitch_rad, heading_rad):
+    """:func:`eps_to_euler_errors` (paper eq. 6.10) for scalars, compiled — what the navigation
+    kernels call per unit.
+
+    Returns
+    -------
+    (d_roll_rad, d_pitch_rad, d_heading_rad) : measured minus true, rad.
+    """
+    sp, cp = math.sin(heading_rad), math.cos(heading_rad)
+    a = eps_e_rad * sp + eps_n_rad * cp
+    return (-a / math.cos(pitch_rad), -eps_e_rad * cp + eps_n_rad * sp,
+            eps_u_rad - math.tan(pitch_rad) * a)
 
 
 def euler_errors_to_eps(d_roll_rad, d_pitch_rad, d_heading_rad, pitch_rad, heading_rad):
