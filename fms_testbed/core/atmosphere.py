@@ -62,6 +62,19 @@ def pressure_altitude_m(alt_m, isa_dev_c=0.0):
     return T0_K / LAPSE_KPM * (1.0 - (np.asarray(p) / P0_PA) ** (1.0 / _N))
 
 
+def altitude_of_pressure_m(p_pa):
+    """ISA (pressure) altitude, m, of a static pressure ``p_pa`` (Pa): the inverse of the
+    standard day's p(h), troposphere and the isothermal layer above 11 km."""
+    p = np.asarray(p_pa, dtype=float)
+    h_trop = T0_K / LAPSE_KPM * (1.0 - (p / P0_PA) ** (1.0 / _N))
+    h_strat = H_TROP_M - R_JPKGK * _T_TROP_K / G0_MPS2 * np.log(p / _P_TROP_PA)
+    return np.where(p >= _P_TROP_PA, h_trop, h_strat)
+
+
+_T_TROP_K = T0_K - LAPSE_KPM * H_TROP_M
+_P_TROP_PA = P0_PA * (_T_TROP_K / T0_K) ** _N
+
+
 def _qc_pa(cas_mps):
     """Impact pressure of a calibrated airspeed (m/s), Pa (subsonic St-Venant at sea level)."""
     return P0_PA * ((1 + (GAMMA - 1) / 2 * (cas_mps / A0_MPS) ** 2) ** (GAMMA / (GAMMA - 1)) - 1)

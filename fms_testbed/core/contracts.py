@@ -7,15 +7,30 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Protocol
 
+import numpy as np
+
 from fms_testbed.core.state import AircraftState, NavSolution
 
 
 class NavigationSource(Protocol):
     """A navigation source: called once per navigation step with the true state (the truth side
-    gives it what its sensors would measure) and returns what the navigation system believes."""
+    gives it what its sensors would measure) and returns what the navigation system believes.
 
-    def update(self, truth: AircraftState) -> NavSolution:  # pragma: no cover - protocol
-        """Return the navigation solution at ``truth.t_s``."""
+    Sensors that sample faster than the navigation step (an IMU at the JSBSim frame rate) name
+    the JSBSim properties they read in :attr:`frame_properties`; the flight loop then reads them
+    after every JSBSim frame of the step and hands them to :meth:`update` as ``frames``.
+    """
+
+    #: ``(property, scale to SI)`` pairs sampled after every JSBSim frame; ``()``: none
+    frame_properties: tuple[tuple[str, float], ...]
+
+    def update(self, truth: AircraftState, frames: np.ndarray | None = None
+               ) -> NavSolution:  # pragma: no cover - protocol
+        """Return the navigation solution at ``truth.t_s``.
+
+        ``frames``: shape ``(n_frames, len(frame_properties))``, the samples (SI) taken after
+        each JSBSim frame since the previous call, the last row at ``truth.t_s``; ``None`` on
+        the first call and when :attr:`frame_properties` is empty."""
 
 
 @dataclass

@@ -35,6 +35,8 @@ class AircraftState:
     f_body_mps2: specific force in body axes (forward, right, down), m/s^2, shape (3,)
     mach: Mach number;  agl_m: height above ground, m
     throttle: mean throttle command, 0..1;  mass_kg: current mass, kg
+    p_static_pa, t_static_k: static pressure (Pa) and temperature (K) of the air at the
+    aircraft (NaN where the producer has no atmosphere, e.g. a synthetic profile)
     """
 
     t_s: float
@@ -63,6 +65,42 @@ class AircraftState:
     agl_m: float
     throttle: float
     mass_kg: float
+    p_static_pa: float = float("nan")
+    t_static_k: float = float("nan")
+
+
+@dataclass(slots=True)
+class AirData:
+    """What the air-data computer gives guidance and the laws (SI): its sensors' view of the air,
+    never the truth itself; the producer is :class:`fms_testbed.sensors.air_data.AirDataComputer`.
+
+    Attributes
+    ----------
+    t_s : time of the measurement, s
+    tas_mps, cas_mps : true and calibrated airspeed, m/s
+    mach : Mach number
+    pressure_alt_m : pressure altitude (the ISA altitude of the measured static pressure), m
+    baro_alt_m : barometric altitude the altimeter shows (pressure altitude corrected with the
+        altimeter setting the computer knows), m
+    vs_mps : barometric vertical speed (up positive), m/s
+    p_static_pa : measured static pressure, Pa
+    t_static_k : measured static (outside) air temperature, K
+    alpha_rad, beta_rad : angle of attack and sideslip from the vanes, rad
+    valid : False when the computer has failed (its numbers are then not to be used)
+    """
+
+    t_s: float
+    tas_mps: float
+    cas_mps: float
+    mach: float
+    pressure_alt_m: float
+    baro_alt_m: float
+    vs_mps: float
+    p_static_pa: float
+    t_static_k: float
+    alpha_rad: float
+    beta_rad: float
+    valid: bool = True
 
 
 @dataclass(slots=True)

@@ -34,6 +34,10 @@ LBF_N = LB_KG * G0_MPS2
 """One pound-force in newtons (exact: lb × g0, 4.4482216152605)."""
 SLUG_KG = LBF_N / FT_M
 """One slug (lbf·s²/ft) in kilograms (exact, 14.5939029372)."""
+PSF_PA = LBF_N / FT_M ** 2
+"""One pound-force per square foot in pascals (exact, 47.880259)."""
+RANKINE_K = 5.0 / 9.0
+"""One degree Rankine in kelvin (a temperature in °R times this is the temperature in K)."""
 
 
 def ft_to_m(x_ft):

@@ -28,9 +28,9 @@ from fms_testbed.core.errors import UserError
 from fms_testbed.core.units import FT_M, KT_MPS, SLUG_KG
 from fms_testbed.loop.log import build_frame
 from fms_testbed.loop.procedure import PreparedProcedure
-from fms_testbed.loop.steps import (WIND_RAMP_S, ConfigStep, EventQueue, LateralStep, NavHold,
-                                    Targets, VerticalStep, WindRamp, apply_event,
-                                    flap_index_for_cas, merge_guidance)
+from fms_testbed.loop.steps import (WIND_RAMP_S, ConfigStep, EventQueue, FrameSampling,
+                                    LateralStep, NavHold, Targets, VerticalStep, WindRamp,
+                                    apply_event, flap_index_for_cas, merge_guidance)
 from fms_testbed.navigation import make_source
 from fms_testbed.sim.divergence import Divergence
 from fms_testbed.sim.jsbsim_core import RAW, JSBSimAircraft
@@ -187,8 +187,9 @@ class Flight:
         nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
         # hold the navigation errors between updates only when navigation runs slower than
         # guidance
+        sampling = FrameSampling(self.navigation, ac)
         navigate = (NavHold(self.navigation, nav_dt) if nav_dt > dt_outer + 1e-9
-                    else self.navigation.update)
+                    else sampling)
         tg = self.targets
         ini = scn.initial
         if scn.hold:
@@ -207,7 +208,7 @@ class Flight:
         configure = self.config_step
         go_around = (lambda: guide.go_around_active) if hasattr(guide, "go_around_active") \
             else (lambda: False)
-        state, read, run = ac.state, ac.read_raw, ac.run
+        state, read, run = ac.state, ac.read_raw, sampling.run
         raw = read()
         for k in range(n_total + 1):
             s = state(raw)                                  # read

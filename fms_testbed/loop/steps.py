@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.config.scenario import Event, Scenario
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
@@ -140,6 +142,50 @@ class WindRamp:
             w = self.wind_ned
         for node, c in zip(self.nodes, w):
             node.set_double_value(frac * c / FT_M)
+
+
+class FrameSampling:
+    """Run JSBSim frames for a navigation source whose sensors sample every frame.
+
+    :meth:`run` advances the aircraft, reading the source's ``frame_properties`` after each frame
+    (:meth:`~fms_testbed.sim.jsbsim_core.JSBSimAircraft.run_sampled`); calling the object with
+    the true state at a navigation step hands the source the frames since its previous call
+    (``None`` on the first). A source with no frame properties costs one attribute test.
+
+    Parameters
+    ----------
+    source : the navigation source (:class:`~fms_testbed.core.contracts.NavigationSource`)
+    aircraft : the :class:`~fms_testbed.sim.jsbsim_core.JSBSimAircraft` it flies on
+    """
+
+    def __init__(self, source, aircraft):
+        self.source, self.aircraft = source, aircraft
+        props = source.frame_properties
+        self.getters = aircraft.frame_getters(props) if props else ()
+        self.buf = np.empty((64, len(props)))
+        self.n = 0
+        self.first = True
+
+    def run(self, n_frames: int) -> bool:
+        """Advance ``n_frames`` JSBSim frames (sampled when the source asks); False if JSBSim
+        stops."""
+        if not self.getters:
+            return self.aircraft.run(n_frames)
+        if self.n + n_frames > len(self.buf):
+            grown = np.empty((2 * (self.n + n_frames), self.buf.shape[1]))
+            grown[:self.n] = self.buf[:self.n]
+            self.buf = grown
+        ok = self.aircraft.run_sampled(n_frames, self.getters, self.buf[self.n:])
+        self.n += n_frames
+        return ok
+
+    def __call__(self, s: AircraftState) -> NavSolution:
+        """The navigation solution at ``s.t_s`` (the frames are valid only during the call)."""
+        if not self.getters:
+            return self.source.update(s)
+        frames = None if self.first else self.buf[:self.n]
+        self.first, self.n = False, 0
+        return self.source.update(s, frames)
 
 
 class NavHold:

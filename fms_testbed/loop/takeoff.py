@@ -61,8 +61,8 @@ from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.geodesy import inverse
 from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.guidance.lateral import LateralGains, anticipation_m
-from fms_testbed.loop.steps import (POSITIVE_RATE_MPS, ConfigStep, LateralStep, NavHold,
-                                    WindRamp, merge_guidance)
+from fms_testbed.loop.steps import (POSITIVE_RATE_MPS, ConfigStep, FrameSampling, LateralStep,
+                                    NavHold, WindRamp, merge_guidance)
 from fms_testbed.sim.divergence import Divergence
 from fms_testbed.sim.jsbsim_core import RAW
 from fms_testbed.sim.takeoff import ground_start, handover, set_controls
@@ -265,8 +265,9 @@ class TakeoffStart:
         t_wind = None
         nav_spec = flight.scn.navigation_spec
         nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
+        sampling = FrameSampling(flight.navigation, ac)
         navigate = (NavHold(flight.navigation, nav_dt) if nav_dt > flight.dt_outer_s + 1e-9
-                    else flight.navigation.update)   # as the flight loop does
+                    else sampling)   # as the flight loop does
         gear_up = cfg.approach is not None and cfg.approach.fixed_gear
         ap = cfg.approach
         h_accel = ap.acceleration_height_m if ap is not None else ACCEL_HEIGHT_M
@@ -388,7 +389,7 @@ class TakeoffStart:
                     set_controls(ac, elevator=pilot.pitch(
                         dt_c, s.pitch_rad, s.q_rps, fdm["fms/sched/qbar-ratio"],
                         s.cas_mps - v_climb if phase == "climb" else None, s.alpha_rad))
-                if not ac.run(frames):
+                if not sampling.run(frames):
                     flight.status, flight.reason = "diverged", "takeoff: JSBSim stopped"
                     return False
             k += 1

@@ -191,6 +191,9 @@ class AttitudeReferenceNavigation:
     receiver : the GNSS receiver;  flt : the filter
     """
 
+    #: per-frame JSBSim samples the truth side needs (none: it reads the outer-step state)
+    frame_properties: tuple[tuple[str, float], ...] = ()
+
     def __init__(self, errors: FlightTestErrors, receiver: GnssReceiver,
                  flt: AttitudeReferenceFilter):
         self.errors, self.receiver, self.filter = errors, receiver, flt
@@ -230,7 +233,7 @@ class AttitudeReferenceNavigation:
                 return comp
         return None
 
-    def update(self, truth: AircraftState) -> NavSolution:
+    def update(self, truth: AircraftState, frames=None) -> NavSolution:
         """Advance to ``truth.t_s``: truth-side errors, prediction, any delivered GNSS fix
         (gated; then the computer's reset); return the corrected solution."""
         errs, flt = self.errors, self.filter

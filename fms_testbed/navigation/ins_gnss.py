@@ -171,6 +171,9 @@ class InsGnssNavigation:
     fdi : the two-stage identification over the units (None: one unit, or no monitoring)
     """
 
+    #: per-frame JSBSim samples the truth side needs (none: it reads the outer-step state)
+    frame_properties: tuple[tuple[str, float], ...] = ()
+
     def __init__(self, bank: InsBank, receiver: GnssReceiver, baro: BaroAltimeter | None,
                  filters: list[InsGnssFilter], alert_delay_s: float = DEFAULT_ALERT_DELAY_S,
                  fdi: TwoStageFdi | None = None):
@@ -286,7 +289,7 @@ class InsGnssNavigation:
         if boundary or full:
             iv.flush(ins, truth)
 
-    def update(self, truth: AircraftState) -> NavSolution:
+    def update(self, truth: AircraftState, frames=None) -> NavSolution:
         """Advance to ``truth.t_s``: INS, prediction, GNSS (feedback), baro, identification;
         return the output."""
         ins = self.bank.update(truth)

@@ -141,6 +141,9 @@ def output_solution(t_s: float, o: np.ndarray, errors: dict | None = None) -> Na
 class SinsNavigation:
     """Navigation source with SINS errors; see the module docstring for the scenario keys."""
 
+    #: per-frame JSBSim samples the truth side needs (none: it reads the outer-step state)
+    frame_properties: tuple[tuple[str, float], ...] = ()
+
     def __init__(self, imu: ImuModel, seed: int = 0, opts: SinsOptions = SinsOptions(),
                  dt_s: float = 0.1, matrices_dt_s: float = 0.0,
                  matrices_rotation_deg: float = 1e9):
@@ -271,7 +274,7 @@ class SinsNavigation:
             self._held = (prev.t_s, dt, phi, L)
             self._turned_rad = 0.0
 
-    def update(self, truth: AircraftState) -> NavSolution:
+    def update(self, truth: AircraftState, frames=None) -> NavSolution:
         """Advance the error state to ``truth.t_s`` and return truth ⊕ errors."""
         self.advance(truth)
         return self.solution(truth)

@@ -26,7 +26,8 @@ from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.core.errors import TrimError, UserError
 from fms_testbed.sim.inner_loops import gain_properties, system_xml
 from fms_testbed.core.state import AircraftState
-from fms_testbed.core.units import DEG_RAD, FT_M, KT_MPS, LBF_N, SLUG_KG, mps_to_kmh
+from fms_testbed.core.units import (DEG_RAD, FT_M, KT_MPS, LBF_N, PSF_PA, RANKINE_K, SLUG_KG,
+                                    mps_to_kmh)
 
 log = logging.getLogger("fms_testbed.jsbsim")
 
@@ -227,6 +228,8 @@ _READ = {  # state field -> (property, scale)
     "wow": ("gear/wow", 1.0),
     "flap_pos_norm": ("fcs/flap-pos-norm", 1.0),
     "gear_pos_norm": ("gear/gear-pos-norm", 1.0),
+    "p_static_pa": ("atmosphere/P-psf", PSF_PA),
+    "t_static_k": ("atmosphere/T-R", RANKINE_K),
 }
 
 
@@ -257,7 +260,8 @@ RAW = {k: i for i, k in enumerate(_READ)}
 _STATE_ORDER = ("t_s", "lat_deg", "lon_deg", "alt_m", "agl_m", "tas_mps", "cas_mps", "gs_mps",
                 "vs_mps", "vn", "ve", "vd", "roll_rad", "pitch_rad", "heading_rad", "track_rad",
                 "alpha_rad", "beta_rad", "gamma_rad", "p_rps", "q_rps", "r_rps", "weight_lbs",
-                "fx", "fy", "fz", "mach", "throttle", "mass_kg")
+                "fx", "fy", "fz", "mach", "throttle", "mass_kg", "elevator", "aileron", "rudder",
+                "wow", "flap_pos_norm", "gear_pos_norm", "p_static_pa", "t_static_k")
 
 
 class JSBSimAircraft:
@@ -489,6 +493,33 @@ class JSBSimAircraft:
                 return False
         return True
 
+    def frame_getters(self, properties) -> tuple:
+        """Cached getters for ``(property, scale to SI)`` pairs, for :meth:`run_sampled`.
+
+        Raises
+        ------
+        UserError
+            When the model lacks one of the properties (named)."""
+        pm = self.fdm.get_property_manager()
+        nodes = [(pm.get_node(p, False), p) for p, _ in properties]
+        missing = [p for n, p in nodes if n is None]
+        if missing:
+            raise UserError(f"{self.cfg.jsbsim_model}: JSBSim properties missing: {missing}")
+        return tuple((n.get_double_value, float(sc)) for (n, _), (_, sc) in zip(nodes, properties))
+
+    def run_sampled(self, n_steps: int, getters: tuple, out: np.ndarray) -> bool:
+        """Advance ``n_steps`` frames, reading ``getters`` (:meth:`frame_getters`) after each
+        one into row ``i`` of ``out`` (shape at least ``(n_steps, len(getters))``, SI); return
+        False if JSBSim stops (the rows after the stop are left as they were)."""
+        run = self.fdm.run
+        for i in range(n_steps):
+            if not run():
+                return False
+            row = out[i]
+            for j, (g, sc) in enumerate(getters):
+                row[j] = g() * sc
+        return True
+
     def read_raw(self) -> list[float]:
         """Read every property of ``_READ`` through its cached node, in JSBSim's units, in
         ``_READ`` order (index with :data:`RAW`); the hot path's one read per outer step."""
@@ -498,7 +529,7 @@ class JSBSimAircraft:
         """Return the true state as an :class:`AircraftState` (SI) from a :meth:`read_raw`
         list (read now when ``raw`` is None)."""
         (t, lat, lon, h, agl, vt, vc, vg, hdot, vn, ve, vd, phi, theta, psi, trk, alpha, beta,
-         gamma, p, q, r, w_lbs, fx, fy, fz, mach, thr, m_slug, *_rest) = (
+         gamma, p, q, r, w_lbs, fx, fy, fz, mach, thr, m_slug, _e, _a, _r, _w, _f, _g, ps, ts) = (
             raw if raw is not None else self.read_raw())
         rad = DEG_RAD
         k = LBF_N / (m_slug * SLUG_KG)
@@ -509,4 +540,4 @@ class JSBSimAircraft:
             t, lat * rad, lon * rad, h * FT_M, vt * FT_M, vc * KT_MPS, vg * FT_M, hdot * FT_M,
             np.array((ve * FT_M, vn * FT_M, -vd * FT_M)), phi, theta, psi, trk, alpha, beta, gamma,
             p, q, r, nx, ny, np.array((fx * k, fy * k, fz * k)), mach, agl * FT_M, thr,
-            m_slug * SLUG_KG)
+            m_slug * SLUG_KG, ps * PSF_PA, ts * RANKINE_K)
