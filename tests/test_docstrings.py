@@ -28,7 +28,7 @@ MODULES = [
     # the strapdown IMU and INS
     "sensors.imu.kinematics", "sensors.imu.synthesis", "sensors.imu.errors",
     "navigation.bank", "navigation.inertial.strapdown", "navigation.inertial.alignment",
-    "navigation.inertial.bank",
+    "navigation.inertial.bank", "navigation.inertial.twin",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")

@@ -31,7 +31,7 @@ State of one unit (:data:`N_ERR` floats): 0:6 b_on, 6:12 b_gm, 12:18 b_rw, 18:24
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -280,6 +280,20 @@ class ImuErrors:
             self._noise_scale[unit, k:k + 3] *= float(factor)
         self._coef = None
         return excess
+
+    def make_deterministic(self) -> None:
+        """Freeze every unit's realisation from now on: the in-run bias parts fold into the
+        turn-on constants, and there is no white noise, no slow-state noise or decay, and no
+        quantisation (for comparisons with the same realisation in another model)."""
+        self.E[:, _ON:_ON + 6] += self.E[:, _GM:_GM + 6] + self.E[:, _RW:_RW + 6]
+        self.E[:, _GM:_SF] = 0.0
+        self.params = [replace(p, white_psd=np.zeros(6), lsb=np.zeros(6), gm_sd=np.zeros(6),
+                               gm_tau_s=np.full(6, math.inf), rw_psd=np.zeros(6),
+                               sf_tau_s=np.full(6, math.inf), mis_tau_s=np.full(12, math.inf))
+                       for p in self.params]
+        self.lsb[:] = 0.0
+        self.res[:] = 0.0
+        self._coef = self._white = None
 
     def values(self, unit: int) -> np.ndarray:
         """Unit ``unit``'s error state (36,), a copy (SI; see the module docstring)."""
