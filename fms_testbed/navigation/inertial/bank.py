@@ -24,7 +24,9 @@ import numpy as np
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import DPH_RPS, G0_MPS2
 from fms_testbed.navigation.inertial.alignment import ALIGNMENTS, align, initial_errors_applied
-from fms_testbed.navigation.inertial.strapdown import (N_OUT, bank_step, correct_row, nav_errors,
+from fms_testbed.navigation.inertial.strapdown import (N_OUT, N_T, N_U, T_MEAN, U_A, U_COMP, U_E,
+                                                       U_LSB, U_MEAN, U_RES, U_S, U_W, U_WSD,
+                                                       bank_step, correct_row, nav_errors,
                                                        output_row, outputs)
 from fms_testbed.sensors.imu.errors import (N_SLOW, ImuErrorParams, ImuErrors, imu_error_params,
                                             layout_33)
@@ -83,12 +85,18 @@ class StrapdownBank:
         self.heading_sigma_rad = math.radians(heading_sigma_deg)
         n = len(seeds)
         self.rows: np.ndarray | None = None           # the units' states
-        self.truth_row: np.ndarray | None = None      # the IMU's error-free state
-        self.comp = np.zeros((n, 6))                  # bias compensation fed back (b_a, b_g)
+        # one array for the kernel; the IMU's errors, the compensation and the means are views
+        self.U = np.zeros((n, N_U))
+        self.U[:, U_E:U_A] = self.imu.E
+        self.imu.E = self.U[:, U_E:U_A]
+        self.imu.res = self.U[:, U_RES:U_COMP]
+        self.comp = self.U[:, U_COMP:U_MEAN]          # bias compensation fed back (b_a, b_g)
+        self.mean = self.U[:, U_MEAN:U_W]             # f̄, ω̄ of the last step (compensated)
+        self.last_w = self.U[:, U_W:]                 # compensated rate of the last frame
+        self.T = np.zeros(N_T)                        # the IMU's error-free state and means
+        self.truth_row = self.T[:T_MEAN]
+        self.true_mean = self.T[T_MEAN:]
         self.fed_back = np.zeros((n, 15))
-        self.mean = np.zeros((n, 6))                  # f̄, ω̄ of the last step (compensated)
-        self.true_mean = np.zeros(6)                  # the same of the error-free increments
-        self.last_w = np.zeros((n, 3))                # compensated rate of the last frame
         self.stuck: dict[int, NavSolution] = {}
         self._out = np.zeros((n, N_OUT))
         self._truth: AircraftState | None = None
@@ -96,6 +104,7 @@ class StrapdownBank:
         self._wpos = 0
         self._slow = np.zeros((0, n, N_SLOW))
         self._spos = 0
+        self._coef_key: tuple | None = None
 
     def __len__(self) -> int:
         return len(self.params)
@@ -121,9 +130,22 @@ class StrapdownBank:
         return self._white, w0, zs
 
     # -- stepping ---------------------------------------------------------------------------
+    def _coefficients(self, step_s: float, frame_s: float) -> None:
+        """Refresh the kernel's copies of the slow states' one-step a, s, the white σ per frame
+        and the quanta when the step, the frame time or the IMU's parameters changed."""
+        key = (step_s, frame_s, self.imu.version)
+        if key == self._coef_key:
+            return
+        a, s = self.imu.coefficients(step_s)
+        self.U[:, U_A:U_S] = a
+        self.U[:, U_S:U_WSD] = s
+        self.U[:, U_WSD:U_LSB] = self.imu.white_sd(frame_s)
+        self.U[:, U_LSB:U_RES] = self.imu.lsb
+        self._coef_key = key
+
     def _start(self, truth: AircraftState) -> None:
         """Start the IMU at ``truth`` and align every unit."""
-        self.truth_row = start_row(truth, self.lever)
+        self.truth_row[:] = start_row(truth, self.lever)
         rows = []
         for i, s in enumerate(self.seeds):
             rng = np.random.default_rng(np.random.SeedSequence([s, 1]))
@@ -151,16 +173,16 @@ class StrapdownBank:
             dt = (truth.t_s - self._truth.t_s) / n_f
             if dt <= 0.0:
                 raise ValueError(f"StrapdownBank.update: time did not advance ({truth.t_s} s)")
-            a, s = self.imu.coefficients(n_f * dt)
+            self._coefficients(n_f * dt, dt)
             white, w0, zs = self._noise(n_f)
             self._out = np.empty((len(self), N_OUT))
-            bank_step(np.ascontiguousarray(frames), dt, self.lever, self.use_rates,
-                      self.truth_row, self.rows, self.imu.E, a, s, zs, self.imu.white_sd(dt),
-                      white, w0, self.imu.lsb, self.imu.res, self.comp, self.mean, self.true_mean,
-                      self.last_w, self._out)
+            bank_step(frames if frames.flags.c_contiguous else np.ascontiguousarray(frames), dt,
+                      self.lever, self.use_rates, self.T, self.rows, self.U, zs, white, w0,
+                      self._out)
         self._truth = truth
         t = truth.t_s
-        out = [_solution(t, o) for o in self._out]
+        o = self._out
+        out = [NavSolution(t, *r[:3], o[i, 3:6], *r[6:], {}) for i, r in enumerate(o.tolist())]
         for i, held in self.stuck.items():
             out[i] = replace(held, t_s=t)
         return out

@@ -90,43 +90,54 @@ def outputs(rows, lever, w_ib, out):
         output_row(rows[i], lever, w_ib[i], out[i])
 
 
+U_E, U_A, U_S, U_WSD, U_LSB, U_RES, U_COMP, U_MEAN, U_W, N_U = (0, 36, 66, 96, 102, 108, 114,
+                                                                120, 126, 129)
+"""Column blocks of the per-unit array of :func:`bank_step` (one row per unit): sensor errors
+(36), their one-step a and s (30 each), white σ per frame (6), quanta (6), quantisation residues
+(6), bias compensation b̂_a m/s², b̂_g rad/s (6), step-mean f̄ m/s², ω̄ rad/s (6), the last frame's
+compensated rate rad/s (3)."""
+T_MEAN, N_T = 22, 28
+"""The truth array of :func:`bank_step`: the IMU's error-free state row (22), then its
+step-mean f̄, ω̄ (6)."""
+
+
 @njit(cache=True)
-def bank_step(frames, dt, lever, use_rates, truth_row, rows, E, a, s, zslow, white_sd,
-              zwhite, w0, lsb, res, comp, mean, tmean, last_w, out):
+def bank_step(frames, dt, lever, use_rates, T, rows, U, zslow, zwhite, w0, out):
     """One navigation step of every unit (module docstring).
 
     frames (n_f, ≥6): the step's JSBSim samples; dt: frame time, s; lever (3,) m; use_rates:
-    frames carry body rates; truth_row: the IMU's error-free state (advanced); rows (n, NS):
-    the units' states (advanced); E (n, 36) sensor errors, a and s (n, 30) their one-step
-    discretisation, zslow (n, 30) standard normals; white_sd (n, 6) white σ per frame, zwhite
-    (n, ≥w0+n_f, 6) standard normals from row w0; lsb, res (n, 6) quantisation; comp (n, 6)
-    bias compensation (b̂_a m/s², b̂_g rad/s); mean (n, 6) set to f̄ m/s², ω̄ rad/s; tmean (6,)
-    set to the same of the error-free increments; last_w (n, 3) set to the compensated rate of
-    the last frame, rad/s (the outputs' lever-arm velocity); out (n, 9) set to the outputs."""
-    advance_slow(E, a, s, zslow)
+    frames carry body rates; T (:data:`N_T`,): the IMU's error-free state and step means
+    (advanced); rows (n, NS): the units' states (advanced); U (n, :data:`N_U`): the units'
+    sensor errors, coefficients, compensation and means (read and updated); zslow (n, 30)
+    standard normals of the slow states; zwhite (n, ≥w0+n_f, 6) standard normals from row w0;
+    out (n, 9) set to the outputs."""
+    advance_slow(U, U[:, U_A:U_S], U[:, U_S:U_WSD], zslow)
     n_u = rows.shape[0]
-    mean[:, :] = 0.0
-    tmean[:] = 0.0
+    U[:, U_MEAN:U_W] = 0.0
+    T[T_MEAN:] = 0.0
     for j in range(frames.shape[0]):
-        v, q = imu_point(frames[j], lever, use_rates, truth_row[0], truth_row[2])
-        dth, dv = inverse_step(truth_row, v, q, dt)
+        v, q = imu_point(frames[j], lever, use_rates, T[0], T[2])
+        dth, dv = inverse_step(T, v, q, dt)
         for c in range(3):
-            tmean[c] += dv[c]
-            tmean[3 + c] += dth[c]
+            T[T_MEAN + c] += dv[c]
+            T[T_MEAN + 3 + c] += dth[c]
         for i in range(n_u):
-            mth, mv = measure_quantised(E[i], dth, dv, dt, white_sd[i], zwhite[i, w0 + j], lsb[i],
-                                         res[i])
-            cth = (mth[0] - comp[i, 3] * dt, mth[1] - comp[i, 4] * dt, mth[2] - comp[i, 5] * dt)
-            cv = (mv[0] - comp[i, 0] * dt, mv[1] - comp[i, 1] * dt, mv[2] - comp[i, 2] * dt)
+            u = U[i]
+            mth, mv = measure_quantised(u[U_E:U_A], dth, dv, dt, u[U_WSD:U_LSB],
+                                        zwhite[i, w0 + j], u[U_LSB:U_RES], u[U_RES:U_COMP])
+            cth = (mth[0] - u[U_COMP + 3] * dt, mth[1] - u[U_COMP + 4] * dt,
+                   mth[2] - u[U_COMP + 5] * dt)
+            cv = (mv[0] - u[U_COMP] * dt, mv[1] - u[U_COMP + 1] * dt, mv[2] - u[U_COMP + 2] * dt)
             forward_step(rows[i], cth, cv, dt)
             for c in range(3):
-                mean[i, c] += cv[c]
-                mean[i, 3 + c] += cth[c]
-                last_w[i, c] = cth[c] / dt
-    T = frames.shape[0] * dt
-    mean /= T
-    tmean /= T
-    outputs(rows, lever, last_w, out)
+                u[U_MEAN + c] += cv[c]
+                u[U_MEAN + 3 + c] += cth[c]
+                u[U_W + c] = cth[c] / dt
+    rT = 1.0 / (frames.shape[0] * dt)
+    U[:, U_MEAN:U_W] *= rT
+    for c in range(6):
+        T[T_MEAN + c] *= rT
+    outputs(rows, lever, U[:, U_W:N_U], out)
 
 
 @njit(cache=True)
@@ -190,5 +201,6 @@ def nav_errors(out_ind, q_ind, lat, lon, alt, v_enu, q_true, err):
     err[6], err[7], err[8] = -r[1], -r[0], r[2]
 
 
-__all__ = ["N_OUT", "bank_step", "cg_state", "correct_row", "mechanise", "nav_errors", "output_row",
+__all__ = ["N_OUT", "N_T", "N_U", "T_MEAN", "U_A", "U_COMP", "U_E", "U_LSB", "U_MEAN",
+           "U_RES", "U_S", "U_W", "U_WSD", "bank_step", "cg_state", "correct_row", "mechanise", "nav_errors", "output_row",
            "outputs"]

@@ -205,8 +205,8 @@ def measure_quantised(e, dth, dv, dt, white_sd, z, lsb, res):
 
 @njit(cache=True)
 def advance_slow(E, a, s, z):
-    """Advance every unit's slow states over one navigation step: E[i, 6:] ← a[i] E[i, 6:] +
-    s[i] z[i] (E (n, 36), a and s (n, 30), z (n, 30) standard normals)."""
+    """Advance every unit's slow states over one navigation step: E[i, 6:36] ← a[i] E[i, 6:36]
+    + s[i] z[i] (E (n, ≥36), a and s (n, 30), z (n, 30) standard normals)."""
     for i in range(E.shape[0]):
         for k in range(N_SLOW):
             E[i, 6 + k] = a[i, k] * E[i, 6 + k] + s[i, k] * z[i, k]
@@ -237,6 +237,7 @@ class ImuErrors:
         self._noise_scale = np.ones((len(params), N_SLOW))   # a drift_scale fault raises it
         self._coef: tuple | None = None
         self._white: tuple | None = None
+        self.version = 0              # raised whenever a parameter or a noise scale changes
 
     def __len__(self) -> int:
         return len(self.params)
@@ -279,6 +280,7 @@ class ImuErrors:
         for k in (_GM - 6 + 3, _RW - 6 + 3):            # gyro columns of the slow block
             self._noise_scale[unit, k:k + 3] *= float(factor)
         self._coef = None
+        self.version += 1
         return excess
 
     def make_deterministic(self) -> None:
@@ -294,6 +296,7 @@ class ImuErrors:
         self.lsb[:] = 0.0
         self.res[:] = 0.0
         self._coef = self._white = None
+        self.version += 1
 
     def values(self, unit: int) -> np.ndarray:
         """Unit ``unit``'s error state (36,), a copy (SI; see the module docstring)."""
@@ -304,6 +307,7 @@ class ImuErrors:
         self.params[unit] = params
         self.lsb[unit] = params.lsb
         self._coef = self._white = None
+        self.version += 1
 
 
 __all__ = ["ImuErrorParams", "ImuErrors", "imu_error_params", "layout_33", "measure",
