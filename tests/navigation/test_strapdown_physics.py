@@ -107,7 +107,7 @@ def test_gnss_heading_start_levels_on_the_accelerometers():
 def test_free_inertial_oscillates_with_the_schuler_period():
     """At rest, an initial north velocity error of 0.1 m/s: the north position error crosses
     zero every π/ω_s, ω_s = √(g/R), R = √(M N) (84.4 min period); the vertical channel is held
-    by correcting its error each step (a perfect baro)."""
+    by the third-order baro loop on an exact baro."""
     truth = recorded_flight(60.0)[0][0]
     from dataclasses import replace
     rest = replace(truth, v_enu_mps=np.zeros(3), p_rps=0.0, q_rps=0.0, r_rps=0.0)
@@ -118,11 +118,11 @@ def test_free_inertial_oscillates_with_the_schuler_period():
     t, north = [], []
     for k in range(1, int(2.2 * 3600 * 10)):
         bank.update(replace(rest, t_s=rest.t_s + 0.1 * k), frames)
+        if k % 10 == 0:                                      # a baro reading a second
+            bank.aid_vertical(rest.alt_m, 1.0)
         if k % 5 == 0:
-            e = bank.errors(0)
-            bank.correct(0, np.r_[0.0, 0.0, e[2], 0.0, 0.0, e[5], np.zeros(9)])
             t.append(0.1 * k)
-            north.append(e[1])
+            north.append(bank.errors(0)[1])
     t, north = np.array(t), np.array(north)
     assert np.max(np.abs(north)) == pytest.approx(0.1 / 1.24e-3, rel=0.05)   # δv0/ω_s
     s = np.sign(north)
@@ -133,6 +133,30 @@ def test_free_inertial_oscillates_with_the_schuler_period():
     assert len(zeros) >= 3
     assert np.diff(zeros) == pytest.approx(math.pi / w_s, rel=2e-3)
     assert 2 * math.pi / w_s / 60 == pytest.approx(84.4, abs=0.2)
+
+
+def test_free_vertical_channel_diverges_at_the_closed_form_rate_and_the_baro_loop_holds_it():
+    """At rest, 1 m initial height error: free, h_err = cosh(ω_v t), ω_v = √(2γ/R) (e-folding
+    570 s); with the third-order baro loop (τ 60 s) it decays."""
+    truth = recorded_flight(60.0)[0][0]
+    from dataclasses import replace
+    rest = replace(truth, v_enu_mps=np.zeros(3), p_rps=0.0, q_rps=0.0, r_rps=0.0)
+    frames = np.tile(sample_of(rest)[:6], (12, 1))
+    free, aided = StrapdownBank([{}], [1]), StrapdownBank([{}], [1])
+    for b in (free, aided):
+        b.update(rest)
+        b.correct(0, np.r_[0.0, 0.0, -1.0, np.zeros(12)])
+    for k in range(1, 12001):
+        r = replace(rest, t_s=rest.t_s + 0.1 * k)
+        free.update(r, frames)
+        aided.update(r, frames)
+        if k % 10 == 0:
+            aided.aid_vertical(rest.alt_m, 1.0)
+    rm, rn = radii_m(rest.lat_rad)
+    w_v = math.sqrt(2 * normal_gravity_mps2(rest.lat_rad, rest.alt_m) / math.sqrt(rm * rn))
+    assert free.errors(0)[2] == pytest.approx(math.cosh(w_v * 1200.0), rel=0.02)
+    assert 1 / w_v == pytest.approx(570, rel=0.01)
+    assert abs(aided.errors(0)[2]) < 1e-3
 
 
 def _same_realisation(preset, seed, calls):

@@ -27,7 +27,8 @@ from fms_testbed.navigation.inertial.alignment import ALIGNMENTS, align, initial
 from fms_testbed.navigation.inertial.strapdown import (N_OUT, N_T, N_U, T_MEAN, U_A, U_COMP, U_E,
                                                        U_LSB, U_MEAN, U_RES, U_S, U_W, U_WSD,
                                                        bank_step, correct_row, nav_errors,
-                                                       output_row, outputs)
+                                                       output_row, outputs, vertical_aid,
+                                                       vertical_gains)
 from fms_testbed.sensors.imu.errors import (N_SLOW, ImuErrorParams, ImuErrors, imu_error_params,
                                             layout_33)
 from fms_testbed.core.earth import earth_rate_ned
@@ -105,6 +106,8 @@ class StrapdownBank:
         self._slow = np.zeros((0, n, N_SLOW))
         self._spos = 0
         self._coef_key: tuple | None = None
+        self._vgain: tuple | None = None              # (τ s, k1, k2, k3) of the baro loop
+        self._vacc = np.zeros((n, 1))                 # its acceleration corrections, m/s²
 
     def __len__(self) -> int:
         return len(self.params)
@@ -219,6 +222,21 @@ class StrapdownBank:
         step: ΣΔv_c / T, ΣΔθ_c / T (before the first step: no force and the true rate
         ω_eb + C_n^b ω_ie^n of the start)."""
         return self.mean[i, :3].copy(), self.mean[i, 3:].copy()
+
+    def aid_vertical(self, alt_m, dt_s: float, tau_s: float = 60.0) -> None:
+        """Damp every unit's vertical channel with a baro altitude: one step of a third-order
+        loop (:func:`~.strapdown.vertical_gains`, poles at -1/``tau_s``) on the error between
+        each unit's indicated altitude and ``alt_m`` (m, the package's sea-level datum; a
+        scalar or one per unit) over ``dt_s`` (s, the time since the last reading). Not for a
+        unit under a filter that already uses the baro."""
+        if self._vgain is None or self._vgain[0] != tau_s:
+            self._vgain = (tau_s, *vertical_gains(tau_s, float(self.rows[0, 0])))
+        k1, k2, k3 = self._vgain[1:]
+        alt = np.broadcast_to(np.asarray(alt_m, float), (len(self),))
+        for i in range(len(self)):
+            o = np.empty(N_OUT)
+            output_row(self.rows[i], self.lever, self.last_w[i], o)
+            vertical_aid(self.rows[i], o[2] - alt[i], k1, k2, k3, self._vacc[i], dt_s)
 
     def sensor_errors(self, truth: AircraftState, dt_s: float) -> np.ndarray:
         """(n, 6) each unit's raw IMU output minus the error-free one, averaged over the last

@@ -187,6 +187,33 @@ def correct_row(row, dx, lever, w_ib):
         row[6 + j] = q_imu[j]
 
 
+def vertical_gains(tau_s: float, lat_rad: float = 0.0) -> tuple[float, float, float]:
+    """Gains (k1 1/s, k2 1/s², k3 1/s³) of a third-order baro loop with all three poles at
+    -1/τ: the aided vertical channel h' = -v_D - k1 e, v_D' = ... + k2 e + a_c, a_c' = k3 e
+    (e = h_ind - h_baro) has the characteristic polynomial s³ + k1 s² + (k2 - ω_v²) s + k3 =
+    (s + 1/τ)³, ω_v² = 2γ/R the free channel's instability (γ normal gravity, R = √(M N))."""
+    from fms_testbed.core.earth import normal_gravity_mps2
+    rm, rn = radii_m(lat_rad)
+    wv2 = 2.0 * normal_gravity_mps2(lat_rad, 0.0) / math.sqrt(rm * rn)
+    w = 1.0 / tau_s
+    return 3.0 * w, 3.0 * w * w + wv2, w ** 3
+
+
+@njit(cache=True)
+def vertical_aid(row, e_m, k1, k2, k3, acc, dt):
+    """One step (Δt s) of the third-order baro loop (:func:`vertical_gains`) on a unit's
+    state row, in place: e_m = h_ind - h_baro (m); acc (1,) the loop's vertical-acceleration
+    correction a_c (m/s², down positive, updated). The extrapolation history moves with the
+    state."""
+    acc[0] += k3 * e_m * dt
+    dh = -k1 * e_m * dt
+    dv = (k2 * e_m + acc[0]) * dt
+    row[2] += dh
+    row[17] += dh
+    row[5] += dv
+    row[20] += dv
+
+
 @njit(cache=True)
 def nav_errors(out_ind, q_ind, lat, lon, alt, v_enu, q_true, err):
     """Navigation errors, indicated minus true, into err (9,): δp E, N, U m, δV E, N, U m/s, ε
@@ -201,6 +228,6 @@ def nav_errors(out_ind, q_ind, lat, lon, alt, v_enu, q_true, err):
     err[6], err[7], err[8] = -r[1], -r[0], r[2]
 
 
-__all__ = ["N_OUT", "N_T", "N_U", "T_MEAN", "U_A", "U_COMP", "U_E", "U_LSB", "U_MEAN",
+__all__ = ["vertical_aid", "vertical_gains", "N_OUT", "N_T", "N_U", "T_MEAN", "U_A", "U_COMP", "U_E", "U_LSB", "U_MEAN",
            "U_RES", "U_S", "U_W", "U_WSD", "bank_step", "cg_state", "correct_row", "mechanise", "nav_errors", "output_row",
            "outputs"]
