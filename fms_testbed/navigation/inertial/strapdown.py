@@ -31,7 +31,8 @@ import numpy as np
 from numba import njit
 
 from fms_testbed.core.earth import earth_rate_ned, radii_m, sea_level_height_m
-from fms_testbed.sensors.imu.errors import advance_slow, measure_quantised
+from fms_testbed.sensors.imu.errors import (N_ROW, ROW_A, ROW_E, ROW_LSB, ROW_RES, ROW_S,
+                                            ROW_WSD, advance_slow, measure_row)
 from fms_testbed.sensors.imu.kinematics import (cross3, forward_step, inverse_step, qconj, qmul,
                                                 qnormalize, qrot, quat_to_euler, quat_to_rotvec,
                                                 rotvec_to_quat)
@@ -90,12 +91,13 @@ def outputs(rows, lever, w_ib, out):
         output_row(rows[i], lever, w_ib[i], out[i])
 
 
-U_E, U_A, U_S, U_WSD, U_LSB, U_RES, U_COMP, U_MEAN, U_W, N_U = (0, 36, 66, 96, 102, 108, 114,
-                                                                120, 126, 129)
-"""Column blocks of the per-unit array of :func:`bank_step` (one row per unit): sensor errors
-(36), their one-step a and s (30 each), white σ per frame (6), quanta (6), quantisation residues
-(6), bias compensation b̂_a m/s², b̂_g rad/s (6), step-mean f̄ m/s², ω̄ rad/s (6), the last frame's
-compensated rate rad/s (3)."""
+U_E, U_A, U_S, U_WSD, U_LSB, U_RES = ROW_E, ROW_A, ROW_S, ROW_WSD, ROW_LSB, ROW_RES
+U_COMP, U_MEAN, U_W, N_U = N_ROW, N_ROW + 6, N_ROW + 12, N_ROW + 15
+"""Column blocks of the per-unit array of :func:`bank_step` (one row per unit): the sensor row
+of :data:`fms_testbed.sensors.imu.errors.ROW_E` (errors 36, their one-step a and s 30 each,
+white σ per frame 6, quanta 6, quantisation residues 6), then the bias compensation b̂_a m/s²,
+b̂_g rad/s (6), the step-mean f̄ m/s², ω̄ rad/s (6), the last frame's compensated rate rad/s
+(3)."""
 T_MEAN, N_T = 22, 28
 """The truth array of :func:`bank_step`: the IMU's error-free state row (22), then its
 step-mean f̄, ω̄ (6)."""
@@ -123,8 +125,7 @@ def bank_step(frames, dt, lever, use_rates, T, rows, U, zslow, zwhite, w0, out):
             T[T_MEAN + 3 + c] += dth[c]
         for i in range(n_u):
             u = U[i]
-            mth, mv = measure_quantised(u[U_E:U_A], dth, dv, dt, u[U_WSD:U_LSB],
-                                        zwhite[i, w0 + j], u[U_LSB:U_RES], u[U_RES:U_COMP])
+            mth, mv = measure_row(u, dth, dv, dt, zwhite[i], w0 + j)
             cth = (mth[0] - u[U_COMP + 3] * dt, mth[1] - u[U_COMP + 4] * dt,
                    mth[2] - u[U_COMP + 5] * dt)
             cv = (mv[0] - u[U_COMP] * dt, mv[1] - u[U_COMP + 1] * dt, mv[2] - u[U_COMP + 2] * dt)
@@ -188,10 +189,16 @@ def correct_row(row, dx, lever, w_ib):
 
 
 def vertical_gains(tau_s: float, lat_rad: float = 0.0) -> tuple[float, float, float]:
-    """Gains (k1 1/s, k2 1/s², k3 1/s³) of a third-order baro loop with all three poles at
+    """Gains (k1 1/s, k2 1/s², k3 1/s³) of a third-order baro loop with its three poles at
     -1/τ: the aided vertical channel h' = -v_D - k1 e, v_D' = ... + k2 e + a_c, a_c' = k3 e
     (e = h_ind - h_baro) has the characteristic polynomial s³ + k1 s² + (k2 - ω_v²) s + k3 =
-    (s + 1/τ)³, ω_v² = 2γ/R the free channel's instability (γ normal gravity, R = √(M N))."""
+    (s + 1/τ)³, ω_v² = 2γ/R the free channel's instability (γ normal gravity, R = √(M N)).
+
+    Parameters
+    ----------
+    tau_s : the loop's time constant τ, s
+    lat_rad : latitude where γ and R are taken, rad
+    """
     from fms_testbed.core.earth import normal_gravity_mps2
     rm, rn = radii_m(lat_rad)
     wv2 = 2.0 * normal_gravity_mps2(lat_rad, 0.0) / math.sqrt(rm * rn)

@@ -189,6 +189,40 @@ def measure(e, dth, dv, dt, white_sd, z):
     return (mt0, mt1, mt2), (mv0, mv1, mv2)
 
 
+ROW_E, ROW_A, ROW_S, ROW_WSD, ROW_LSB, ROW_RES, N_ROW = 0, 36, 66, 96, 102, 108, 114
+"""A unit's sensor row as one array (what a compiled caller packs per unit): the error state
+(36), the slow states' one-step a and s (30 each), white σ per increment (6), quanta (6),
+quantisation residues (6)."""
+
+
+@njit(cache=True, inline="always")
+def measure_row(u, dth, dv, dt, z, k):
+    """:func:`measure` then :func:`quantise` per channel for a unit whose sensor row (layout
+    :data:`ROW_E`..) is ``u``; z (m, 6) standard normals, row k used (accelerometer channels
+    0..2, gyro 3..5; the residues in ``u`` updated)."""
+    e = u
+    ga = _gamma(dv, e[24], e[25], e[26], e[27], e[28], e[29])
+    gg = _gamma(dth, e[30], e[31], e[32], e[33], e[34], e[35])
+    out = (dv[0] + (e[0] + e[6] + e[12]) * dt + e[18] * dv[0] + ga[0],
+           dv[1] + (e[1] + e[7] + e[13]) * dt + e[19] * dv[1] + ga[1],
+           dv[2] + (e[2] + e[8] + e[14]) * dt + e[20] * dv[2] + ga[2],
+           dth[0] + (e[3] + e[9] + e[15]) * dt + e[21] * dth[0] + gg[0],
+           dth[1] + (e[4] + e[10] + e[16]) * dt + e[22] * dth[1] + gg[1],
+           dth[2] + (e[5] + e[11] + e[17]) * dt + e[23] * dth[2] + gg[2])
+    y0, u[ROW_RES] = quantise(out[0] + u[ROW_WSD] * z[k, 0], u[ROW_LSB], u[ROW_RES])
+    y1, u[ROW_RES + 1] = quantise(out[1] + u[ROW_WSD + 1] * z[k, 1], u[ROW_LSB + 1],
+                                  u[ROW_RES + 1])
+    y2, u[ROW_RES + 2] = quantise(out[2] + u[ROW_WSD + 2] * z[k, 2], u[ROW_LSB + 2],
+                                  u[ROW_RES + 2])
+    y3, u[ROW_RES + 3] = quantise(out[3] + u[ROW_WSD + 3] * z[k, 3], u[ROW_LSB + 3],
+                                  u[ROW_RES + 3])
+    y4, u[ROW_RES + 4] = quantise(out[4] + u[ROW_WSD + 4] * z[k, 4], u[ROW_LSB + 4],
+                                  u[ROW_RES + 4])
+    y5, u[ROW_RES + 5] = quantise(out[5] + u[ROW_WSD + 5] * z[k, 5], u[ROW_LSB + 5],
+                                  u[ROW_RES + 5])
+    return (y3, y4, y5), (y0, y1, y2)
+
+
 @njit(cache=True, inline="always")
 def measure_quantised(e, dth, dv, dt, white_sd, z, lsb, res):
     """:func:`measure` then :func:`quantise` per channel (lsb (6,) quanta, res (6,) residues,
@@ -311,6 +345,7 @@ class ImuErrors:
 
 
 __all__ = ["ImuErrorParams", "ImuErrors", "imu_error_params", "layout_33", "measure",
-           "measure_quantised", "quantise",
+           "measure_quantised", "measure_row", "quantise", "ROW_E", "ROW_A", "ROW_S", "ROW_WSD",
+           "ROW_LSB", "ROW_RES", "N_ROW",
            "advance_slow", "N_ERR", "N_SLOW"]
 
