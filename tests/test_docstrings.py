@@ -25,6 +25,10 @@ MODULES = [
     "campaign.worker", "campaign.executors", "campaign.store", "campaign.runner",
     "campaign.diff", "campaign.report", "campaign.figures", "cli.regress",
     "procedures.testdb", "campaign.manifest",
+    # the strapdown IMU and INS
+    "sensors.imu.kinematics", "sensors.imu.synthesis", "sensors.imu.errors",
+    "navigation.bank", "navigation.inertial.strapdown", "navigation.inertial.alignment",
+    "navigation.inertial.bank", "navigation.inertial.twin",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")

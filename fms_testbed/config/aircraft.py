@@ -272,6 +272,10 @@ class AircraftConfig(_Frozen):
     jsbsim_model: Annotated[str, Field(pattern=r"^[A-Za-z0-9][A-Za-z0-9_-]*$", max_length=64)] = Field(
         description="model folder name in the jsbsim wheel's aircraft/ (a plain name: no path)")
     category: str = Field(description="narrow-body | business-jet | light")
+    imu_lever_arm_m: tuple[float, float, float] = Field(
+        (0.0, 0.0, 0.0), description="position of the IMU relative to the centre of gravity in "
+        "body axes (x forward, y right, z down), m: the lever arm of the strapdown navigation's "
+        "IMU (its outputs are moved back to the CG); 0: the IMU at the CG")
     limits: Limits
     trim: TrimSettings
     envelope: list[EnvelopePoint] = Field(min_length=1)

@@ -234,6 +234,18 @@ class Turbulence(_Strict):
         "light", description="MIL-HDBK-1797 severity (wind at 20 ft 25 / 50 / 75 kt)")
 
 
+class AirDataBlock(_Strict):
+    """The air-data computer's errors (:mod:`fms_testbed.sensors.air_data`); without this block
+    it reports the truth."""
+
+    errors: Literal["none", "typical"] = Field(
+        "none", description="none (the truth) or typical (a transport aircraft's calibrated "
+                            "air data: static-source residual, transducers, temperature probe, "
+                            "vanes, pneumatic lags; seeded realisation)")
+    seed: Annotated[int, Field(ge=0)] | None = Field(
+        None, description="seed of the realisation (default: the run's seed)")
+
+
 class When(_Strict):
     """Condition that fires an event once: altitude crossing and/or time."""
 
@@ -360,6 +372,9 @@ class Scenario(_Strict):
     log_rate_hz: Annotated[float, Field(ge=1, le=120)] = Field(
         10.0, description="timeseries rate, Hz (at most the outer rate)")
     navigation: NavigationBlock | None = None
+    air_data: AirDataBlock | None = Field(
+        None, description="air-data computer errors (default: none, the computer reports the "
+                          "truth)")
     rnp_nm: Annotated[float, Field(gt=0, le=30)] | None = Field(
         None, description="RNP for the navigation error of a flight without a procedure, NM "
                           "(default: 2 NM when the navigation source is not truth; a procedure "

@@ -13,13 +13,15 @@ bias compensation does to the error (the error model is linear, so the two are t
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 
 import numpy as np
 from numba import njit
 
+from fms_testbed.core.earth import OMEGA_IE_RPS
 from fms_testbed.core.state import AircraftState, NavSolution
-from fms_testbed.navigation.sins import SinsNavigation, output_solution, outputs
+from fms_testbed.navigation.sins import SinsNavigation, _c_bn, output_solution, outputs
 from fms_testbed.sensors.sins.analysis import SinsOptions
 from fms_testbed.sensors.sins.presets import ImuModel
 
@@ -131,9 +133,13 @@ class InsBank:
             u._prev = truth
         return True
 
-    def update(self, truth: AircraftState) -> list[NavSolution]:
+    #: per-frame JSBSim samples the units need (none: the error model reads the outer-step state)
+    frame_properties: tuple[tuple[str, float], ...] = ()
+
+    def update(self, truth: AircraftState, frames=None) -> list[NavSolution]:
         """Advance every unit to ``truth.t_s`` and return their outputs (indicated solutions); a
-        stuck unit repeats its frozen output (time stamp advancing)."""
+        stuck unit repeats its frozen output (time stamp advancing). ``frames`` is not used
+        (:class:`~fms_testbed.navigation.bank.InsBankLike`)."""
         if self._advance_held(truth):
             O = outputs(np.array([u.x[:9] for u in self.units]), truth)
             out = [output_solution(truth.t_s, o) for o in O]
@@ -208,6 +214,23 @@ class InsBank:
         noise = self._noise[self._noise_i]
         self._noise_i += 1
         return _sensor_errors(X, self.compensation, f, w, self._sd[1], noise)
+
+    def measured(self, i: int) -> tuple[np.ndarray, np.ndarray]:
+        """Unit ``i``'s compensated measured specific force (3,) m/s² and angular rate ω_ib
+        (3,) rad/s, body axes, at the last update's true state: the truth plus the unit's
+        deterministic sensor errors less the compensation fed back (bias residual + scale
+        factor + misalignment, paper eq. 5.1-5.6, :func:`_sensor_errors` without its white
+        noise — the noise is drawn only by :meth:`sensor_errors`, whose stream this leaves
+        untouched). The :class:`~fms_testbed.navigation.bank.InsBankLike` method."""
+        truth = self.units[i]._prev
+        f = np.asarray(truth.f_body_mps2, float)
+        c = _c_bn(truth.roll_rad, truth.pitch_rad, truth.heading_rad)
+        w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(truth.lat_rad),
+                         OMEGA_IE_RPS * math.sin(truth.lat_rad)])
+        w = np.array([truth.p_rps, truth.q_rps, truth.r_rps]) + c.T @ w_ie
+        e = _sensor_errors(self.units[i].x[None, :], np.zeros((1, 6)), f, w, np.zeros((1, 6)),
+                           np.zeros((1, 6)))[0]
+        return f + e[:3], w + e[3:]
 
     def freeze(self, i: int, last: NavSolution) -> None:
         """Unit ``i``'s output sticks at ``last`` from now on (a stuck-output fault)."""

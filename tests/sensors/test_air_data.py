@@ -45,3 +45,62 @@ def test_errors_enter_through_the_air_data_equations(truth):
     assert b.pressure_alt_m - a0.pressure_alt_m == pytest.approx(dh, rel=0.01)
     assert b.baro_alt_m - truth.alt_m == pytest.approx(b.pressure_alt_m - a0.pressure_alt_m)
     assert dataclasses.replace(AirDataSpec()) == AirDataSpec()
+
+
+def test_typical_errors_have_the_declared_altitude_and_airspeed_spread(truth):
+    """Over 400 installations: the pressure-altitude error's σ is what the static-source
+    residual and the transducer bias give through dh = -R T / (g p) dp, the Mach error's σ is
+    the q_c and Mach-scale errors' (first order), the vanes' biases their σ."""
+    import math
+
+    import numpy as np
+
+    from fms_testbed.core.units import G0_MPS2
+    from fms_testbed.sensors.air_data import TYPICAL
+
+    sp = TYPICAL.spec
+    m2 = truth.mach ** 2
+    qc = truth.p_static_pa * ((1 + 0.2 * m2) ** 3.5 - 1)
+    dp = math.hypot(qc * math.hypot(sp.static_position_error,
+                                    sp.static_position_error_per_rad * truth.alpha_rad),
+                    sp.static_pressure_bias_pa)
+    want_h = 287.05287 * truth.t_static_k / (G0_MPS2 * truth.p_static_pa) * dp
+    dh, dm, da = [], [], []
+    a0 = AirDataComputer().update(truth)
+    for seed in range(400):
+        a = AirDataComputer.from_spec({"errors": "typical"}, seed).update(truth)
+        dh.append(a.pressure_alt_m - a0.pressure_alt_m)
+        dm.append(a.mach / truth.mach - 1)
+        da.append(a.alpha_rad - truth.alpha_rad)
+    assert np.std(dh) == pytest.approx(want_h, rel=0.15)
+    assert np.std(da) == pytest.approx(math.hypot(sp.alpha_bias_rad, sp.vane_noise_rad,
+                                                  sp.alpha_scale * truth.alpha_rad), rel=0.15)
+    assert 0.001 < np.std(dm) < 0.01
+
+
+def test_lags_and_the_scenario_key(truth):
+    import math
+
+    from fms_testbed.config.scenario import parse_scenario
+    from fms_testbed.core.errors import ConfigError
+
+    spec = AirDataSpec(static_pressure_bias_pa=0.0, static_lag_s=2.0, temperature_lag_s=1.0,
+                       tas_scale=1e-12)
+    adc = AirDataComputer(spec)
+    adc.update(truth)
+    step = dataclasses.replace(truth, p_static_pa=truth.p_static_pa + 200.0,
+                               t_s=truth.t_s + 2.0)
+    a = adc.update(step)
+    assert a.p_static_pa - truth.p_static_pa == pytest.approx(200 * (1 - math.exp(-1)), rel=1e-9)
+    assert AirDataComputer.from_spec(None).update(truth).tas_mps == truth.tas_mps
+    assert AirDataComputer.from_spec({"errors": "none"}).update(truth).mach == truth.mach
+    with pytest.raises(ConfigError, match="air_data.errors"):
+        AirDataComputer.from_spec({"errors": "bad"})
+    with pytest.raises(ConfigError, match="air_data.sigma"):
+        AirDataComputer.from_spec({"sigma": 1})
+    base = {"aircraft": "737", "initial": {"alt_m": 3000, "tas_kmh": 400}, "duration_s": 10}
+    assert parse_scenario(base).air_data is None
+    assert parse_scenario({**base, "air_data": {"errors": "typical"}}).air_data.errors == "typical"
+    a1 = AirDataComputer.from_spec({"errors": "typical", "seed": 4}).spec
+    assert a1 == AirDataComputer.from_spec({"errors": "typical"}, 4).spec
+    assert a1 != AirDataComputer.from_spec({"errors": "typical"}, 5).spec

@@ -14,6 +14,10 @@ is a stationary Gauss-Markov state. With a turn-on (run-to-run) value the paper'
 b' = η with b(0) ~ N(0, σ_turn_on²): the constant does not decay, and the in-run instability
 becomes a random walk of density 2σ²/τ (the Gauss-Markov's initial growth; conservative beyond τ),
 plus ``bias_rate_random_walk_*`` if given.
+
+``quantization_rad`` / ``quantization_mps`` (the LSB of the angle and velocity increments) are
+read only by the truth-side IMU of the strapdown navigation (:mod:`fms_testbed.sensors.imu`); the
+33-state model has no quantisation state.
 """
 
 from __future__ import annotations
@@ -53,6 +57,8 @@ class GyroSpec(_Frozen):
     scale_factor_correlation_time_s: PosOrNone = None
     misalignment_mrad: NonNeg = 0.0
     misalignment_correlation_time_s: PosOrNone = None
+    quantization_rad: NonNeg = 0.0
+    """LSB of the angle-increment output, rad (0: not quantised; the strapdown IMU only)."""
 
 
 class AccelSpec(_Frozen):
@@ -67,6 +73,8 @@ class AccelSpec(_Frozen):
     scale_factor_correlation_time_s: PosOrNone = None
     misalignment_mrad: NonNeg = 0.0
     misalignment_correlation_time_s: PosOrNone = None
+    quantization_mps: NonNeg = 0.0
+    """LSB of the velocity-increment output, m/s (0: not quantised; the strapdown IMU only)."""
 
 
 class InitialSpec(_Frozen):
