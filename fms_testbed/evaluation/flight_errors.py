@@ -34,12 +34,15 @@ elevation + 591 ft) is checked against that floor (:func:`constraint_checks`).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.evaluation.records import (ConstraintCheck, ErrorParts, ErrorStat,
+                                            FlightErrors, LegErrors, RnpContainment, Sequencing)
 from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.profile import window
 
@@ -78,19 +81,19 @@ def error_columns(df: pd.DataFrame) -> pd.DataFrame:
     return df
 
 
-def error_stats(df: pd.DataFrame) -> dict:
+def error_stats(df: pd.DataFrame) -> dict[str, ErrorParts]:
     """FTE/NSE/PDE/TSE statistics overall, on straight flight and in turns (module docstring)."""
     straight = (df["curvature_1pm"].to_numpy() == 0) & (df["straight_m"].to_numpy()
                                                        >= STRAIGHT_MARGIN_M)
     out = {}
     for name in ("fte", "nse", "pde", "tse"):
         x = df[f"{name}_m"].to_numpy(dtype=float)
-        out[name] = {"all": _stats(x), "straight": _stats(x[straight]),
-                     "turns": _stats(x[~straight])}
+        out[name] = ErrorParts(ErrorStat(**_stats(x)), ErrorStat(**_stats(x[straight])),
+                               ErrorStat(**_stats(x[~straight])))
     return out
 
 
-def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
+def per_leg(df: pd.DataFrame, seq_legs) -> list[LegErrors]:
     """Per-leg statistics and RNP containment (TSE95 ≤ RNP and max TSE ≤ 2 × RNP)."""
     rows = []
     for k, rec in enumerate(seq_legs):
@@ -107,7 +110,7 @@ def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
             row["rnp_contained"] = (None if row["tse95_m"] is None
                                     else bool(row["tse95_m"] <= rnp
                                               and row["tse_max_m"] <= 2.0 * rnp))
-        rows.append(row)
+        rows.append(LegErrors(**row))
     return rows
 
 
@@ -116,11 +119,12 @@ FIX_LEFT_M = 2000.0
 aircraft is this much farther from the fix than its closest approach so far, m."""
 
 
-def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf) -> list[dict]:
+def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf
+                      ) -> list[ConstraintCheck]:
     """Altitude and speed compliance at each constrained fix (module docstring).
 
     ``floor_m``: the lowest altitude guidance descends to, m (a circling approach: the airport
-    elevation + ``guidance.fms.CIRCLING_FLOOR_HEIGHT_M``). A coded top below it — the CIFP
+    elevation + ``guidance.vnav.CIRCLING_FLOOR_HEIGHT_M``). A coded top below it — the CIFP
     codes a circling MAP at the field elevation, not at an MDA — is checked against the floor
     instead (``floor_ft`` in the row): the aircraft must not descend below the coded bottom
     and must reach the floor, within the tolerance."""
@@ -217,7 +221,7 @@ def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf) -> list[
         if msgs:
             row["why"] = ", ".join(msgs)
         out.append(row)
-    return out
+    return [ConstraintCheck(**r) for r in out]
 
 
 def _passing_points(path) -> dict[int, tuple[float, float]]:
@@ -230,9 +234,16 @@ def _passing_points(path) -> dict[int, tuple[float, float]]:
             for k, sg in last.items() if sg.role == "flyby"}
 
 
-def sequencing(guidance, n_legs: int) -> dict:
-    """Legs entered in order: none skipped, none entered twice."""
-    seq = list(guidance.legs_sequenced)
+def sequencing(legs_sequenced: list[int], completed: bool, n_legs: int) -> Sequencing:
+    """Legs entered in order: none skipped, none entered twice.
+
+    Parameters
+    ----------
+    legs_sequenced : whole-procedure leg indices in the order guidance entered them
+    completed : the path was flown to its end and not abandoned
+    n_legs : legs of the procedure
+    """
+    seq = list(legs_sequenced)
     seen, repeated = set(), []
     for k in seq:
         if k in seen:
@@ -240,33 +251,48 @@ def sequencing(guidance, n_legs: int) -> dict:
         seen.add(k)
     last = max(seq) if seq else -1
     skipped = [k + 1 for k in range(last + 1) if k not in seen]
-    return {"legs": n_legs, "legs_entered": len(seen), "skipped": skipped,
-            "repeated": repeated, "in_order": seq == sorted(seq),
-            "completed": bool(guidance.done and not guidance.abort_reason)}
+    return Sequencing(n_legs, len(seen), skipped, repeated, seq == sorted(seq), bool(completed))
 
 
-def flight_errors(df: pd.DataFrame, fp, guidance) -> dict:
-    """Everything the summary gets: ``errors``, ``rnp``, ``constraints``, ``sequencing``."""
+@dataclass(frozen=True)
+class ProcedureErrors:
+    """What a procedure flight's errors give the summary: ``errors`` (None: nothing flown on a
+    path), ``rnp`` (None: idem), ``constraints``, ``constraints_met``, ``sequencing``."""
+
+    errors: FlightErrors | None
+    rnp: RnpContainment | None
+    constraints: list[ConstraintCheck]
+    constraints_met: bool | None
+    sequencing: Sequencing
+
+
+def flight_errors(df: pd.DataFrame, fp, legs_sequenced: list[int], completed: bool,
+                  floor_m: float = -math.inf) -> ProcedureErrors:
+    """Errors, RNP containment, constraints and sequencing of a procedure flight.
+
+    Parameters
+    ----------
+    df : the timeseries with the guidance columns (``xtk_m``, ``nav_xtk_m``, ``leg_index`` …)
+    fp : the built procedure flown; legs_sequenced, completed : :func:`sequencing`'s
+    floor_m : the lowest altitude guidance descends to, m (:func:`constraint_checks`)
+    """
     if df.empty or "xtk_m" not in df:
-        return {"errors": {}, "constraints": [], "sequencing": sequencing(guidance, 0)}
+        return ProcedureErrors(None, None, [], None, sequencing(legs_sequenced, completed, 0))
     d = error_columns(df)
     legs = per_leg(d, fp.seq.legs)
-    flown = [r for r in legs if r["samples"]]
-    cons = constraint_checks(d, fp, getattr(guidance, "floor_m", -math.inf))
+    flown = [r for r in legs if r.samples]
+    cons = constraint_checks(d, fp, floor_m)
     tse95 = _stats(d["tse_m"].to_numpy(dtype=float))["p95_m"]
-    return {
-        "errors": {**error_stats(d), "per_leg": legs,
-                   "heading_leg_samples": int(d["heading_leg"].sum()) if "heading_leg" in d
-                   else 0},
-        "rnp": {"contained": all(r["rnp_contained"] is not False for r in flown),
-                "legs_not_contained": [r["leg"] for r in flown if r["rnp_contained"] is False],
-                "tse95_m": tse95,
-                "min_rnp_nm": round(min(r["rnp_nm"] for r in flown), 2) if flown else None},
-        "constraints": cons,
-        "constraints_met": all(c.get("ok") is not False for c in cons),
-        "sequencing": sequencing(guidance, len(fp.seq.legs)),
-    }
+    st = error_stats(d)
+    return ProcedureErrors(
+        FlightErrors(st["fte"], st["nse"], st["pde"], st["tse"], legs,
+                     int(d["heading_leg"].sum()) if "heading_leg" in d else 0),
+        RnpContainment(all(r.rnp_contained is not False for r in flown),
+                       [r.leg for r in flown if r.rnp_contained is False], tse95,
+                       round(min(r.rnp_nm for r in flown), 2) if flown else None),
+        cons, all(c.ok is not False for c in cons),
+        sequencing(legs_sequenced, completed, len(fp.seq.legs)))
 
 
-__all__ = ["error_columns", "error_stats", "per_leg", "constraint_checks", "sequencing",
-           "flight_errors"]
+__all__ = ["ProcedureErrors", "error_columns", "error_stats", "per_leg", "constraint_checks",
+           "sequencing", "flight_errors"]

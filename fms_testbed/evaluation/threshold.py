@@ -31,6 +31,7 @@ import pandas as pd
 
 from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.evaluation.records import ThresholdChecks, ThresholdCrossing
 
 CAS_TOL_KT = 5.0
 """Threshold crossing CAS within this of Vapp, kt."""
@@ -67,7 +68,7 @@ def final_course_deg(path, map_leg: int) -> float | None:
 
 
 def threshold_crossing(df: pd.DataFrame, path, runway, vapp_cas_mps: float | None,
-                       approach) -> dict | None:
+                       approach) -> ThresholdCrossing | None:
     """The threshold-crossing record of a flight (module docstring); None when the flight is
     no approach to a known runway.
 
@@ -101,7 +102,7 @@ def threshold_crossing(df: pd.DataFrame, path, runway, vapp_cas_mps: float | Non
                 or abs(xt[-1]) >= CROSS_TRACK_MAX_M:
             out.update(crossed=False, reason=f"threshold not reached: the flight ended "
                        f"{-s[-1] / NM_M:.2f} NM before it")
-            return out
+            return ThresholdCrossing(**out)
         i0, i1 = s.size - 2, s.size - 1
         extrap = float(-s[-1])
     else:
@@ -157,10 +158,10 @@ def threshold_crossing(df: pd.DataFrame, path, runway, vapp_cas_mps: float | Non
         else abs(out["height_minus_tch_ft"]) <= HEIGHT_TOL_FT,
         "configured": out["configured"],
     }
-    out["checks"] = checks
+    out["checks"] = ThresholdChecks(**checks)
     out["ok"] = all(v is not False for v in checks.values()) and \
         any(v is not None for v in checks.values())
-    return out
+    return ThresholdCrossing(**out)
 
 
 __all__ = ["CAS_TOL_KT", "ANGLE_TOL_DEG", "HEIGHT_TOL_FT", "along_track_m",
