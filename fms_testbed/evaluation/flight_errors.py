@@ -140,88 +140,93 @@ def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf
         row = {"leg": k + 1, "code": rec.path_term, "fix": rec.fix.ident if rec.fix else "",
                "alt_desc": rec.alt_desc}
         bl = built.get(k)
-        term = bl.termination if bl is not None else None
-        if term is not None and (term.kind == "altitude" or not term.fix_ident and term.kind
-                                 in ("dme", "radial", "intercept", "manual", "distance")):
-            # a leg that ends where a condition is met (an HA at its altitude over its fix):
-            # checked where it ended, not where it first passed the fix
-            sel = np.flatnonzero(leg_col == k)
-            if sel.size:
-                i = int(sel[-1])
-                row["where"] = "leg end"
-            else:
-                # ended between two logged rows (an altitude already reached when the leg
-                # began): check the state when the next leg began
-                after = np.flatnonzero(leg_col > k)
-                if not after.size:
-                    row.update(ok=False, why="leg not flown")
-                    out.append(row)
-                    continue
-                i = int(after[0])
-                row["where"] = "leg end (ended within one logged step)"
-        else:
-            if term is None or term.lat_deg is None or k == 0 and LEG_TYPES[rec.path_term].initial \
-                    and not len(df):
-                row.update(ok=None, why="no fix position to check against")
-                out.append(row)
-                continue
-            sel = np.flatnonzero((leg_col >= k - 1) & (leg_col <= k + 1))
-            if not sel.size:
-                row.update(ok=False, why="fix never approached")
-                out.append(row)
-                continue
-            # a fly-by fix is passed where its fly-by arc is nearest to it (the arc's middle),
-            # up to R (1/cos(Ω/2) − 1) away: the check is against that planned point
-            plat, plon = passing.get(k, (term.lat_deg, term.lon_deg))
-            d = _dist_m(df["lat_deg"].to_numpy()[sel], df["lon_deg"].to_numpy()[sel],
-                        plat, plon)
-            # the first passage: the next leg's samples only until the aircraft has left the
-            # fix (a hold at the fix comes back to it a circuit later, lower)
-            nxt = leg_col[sel] == k + 1
-            left = nxt & (d > np.minimum.accumulate(d) + FIX_LEFT_M)
-            if left.any():
-                cut = int(np.argmax(left))
-                sel, d = sel[:cut], d[:cut]
-            j = int(np.argmin(d))
-            i = int(sel[j])
-            what = "the fix" if k not in passing else "the fly-by point abeam the fix"
-            row["where"] = f"{d[j]:.0f} m from {what}"
-            if d[j] > FIX_PASS_MAX_M:
-                row.update(ok=False, why=f"{what} passed {d[j] / NM_M:.2f} NM away")
-                out.append(row)
-                continue
-        alt_ft = float(df["alt_m"].iloc[i]) / FT_M
-        cas_kt = float(df["cas_mps"].iloc[i]) / KT_MPS
-        ok = True
-        msgs = []
-        row["alt_ft"] = round(alt_ft)
-        if lo is not None or hi is not None:
-            row["window_ft"] = [None if lo is None else round(lo / FT_M),
-                                None if hi is None else round(hi / FT_M)]
-            if hi is not None and hi < floor_m:
-                row["floor_ft"] = round(floor_m / FT_M)
-                hi = floor_m
-            if lo is not None and alt_ft < lo / FT_M - ALT_TOL_FT:
-                ok = False
-                msgs.append(f"{lo / FT_M - alt_ft:.0f} ft below")
-            if hi is not None and alt_ft > hi / FT_M + ALT_TOL_FT:
-                ok = False
-                msgs.append(f"{alt_ft - hi / FT_M:.0f} ft above")
-        if spd:
-            row["cas_kt"] = round(cas_kt, 1)
-            row["speed_limit_kt"] = f"{rec.speed_desc or '@'}{spd / KT_MPS:.0f}"
-            lim = spd / KT_MPS
-            if rec.speed_desc in ("", "@", "-") and cas_kt > lim + SPEED_TOL_KT:
-                ok = False
-                msgs.append(f"{cas_kt - lim:.1f} kt fast")
-            if rec.speed_desc in ("", "@", "+") and cas_kt < lim - SPEED_TOL_KT:
-                ok = False
-                msgs.append(f"{lim - cas_kt:.1f} kt slow")
-        row["ok"] = ok
-        if msgs:
-            row["why"] = ", ".join(msgs)
+        i = _check_row(df, leg_col, k, rec, bl.termination if bl is not None else None,
+                       passing, row)
+        if i is not None:
+            _judge(row, float(df["alt_m"].iloc[i]) / FT_M, float(df["cas_mps"].iloc[i]) / KT_MPS,
+                   lo, hi, spd, rec.speed_desc, floor_m)
         out.append(row)
     return [ConstraintCheck(**r) for r in out]
+
+
+def _check_row(df, leg_col, k: int, rec, term, passing, row: dict) -> int | None:
+    """The timeseries row at which leg ``k``'s constraint is checked (``row['where']`` says
+    where), or None with ``row['ok']``/``row['why']`` set when it cannot be checked."""
+    if term is not None and (term.kind == "altitude" or not term.fix_ident and term.kind
+                             in ("dme", "radial", "intercept", "manual", "distance")):
+        # a leg that ends where a condition is met (an HA at its altitude over its fix):
+        # checked where it ended, not where it first passed the fix
+        sel = np.flatnonzero(leg_col == k)
+        if sel.size:
+            row["where"] = "leg end"
+            return int(sel[-1])
+        # ended between two logged rows (an altitude already reached when the leg began):
+        # check the state when the next leg began
+        after = np.flatnonzero(leg_col > k)
+        if not after.size:
+            row.update(ok=False, why="leg not flown")
+            return None
+        row["where"] = "leg end (ended within one logged step)"
+        return int(after[0])
+    if term is None or term.lat_deg is None or k == 0 and LEG_TYPES[rec.path_term].initial \
+            and not len(df):
+        row.update(ok=None, why="no fix position to check against")
+        return None
+    sel = np.flatnonzero((leg_col >= k - 1) & (leg_col <= k + 1))
+    if not sel.size:
+        row.update(ok=False, why="fix never approached")
+        return None
+    # a fly-by fix is passed where its fly-by arc is nearest to it (the arc's middle), up to
+    # R (1/cos(Ω/2) − 1) away: the check is against that planned point
+    plat, plon = passing.get(k, (term.lat_deg, term.lon_deg))
+    d = _dist_m(df["lat_deg"].to_numpy()[sel], df["lon_deg"].to_numpy()[sel], plat, plon)
+    # the first passage: the next leg's samples only until the aircraft has left the fix (a
+    # hold at the fix comes back to it a circuit later, lower)
+    nxt = leg_col[sel] == k + 1
+    left = nxt & (d > np.minimum.accumulate(d) + FIX_LEFT_M)
+    if left.any():
+        cut = int(np.argmax(left))
+        sel, d = sel[:cut], d[:cut]
+    j = int(np.argmin(d))
+    what = "the fix" if k not in passing else "the fly-by point abeam the fix"
+    row["where"] = f"{d[j]:.0f} m from {what}"
+    if d[j] > FIX_PASS_MAX_M:
+        row.update(ok=False, why=f"{what} passed {d[j] / NM_M:.2f} NM away")
+        return None
+    return int(sel[j])
+
+
+def _judge(row: dict, alt_ft: float, cas_kt: float, lo: float | None, hi: float | None,
+           spd: float | None, speed_desc: str, floor_m: float) -> None:
+    """Set the row's altitude (ft), CAS (kt), window, verdict and why (module docstring)."""
+    ok = True
+    msgs = []
+    row["alt_ft"] = round(alt_ft)
+    if lo is not None or hi is not None:
+        row["window_ft"] = [None if lo is None else round(lo / FT_M),
+                            None if hi is None else round(hi / FT_M)]
+        if hi is not None and hi < floor_m:
+            row["floor_ft"] = round(floor_m / FT_M)
+            hi = floor_m
+        if lo is not None and alt_ft < lo / FT_M - ALT_TOL_FT:
+            ok = False
+            msgs.append(f"{lo / FT_M - alt_ft:.0f} ft below")
+        if hi is not None and alt_ft > hi / FT_M + ALT_TOL_FT:
+            ok = False
+            msgs.append(f"{alt_ft - hi / FT_M:.0f} ft above")
+    if spd:
+        row["cas_kt"] = round(cas_kt, 1)
+        row["speed_limit_kt"] = f"{speed_desc or '@'}{spd / KT_MPS:.0f}"
+        lim = spd / KT_MPS
+        if speed_desc in ("", "@", "-") and cas_kt > lim + SPEED_TOL_KT:
+            ok = False
+            msgs.append(f"{cas_kt - lim:.1f} kt fast")
+        if speed_desc in ("", "@", "+") and cas_kt < lim - SPEED_TOL_KT:
+            ok = False
+            msgs.append(f"{lim - cas_kt:.1f} kt slow")
+    row["ok"] = ok
+    if msgs:
+        row["why"] = ", ".join(msgs)
 
 
 def _passing_points(path) -> dict[int, tuple[float, float]]:

@@ -18,13 +18,14 @@ status                 meaning                                                  
                        NSE > 2 × RNP (other flights with a navigation source);
                        or the on-board RNP alert was raised (ANP > RNP)
 ``constraints_missed`` a coded altitude/speed constraint was missed               1
+``timeout``            stopped from outside before its end (a regression run's    1
+                       ``--case-timeout``); the checks of what was flown are kept
 =====================  =========================================================  =========
 
 A user error (bad file, bad argument) is exit code 2 and no flight. When several apply, the
 status is the first in the table's order (``diverged`` before ``incomplete`` before
-``envelope_exceeded`` ...); the ``reason`` names every one that applies, and ``outcome.checks``
-in the summary holds each check's verdict. A flight stopped from outside before its end (a
-regression run's wall-time limit) is ``timeout`` (exit code 1), its checks recorded.
+``envelope_exceeded`` ...; ``timeout`` whatever the checks say); the ``reason`` names every one
+that applies, and ``outcome.checks`` in the summary holds each check's verdict.
 
 :func:`decide` is the one place a flight's status is decided: the flight loop reports how it
 ended (:class:`~fms_testbed.core.contracts.Ending`), the checks here say what that means.
@@ -171,22 +172,7 @@ def decide(flight: Mapping, df: pd.DataFrame, cfg: AircraftConfig,
     env = envelope_violations(df, cfg)
     checks["envelope"] = EnvelopeCheck(not env, env)
     found["envelope_exceeded"] += env
-    if flight.get("rnp") is not None:
-        r = flight["rnp"]
-        checks["rnp"] = RnpCheck(bool(r["contained"]), list(r["legs_not_contained"]))
-        if not r["contained"]:
-            found["not_contained"].append(f"RNP containment lost on legs {r['legs_not_contained']}")
-    elif rnp_nm is not None:
-        nc = navigation_containment(df, rnp_nm)
-        checks["navigation"] = NavigationCheck(**nc)
-        if nc["contained"] is False:
-            found["not_contained"].append(
-                f"navigation error NSE95 {nc['nse95_m']:.0f} m / max {nc['nse_max_m']:.0f} m "
-                f"outside RNP {rnp_nm:g} NM")
-    if "rnp_alert" in df and (df["rnp_alert"].to_numpy() > 0).any():
-        t_alert = float(df["t_s"].to_numpy()[np.argmax(df["rnp_alert"].to_numpy() > 0)])
-        checks["rnp_alert"] = AlertCheck(False, round(t_alert, 2))
-        found["not_contained"].append(f"RNP alert (ANP > RNP) from t={t_alert:.1f} s")
+    _containment(flight, df, rnp_nm, checks, found["not_contained"])
     if "constraints" in flight:
         cons = flight["constraints"]
         bad = [c for c in cons if c.get("ok") is False]
@@ -202,6 +188,28 @@ def decide(flight: Mapping, df: pd.DataFrame, cfg: AircraftConfig,
     elif failed:
         status, reason = failed[0], "; ".join(r for s in failed for r in found[s])
     return Decision(status, reason, Outcome(status, failed, Checks(**checks)))
+
+
+def _containment(flight: Mapping, df: pd.DataFrame, rnp_nm: float | None, checks: dict,
+                 found: list[str]) -> None:
+    """RNP containment (a procedure flight's ``rnp``, else the navigation error against
+    ``rnp_nm`` NM) and the on-board RNP alert: their checks into ``checks``, their failures
+    into ``found``."""
+    if flight.get("rnp") is not None:
+        r = flight["rnp"]
+        checks["rnp"] = RnpCheck(bool(r["contained"]), list(r["legs_not_contained"]))
+        if not r["contained"]:
+            found.append(f"RNP containment lost on legs {r['legs_not_contained']}")
+    elif rnp_nm is not None:
+        nc = navigation_containment(df, rnp_nm)
+        checks["navigation"] = NavigationCheck(**nc)
+        if nc["contained"] is False:
+            found.append(f"navigation error NSE95 {nc['nse95_m']:.0f} m / max "
+                         f"{nc['nse_max_m']:.0f} m outside RNP {rnp_nm:g} NM")
+    if "rnp_alert" in df and (df["rnp_alert"].to_numpy() > 0).any():
+        t_alert = float(df["t_s"].to_numpy()[np.argmax(df["rnp_alert"].to_numpy() > 0)])
+        checks["rnp_alert"] = AlertCheck(False, round(t_alert, 2))
+        found.append(f"RNP alert (ANP > RNP) from t={t_alert:.1f} s")
 
 
 __all__ = ["ORDER", "EXIT_CODES", "DEFAULT_ENROUTE_RNP_NM", "STOPPED", "Decision", "decide",

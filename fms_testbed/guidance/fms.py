@@ -73,7 +73,7 @@ class ProcedureGuidance(GuidanceBase):
         self.whole, self.cfg = fp, cfg
         self.gains = gains or LateralGains.for_aircraft(cfg)
         self.heading_kp = cfg.inner_loops.heading_kp
-        self.act = activate(fp, 0.0, cfg.limits.climb_tas_mps)
+        self.act = activate(fp, 0.0)
         self.vnav = VerticalGuidance(fp, cfg, spec, db, self.gains.bank_max_deg)
         self.seq = LegSequencer([r.path_term for r in fp.seq.legs], self.vnav.speed.enter_leg,
                                 self.events)

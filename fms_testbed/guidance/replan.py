@@ -247,7 +247,7 @@ class Replanner:
             if broken:
                 return None, f"leg {broken[0].leg_index + w.leg}: {broken[0].message}"
         self.rebuilt.append(fp)
-        return activate(fp, w.s_flight_m, self.cfg.limits.climb_tas_mps,
+        return activate(fp, w.s_flight_m,
                         lead_from=(math.degrees(nav.lat_rad), math.degrees(nav.lon_rad))), ""
 
 

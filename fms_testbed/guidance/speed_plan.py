@@ -105,14 +105,14 @@ class SpeedPlan:
     """The TAS target and the state it carries from leg to leg (module docstring).
 
     limits: coded speed limit per leg of the whole procedure; descent: STAR/approach (limits
-    carry on); plan_tas_mps: the aircraft's planned speed (flown as a CAS), m/s; cas_min_mps:
+    carry on); plan_cas_mps: the aircraft's planned speed, a CAS, m/s; cas_min_mps:
     its minimum CAS, m/s; tas_cmd_mps: the present target, m/s; carry_max_cas_mps: the lowest
     'at'/'at or below' CAS entered in descent, m/s; next_t_s: when the target is due again, s.
     """
 
     limits: list[SpeedLimit | None]
     descent: bool
-    plan_tas_mps: float
+    plan_cas_mps: float
     cas_min_mps: float
     tas_cmd_mps: float
     carry_max_cas_mps: float | None = None
@@ -186,7 +186,7 @@ class SpeedPlan:
             return self._go_around_update(t_s, alt_m, w, ga, wind_mps)
         lim = self.limits[leg] if leg < len(self.limits) else None
         lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
-        plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
+        plan = min(cas_to_tas_scalar(self.plan_cas_mps, alt_m, self.isa_dev_c),
                    arc_speed_cap_mps(a.pieces, i, along_m, gs_mps, self.bank_max_deg, wind_mps))
         plan = min(plan, self.limit_ahead_cap_mps(alt_m, leg, a.pieces, i, along_m,
                                                   self.tas_cmd_mps, a.piece_legs))
@@ -214,7 +214,7 @@ class SpeedPlan:
         lim = self.limits[w.leg] if w.leg < len(self.limits) else None
         lo, hi = cas_band(lim, None)
         if self.accelerated:
-            plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
+            plan = min(cas_to_tas_scalar(self.plan_cas_mps, alt_m, self.isa_dev_c),
                        arc_speed_cap_mps(w.act.pieces, w.i, w.along_m, w.gs_mps,
                                          self.bank_max_deg, wind_mps))
         else:

@@ -1,12 +1,12 @@
 """The flight log: which outer steps are logged (the cadence, in one place), what the loop keeps
 of each, and the timeseries built from it once, vectorised, at the end.
 
-Per logged step the loop keeps only what it already has: the raw JSBSim read
-(:meth:`~fms_testbed.sim.jsbsim_core.JSBSimAircraft.read_raw`, JSBSim units) and the commands
-and navigation solution (:data:`~fms_testbed.core.timeseries.LOG_FIELDS`, SI), appended to flat
-float buffers (no object the garbage collector must walk), the navigation source's error
-record (the dict it returned, not copied) and the guidance's log record (opaque, turned into
-its columns by the guidance after the flight). The columns, with their units:
+Per logged step the loop keeps only references to what it already has — no copy, no
+conversion: the raw JSBSim read (:meth:`~fms_testbed.sim.jsbsim_core.JSBSimAircraft.read_raw`,
+a fresh list of floats in JSBSim units), the commands (a tuple), the navigation solution (its
+:data:`~fms_testbed.core.timeseries.LOG_FIELDS` and error record are read at the end) and the
+guidance's log record (opaque, turned into its columns by the guidance after the flight). The
+columns, with their units:
 
 * :data:`~fms_testbed.core.timeseries.COLUMNS` (the contract), then :data:`EXTRA_COLUMNS`;
 * the navigation source's error components (``nse_*``, ``bias_*`` …; their names carry units);
@@ -16,7 +16,6 @@ its columns by the guidance after the flight). The columns, with their units:
 from __future__ import annotations
 
 import math
-from array import array
 
 import numpy as np
 import pandas as pd
@@ -54,9 +53,9 @@ class FlightLog:
     def __init__(self, every: int, guidance=None):
         self.every = int(every)
         self.guidance = guidance
-        self.raw = array("d")
-        self.fields = array("d")
-        self.errors: list[dict] = []
+        self.raw: list[list[float]] = []
+        self.cmds: list[tuple] = []
+        self.navs: list = []
         self.records: list = []
 
     def due(self, k: int) -> bool:
@@ -66,16 +65,15 @@ class FlightLog:
     def add(self, raw: list[float], cmd: tuple, nav, record=None) -> None:
         """Log one step: the raw read, the commands (bank rad, heading rad, n_x g, n_y g,
         throttle, altitude m, TAS m/s; NaN where inactive), the navigation solution and the
-        guidance's record (None: no guidance this step)."""
-        self.raw.extend(raw)
-        self.fields.extend(cmd)
-        self.fields.extend((nav.lat_rad, nav.lon_rad, nav.alt_m, nav.heading_rad, nav.roll_rad,
-                            nav.pitch_rad))
-        self.errors.append(nav.errors)
+        guidance's record (None: no guidance this step). The objects are kept, not copied:
+        the caller hands over fresh ones every step."""
+        self.raw.append(raw)
+        self.cmds.append(cmd)
+        self.navs.append(nav)
         self.records.append(record)
 
     def __len__(self) -> int:
-        return len(self.errors)
+        return len(self.raw)
 
     def columns(self) -> tuple[tuple[str, str], ...]:
         """``(column, description with unit)`` of the fixed columns and the guidance's (the
@@ -86,27 +84,30 @@ class FlightLog:
     def frame(self) -> pd.DataFrame:
         """The timeseries (module docstring), one row per logged step."""
         names = [c for c, _ in COLUMNS]
-        if not len(self.raw):
+        if not self.raw:
             return pd.DataFrame({c: pd.Series(dtype=float) for c in names})
-        r = raw_to_si(np.asarray(self.raw, dtype=float))
-        lg = np.asarray(self.fields, dtype=float).reshape(-1, len(LOG_FIELDS))
+        raw = np.array(self.raw, dtype=float)
+        r = raw_to_si(raw)
+        cmd = np.array(self.cmds, dtype=float)
+        nav = np.array([(n.lat_rad, n.lon_rad, n.alt_m, n.heading_rad, n.roll_rad, n.pitch_rad)
+                        for n in self.navs], dtype=float)
+        lg = np.concatenate([cmd, nav], axis=1)
         cols = _base_columns(r, {f: lg[:, j] for j, f in enumerate(LOG_FIELDS)})
         df = pd.DataFrame({**{c: cols[c] for c in names},
                            **{c: r[c] for c, _ in EXTRA_COLUMNS}})
-        extra = self._extra_columns(r)
+        extra = self._extra_columns(raw)
         return pd.concat([df, pd.DataFrame(extra)], axis=1) if extra else df
 
-    def _extra_columns(self, r: dict) -> dict[str, list]:
+    def _extra_columns(self, raw: np.ndarray) -> dict[str, list]:
         """The navigation-error and guidance columns (NaN where a row has none)."""
         out: dict[str, list] = {}
-        n = len(self.errors)
-        if any(self.errors):
-            keys = list(dict.fromkeys(k for e in self.errors for k in e))
-            for k in keys:
-                out[k] = [e.get(k, _NAN) for e in self.errors]
+        errors = [n.errors for n in self.navs]
+        if any(errors):
+            for k in dict.fromkeys(k for e in errors for k in e):
+                out[k] = [e.get(k, _NAN) for e in errors]
         if self.guidance is not None and any(rec is not None for rec in self.records):
-            lat = np.asarray(self.raw, dtype=float).reshape(n, -1)[:, RAW["lat_deg"]] * DEG_RAD
-            lon = np.asarray(self.raw, dtype=float).reshape(n, -1)[:, RAW["lon_deg"]] * DEG_RAD
+            lat = raw[:, RAW["lat_deg"]] * DEG_RAD
+            lon = raw[:, RAW["lon_deg"]] * DEG_RAD
             out.update(self.guidance.log_frame(self.records, lat, lon))
         return out
 

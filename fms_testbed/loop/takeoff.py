@@ -287,19 +287,19 @@ class TakeoffPhase:
         to = cfg.takeoff
         self.parts, self.runway, self.cfg, self.to, self.ac = parts, runway, cfg, to, ac
         self.guided_flight, self.airborne = guided, airborne
-        self.t_s: dict[str, float] = {}
-        self.at: dict[str, TakeoffMark] = {}
+        self.times_s: dict[str, float] = {}
+        self.marks: dict[str, TakeoffMark] = {}
         self.max_dev_ground_m = self.max_dev_air_m = 0.0
         ac.engage(bank=False, yaw=False, ny=False, nx=False)
         self.vr_cas_mps, self.v2_cas_mps = to.speeds_cas_mps(float(ac.state().mass_kg))
-        self.v_climb = self.v2_cas_mps + to.climb_add_cas_mps
-        self.idle = cfg.inner_loops.throttle_min
-        self.brg_rad = math.radians(runway.bearing_deg)
+        self.v_climb_cas_mps = self.v2_cas_mps + to.climb_add_cas_mps
+        self.throttle_idle = cfg.inner_loops.throttle_min
+        self.bearing_rad = math.radians(runway.bearing_deg)
         self.check_air = Divergence(cfg)
         self.n_sub = max(1, parts.n_frames // CONTROL_FRAMES)
         self.frames = parts.n_frames // self.n_sub
         self.dt_c = self.frames * ac.dt_s
-        self.sub = "roll"
+        self.stage = "roll"
         self.pilot = TakeoffControl(math.radians(to.pitch_deg), math.radians(to.pitch_max_deg),
                                     to.pitch_rate_kp, to.pitch_rate_ki)
         ap = cfg.approach
@@ -310,11 +310,12 @@ class TakeoffPhase:
         # LNAV from where the airborne start starts: one roll-in anticipation before the DER
         self.lnav_lead_m = anticipation_m(cfg.limits.climb_tas_mps, math.radians(PLANNED_BANK_DEG),
                                           LateralGains.for_aircraft(cfg))
-        self.v_plan = cfg.limits.climb_tas_mps   # planned climb speed, CAS (the guidance's, once on)
+        # planned climb speed, a CAS (limits.climb_tas_mps holds a CAS; the guidance's once on)
+        self.v_plan_cas_mps = cfg.limits.climb_tas_mps
         self.t0 = ac.fdm.get_sim_time()
-        self.bank_cmd, self.thr = 0.0, self.idle
+        self.bank_cmd_rad, self.throttle = 0.0, self.throttle_idle
         self._s, self._wow = None, True           # this step's state, on the wheels
-        self.t = self.along_m = self.cross_m = self.h_m = 0.0
+        self.t_run_s = self.along_m = self.cross_m = self.h_m = 0.0   # s, m, m, m
 
     # ------------------------------------------------------------------ the phase steps
     def check(self, s: AircraftState, raw: list[float]) -> str | None:
@@ -333,14 +334,14 @@ class TakeoffPhase:
     def guided(self, s: AircraftState) -> bool:
         """LNAV: the guidance steers from :data:`LNAV_HEIGHT_M` above the runway and one roll-in
         anticipation before its end (engaged here, with the lateral trims of the moment)."""
-        if not self.guided_flight or self.sub != "climb":
+        if not self.guided_flight or self.stage != "climb":
             return False
         if self.n_guided:
             return True
         if self.h_m < LNAV_HEIGHT_M or self.along_m < self.runway.length_m - self.lnav_lead_m:
             return False
         self._mark("lnav", s)
-        self.parts.lateral.last_bank_rad = self.bank_cmd
+        self.parts.lateral.last_bank_rad = self.bank_cmd_rad
         # steady and wings level on the centreline: the aileron and rudder of the moment are
         # the lateral trims (the bank loop has no integral for a propeller's torque)
         fdm = self.ac.fdm
@@ -354,14 +355,14 @@ class TakeoffPhase:
         if gout is not None:
             self.n_guided += 1
             if gout.tas_mps is not None and s.tas_mps > 1.0:    # the planned speed, as a CAS
-                self.v_plan = gout.tas_mps * s.cas_mps / s.tas_mps
+                self.v_plan_cas_mps = gout.tas_mps * s.cas_mps / s.tas_mps
         length, h_m = self.runway.length_m, self.h_m
-        if self.sub == "climb" and "der" not in self.t_s and self.along_m >= length:
+        if self.stage == "climb" and "der" not in self.times_s and self.along_m >= length:
             self._mark("der", s)
         done = gout is not None and gout.done
-        if not (done or (self.sub == "climb" and h_m >= HANDOVER_HEIGHT_M
+        if not (done or (self.stage == "climb" and h_m >= HANDOVER_HEIGHT_M
                          and self.along_m >= length
-                         and (s.cas_mps >= self.v_plan - HANDOVER_SPEED_MARGIN_MPS
+                         and (s.cas_mps >= self.v_plan_cas_mps - HANDOVER_SPEED_MARGIN_MPS
                               or h_m >= HANDOVER_MAX_HEIGHT_M))):
             return self
         self._mark("handover", s)
@@ -375,9 +376,9 @@ class TakeoffPhase:
         """LNAV's bank command (through the flight's roll-rate limit) when the guidance steers;
         the log values: (bank rad, runway heading rad until LNAV, -, -, throttle, -, -)."""
         if gout is not None:
-            self.bank_cmd = self.parts.lateral(self.parts.targets, nav, True)
+            self.bank_cmd_rad = self.parts.lateral(self.parts.targets, nav, True)
         nan = math.nan
-        return (self.bank_cmd, self.brg_rad if gout is None else nan, nan, nan, self.thr, nan,
+        return (self.bank_cmd_rad, self.bearing_rad if gout is None else nan, nan, nan, self.throttle, nan,
                 nan)
 
     def advance(self) -> str:
@@ -400,7 +401,7 @@ class TakeoffPhase:
         ``cross_m`` on the centreline, ``h_m`` above the runway); True on the wheels."""
         self._s, self._wow = s, wow > 0.5
         rw = self.runway
-        self.t = s.t_s - self.t0
+        self.t_run_s = s.t_s - self.t0
         self.along_m, self.cross_m = rw.along_cross_m(math.degrees(s.lat_rad),
                                                      math.degrees(s.lon_rad))
         self.h_m = s.alt_m - rw.elev_m
@@ -409,55 +410,55 @@ class TakeoffPhase:
     def _control(self, s: AircraftState, wow: bool) -> None:
         """One takeoff-control update (module docstring, steps 1-3)."""
         ac, to, h_m, cross = self.ac, self.to, self.h_m, self.cross_m
-        if self.sub == "roll" and s.cas_mps >= self.vr_cas_mps:
-            self.sub = "rotate"
+        if self.stage == "roll" and s.cas_mps >= self.vr_cas_mps:
+            self.stage = "rotate"
             self._mark("rotate", s)
-        if self.sub == "rotate" and not wow and h_m > 0.0:
-            self.sub = "climb"
+        if self.stage == "rotate" and not wow and h_m > 0.0:
+            self.stage = "climb"
             self._mark("liftoff", s)
             fdm = ac.fdm
             fdm["fcs/steer-cmd-norm"] = 0.0
             fdm["fms/trim/rudder"] = 0.0       # the yaw loop takes the rudder
             fdm["fms/trim/aileron"] = 0.0
             ac.engage(bank=True, yaw=True, ny=False, nx=False)
-        if "v2" not in self.t_s and s.cas_mps >= self.v2_cas_mps:
+        if "v2" not in self.times_s and s.cas_mps >= self.v2_cas_mps:
             self._mark("v2", s)
-        if self.sub == "climb" and not self.gear_up and s.vs_mps > POSITIVE_RATE_MPS \
+        if self.stage == "climb" and not self.gear_up and s.vs_mps > POSITIVE_RATE_MPS \
                 and h_m > GEAR_UP_HEIGHT_M:
             self.gear_up = True
             ac.configure(gear_down=False)
             self._mark("gear_up", s)
-        self.thr = self.idle + (to.thrust_norm - self.idle) * min(1.0, self.t / SPOOL_S)
-        if self.sub != "climb":
+        self.throttle = self.throttle_idle + (to.thrust_norm - self.throttle_idle) * min(1.0, self.t_run_s / SPOOL_S)
+        if self.stage != "climb":
             self.max_dev_ground_m = max(self.max_dev_ground_m, abs(cross))
-            steer, rudder = self.pilot.ground(self.dt_c, wrap_pi(s.heading_rad - self.brg_rad),
+            steer, rudder = self.pilot.ground(self.dt_c, wrap_pi(s.heading_rad - self.bearing_rad),
                                               cross, s.gs_mps, s.r_rps)
-            set_controls(ac, steer=steer, rudder=rudder, throttle=self.thr)
+            set_controls(ac, steer=steer, rudder=rudder, throttle=self.throttle)
         else:
             self._climb_out(s, cross, h_m)
-        if self.sub != "roll":
+        if self.stage != "roll":
             set_controls(ac, elevator=self.pilot.pitch(
                 self.dt_c, s.pitch_rad, s.q_rps, ac.fdm["fms/sched/qbar-ratio"],
-                s.cas_mps - self.v_climb if self.sub == "climb" else None, s.alpha_rad))
+                s.cas_mps - self.v_climb_cas_mps if self.stage == "climb" else None, s.alpha_rad))
 
     def _climb_out(self, s: AircraftState, cross: float, h_m: float) -> None:
         """After lift-off: wings level on the extended centreline until LNAV, the acceleration
         from the acceleration height, flaps up on schedule."""
         if not self.n_guided:   # on the extended centreline until LNAV
             self.max_dev_air_m = max(self.max_dev_air_m, abs(cross))
-            self.bank_cmd = self.pilot.bank(wrap_pi(s.track_rad - self.brg_rad), cross)
-        self.ac.command(bank_rad=self.bank_cmd, throttle=self.thr)
-        if h_m >= self.h_accel and "accelerate" not in self.t_s:
+            self.bank_cmd_rad = self.pilot.bank(wrap_pi(s.track_rad - self.bearing_rad), cross)
+        self.ac.command(bank_rad=self.bank_cmd_rad, throttle=self.throttle)
+        if h_m >= self.h_accel and "accelerate" not in self.times_s:
             self._mark("accelerate", s)
-        if "accelerate" in self.t_s:
-            self.v_climb = max(self.v2_cas_mps + self.to.climb_add_cas_mps, self.v_plan)
+        if "accelerate" in self.times_s:
+            self.v_climb_cas_mps = max(self.v2_cas_mps + self.to.climb_add_cas_mps, self.v_plan_cas_mps)
             if self.config is not None:
                 self.config.gear_down = not self.gear_up
                 self.config(s, self.parts.targets, False)     # flaps up on schedule
 
     def _failure(self, s: AircraftState, wow: float) -> str | None:
-        t, along, cross = self.t, self.along_m, self.cross_m
-        if self.sub == "climb":
+        t, along, cross = self.t_run_s, self.along_m, self.cross_m
+        if self.stage == "climb":
             return self.check_air(s, wow)
         if not math.isfinite(s.alt_m + s.tas_mps + s.pitch_rad + s.alpha_rad):
             return "non-finite state (JSBSim diverged)"
@@ -473,8 +474,8 @@ class TakeoffPhase:
         return None
 
     def _mark(self, name: str, s: AircraftState) -> None:
-        self.t_s[name] = round(self.t, 2)
-        self.at[name] = TakeoffMark(round(self.along_m, 1), round(self.cross_m, 2),
+        self.times_s[name] = round(self.t_run_s, 2)
+        self.marks[name] = TakeoffMark(round(self.along_m, 1), round(self.cross_m, 2),
                                     round(s.cas_mps, 2), round(s.alt_m - self.runway.elev_m, 1),
                                     round(math.degrees(s.pitch_rad), 2))
 
@@ -490,7 +491,7 @@ class TakeoffPhase:
 
     def record(self) -> TakeoffRecord:
         """The takeoff as flown (:class:`TakeoffRecord`)."""
-        at, ts = self.at, self.t_s
+        at, ts = self.marks, self.times_s
         return TakeoffRecord(
             "takeoff", self.runway.ident, round(self.vr_cas_mps, 2), round(self.v2_cas_mps, 2), dict(ts),
             dict(at), round(self.max_dev_ground_m, 2), round(self.max_dev_air_m, 2),

@@ -67,7 +67,7 @@ def test_the_takeoff_and_the_airborne_phase_sample_one_stream_of_frames(monkeypa
         "airport": "KJFK", "procedure": "DEEZZ5", "runway": "31L", "transition": "CANDR",
         "start": "takeoff"}})
     fl, rec = _fly_on_recorder(monkeypatch, scn, procedure=proc)
-    handover = fl.takeoff.t_s["handover"]
+    handover = fl.takeoff.times_s["handover"]
     assert fl.phase.name == "airborne" and 0.0 < handover < 100.0
     t_all = _check_blocks(fl, rec)
     assert t_all[0] < handover < t_all[-1]
