@@ -35,7 +35,7 @@ from fms_testbed.guidance.lateral import LateralGains
 from fms_testbed.guidance.locate import Where, locate
 from fms_testbed.guidance.replan import Rebuild, Replanner
 from fms_testbed.guidance.sequencing import LegSequencer
-from fms_testbed.guidance.step_log import LOG_COLUMNS, log_frame
+from fms_testbed.guidance.step_log import LOG_COLUMNS, log_frame, record
 from fms_testbed.guidance.steering import steer_bank_rad
 from fms_testbed.guidance.vnav import VerticalGuidance
 from fms_testbed.path.plan import FlyablePath
@@ -74,12 +74,14 @@ class ProcedureGuidance(GuidanceBase):
         self.gains = gains or LateralGains.for_aircraft(cfg)
         self.heading_kp = cfg.inner_loops.heading_kp
         self.act = activate(fp, 0.0)
+        self.paths = [self.act]
+        """Every path made active, in order (the log records name them by index)."""
         self.vnav = VerticalGuidance(fp, cfg, spec, db, self.gains.bank_max_deg)
         self.seq = LegSequencer([r.path_term for r in fp.seq.legs], self.vnav.speed.enter_leg,
                                 self.events)
         self.replan = Replanner(fp, cfg, db, spec, self.gains)
         self.done = False
-        self._last: Where | None = None
+        self._last: tuple | None = None
 
     # ------------------------------------------------------------------ the Guidance interface
     @property
@@ -95,13 +97,14 @@ class ProcedureGuidance(GuidanceBase):
         """'leg k of n' (whole procedure)."""
         return f"leg {self.seq.leg + 1} of {len(self.whole.seq.legs)}"
 
-    def log_record(self) -> Where | None:
-        """Where the last :meth:`update` located the aircraft (None: nowhere)."""
+    def log_record(self) -> tuple | None:
+        """Where the last :meth:`update` located the aircraft (:func:`~.step_log.record`; None:
+        nowhere)."""
         return self._last
 
     def log_frame(self, records, true_lat_rad, true_lon_rad) -> dict[str, list]:
         """The guidance columns (:data:`~.step_log.LOG_COLUMNS`) of the logged records."""
-        return log_frame(records, true_lat_rad, true_lon_rad)
+        return log_frame(self.paths, records, true_lat_rad, true_lon_rad)
 
     def update(self, dt_s: float, nav: NavSolution, air: AirData) -> GuidanceOutput:
         """One guidance step: bank command, altitude and TAS targets, done flag (module
@@ -126,7 +129,7 @@ class ProcedureGuidance(GuidanceBase):
             if abs(w.xtk_m) > XTK_ABORT_M:
                 return self._abort(t, f"off the procedure: cross-track {w.xtk_m / NM_M:.1f} NM "
                                       f"on leg {w.leg + 1} ({w.built.path_term})")
-            self._last = w
+            self._last = record(len(self.paths) - 1, w)
             nxt = None if hold else w.next_piece
             bank = steer_bank_rad(w.seg, w.p, w.along_m, w.xtk_m, w.dtrk_rad, nxt, w.trk_rad,
                                   nav.heading_rad, w.gs_mps, self.gains, self.heading_kp)
@@ -160,6 +163,7 @@ class ProcedureGuidance(GuidanceBase):
                             f"conditions changed ({r.why}); {why}: the plan is kept")
             return False
         self.act = act
+        self.paths.append(act)
         self.seq.restart()
         if r.kind == "conditions":
             self.vnav.speed.isa_dev_c = r.params.isa_dev_c
@@ -169,7 +173,7 @@ class ProcedureGuidance(GuidanceBase):
     def _finish(self, w: Where | None) -> GuidanceOutput:
         """The path has been flown to its end (``w``: where, for the last log record)."""
         self.done = True
-        self._last = w
+        self._last = None if w is None else record(len(self.paths) - 1, w)
         return _DONE
 
     def _event(self, t_s: float, kind: str, leg: int, detail: str) -> None:

@@ -108,6 +108,22 @@ BLEND_S = 6.0
 """Each slope change of the planned profile is blended over ±BLEND_S seconds of flight."""
 
 
+def _slope(ps: list[float], ph: list[float], k: int, extend: bool) -> float:
+    """Slope of profile piece ``k`` (between nodes k-1 and k); 0 before the first node, the last
+    piece's (``extend``) or 0 after the last."""
+    n = len(ps)
+    if k <= 0:
+        return 0.0
+    if k >= n:
+        if not extend:
+            return 0.0
+        k = n - 1
+        if k <= 0:
+            return 0.0
+    d = ps[k] - ps[k - 1]
+    return (ph[k] - ph[k - 1]) / d if d > 1e-6 else 0.0
+
+
 def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
                     extend: bool) -> tuple[float, float, float]:
     """Planned altitude at path distance ``s_m`` with every slope change blended by a parabola
@@ -122,17 +138,8 @@ def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
     n = len(ps)
     if n == 1:
         return ph[0], 0.0, 0.0
-
-    def slope(k: int) -> float:  # slope of piece k (between nodes k-1 and k); 0 off the ends
-        if k <= 0:
-            return 0.0
-        if k >= n:
-            return slope(n - 1) if extend else 0.0
-        d = ps[k] - ps[k - 1]
-        return (ph[k] - ph[k - 1]) / d if d > 1e-6 else 0.0
-
     j = bisect.bisect_right(ps, s_m)
-    m = slope(j)
+    m = _slope(ps, ph, j, extend)
     if j <= 0:
         h = ph[0]
     elif j >= n:
@@ -146,7 +153,7 @@ def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
         sk = ps[k]
         if abs(s_m - sk) >= w_m:
             continue
-        delta = slope(k + 1) - slope(k)
+        delta = _slope(ps, ph, k + 1, extend) - _slope(ps, ph, k, extend)
         if delta == 0.0:
             continue
         u = s_m - sk + w_m

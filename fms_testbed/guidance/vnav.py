@@ -1,7 +1,7 @@
 """The vertical step of procedure guidance: the altitude command from the planned profile and
 the TAS target from the speed plan, for the aircraft located on the active path.
 
-Altitude (:func:`.vertical.altitude_command_m`): the blended planned profile read ahead by the
+Altitude (:func:`.vertical.altitude_command_m`, compiled: :mod:`.profile_kernel`): the blended planned profile read ahead by the
 coupled law's lag, ``H_cmd = h + 2 ξ_H T_H V dh/ds + T_H² V_g² d²h/ds²`` with V the TAS from the
 air data, or in a climb phase the climb target of the node ahead, never above the climb top and
 never below the circling floor (:data:`CIRCLING_FLOOR_HEIGHT_M` above the airport of a circling
@@ -19,8 +19,8 @@ from fms_testbed.core.units import FT_M
 from fms_testbed.guidance.active_path import ActivePath
 from fms_testbed.guidance.locate import Where
 from fms_testbed.guidance.speed_plan import GoAround, SpeedPlan
-from fms_testbed.guidance.vertical import (altitude_command_m, altitude_lead_s,
-                                          planned_limits)
+from fms_testbed.guidance.profile_kernel import ProfileNodes, altitude_command_fast_m
+from fms_testbed.guidance.vertical import altitude_lead_s, planned_limits
 from fms_testbed.legs.model import CEILING_MARGIN_M
 from fms_testbed.path.plan import FlyablePath
 
@@ -124,25 +124,24 @@ class VerticalGuidance:
             self.speed.go_around = replace(self.speed.go_around,
                                            vapp_cas_mps=self.speed.vapp_cas_mps)
 
-    def _profile(self, a: ActivePath, leg: int) -> tuple:
-        """The profile nodes flown now: (distances m, altitudes m, climb targets, windows,
-        coded angle), cut after the MAP before the go-around."""
-        ps, ph, ct, win, va = a.prof_s, a.prof_h, a.climb_tgt, a.windows, a.coded_angle
-        if self.go_around_leg is None or self.go_around_active(leg):
-            return ps, ph, ct, win, va
-        j = self.go_around_leg - a.fp.leg_offset + 1
-        if not 1 < j < len(ps):
-            return ps, ph, ct, win, va
+    def _nodes(self, a: ActivePath, leg: int) -> ProfileNodes:
+        """The profile nodes flown now (packed once per path), cut after the MAP before the
+        go-around."""
+        j = len(a.prof_s)
+        if self.go_around_leg is not None and not self.go_around_active(leg):
+            cut = self.go_around_leg - a.fp.leg_offset + 1
+            if 1 < cut < j:
+                j = cut
         if self._cut[0] is not a or self._cut[1] != j:
-            self._cut = (a, j, (ps[:j], ph[:j], ct[:j], win[:j], va[:j]))
+            self._cut = (a, j, ProfileNodes.of(a.prof_s[:j], a.prof_h[:j], a.climb_tgt[:j],
+                                               a.windows[:j], a.coded_angle[:j]))
         return self._cut[2]
 
     def update(self, w: Where, nav: NavSolution, air: AirData) -> tuple[float, float]:
         """(altitude command m, TAS target m/s) at ``w`` (module docstring)."""
-        ps, ph, ct, win, va = self._profile(w.act, w.leg)
-        alt_cmd = max(altitude_command_m(ps, ph, ct, w.s_path_m, w.gs_mps, self.lead_s,
-                                         self.t2_s2, self.top_m, self.approach, win, va,
-                                         air.tas_mps),
+        alt_cmd = max(altitude_command_fast_m(self._nodes(w.act, w.leg), w.s_path_m, w.gs_mps,
+                                              self.lead_s, self.t2_s2, self.top_m,
+                                              self.approach, air.tas_mps),
                       self.floor_m)
         return alt_cmd, self.speed.update(nav.t_s, nav.alt_m, w)
 

@@ -166,7 +166,8 @@ class Flight:
         spec = self.scn.navigation_spec
         nav_dt = float(spec.get("dt_s", 0.1)) if spec.get("source") == "sins" else 0.0
         # hold the navigation errors between updates when navigation runs slower than guidance
-        self._navigate = NavHold(self.navigation, nav_dt) if nav_dt > dt + 1e-9 else sampling
+        self._navigate = (NavHold(self.navigation, nav_dt) if nav_dt > dt + 1e-9 else
+                          sampling if sampling.getters else self.navigation.update)
         parts = LoopParts(cfg, ac, self.targets, LateralStep(cfg, dt),
                           WindRamp(ac.fdm, self.scn, dt, None if runway is not None else 0.0),
                           sampling, self.n_frames, dt,
@@ -230,33 +231,43 @@ class Flight:
             self.air_data.update
         dt, bar, phase = self.dt_outer_s, self._bar, self.phase
         n_total = int(math.ceil(self.scn.duration_s / dt))
-        log_add, every = log.add, log.every
+        every = log.every
+        raws, cmds, errors, records = (log.raw.append, log.cmds.append, log.errors.append,
+                                       log.records.append)
+        windy = self.phase.parts.wind.active
+        check, wind, guided, after, command, advance = _bind(phase, windy)
         for k in range(n_total + 1):
             raw = read()
             s = state(raw)                                           # read
-            why = phase.check(s, raw)                                # check
+            why = check(s, raw)                                      # check
             if why:
                 return self._end("diverged", why)
-            phase.wind(s)                                            # wind
+            if windy:                                                # wind
+                wind(s)
             nav = navigate(s)                                        # navigate
             air = air_data(s)                                        # air data
             if events.pending and phase.fires_events:                # events
                 self._events_due(s)
             gout = None
-            if guide is not None and phase.guided(s):                # guide
+            if guide is not None and (guided is None or guided(s)):  # guide
                 gout = guide.update(dt, nav, air)
                 merge_guidance(gout, tg)
-            nxt = phase.after_guidance(s, gout)                      # phase change
-            if nxt is not phase:
-                phase = self.phase = nxt
-            cmd = phase.command(s, nav, air, gout)                   # command
+            if after is not None:                                    # phase change
+                nxt = after(s, gout)
+                if nxt is not phase:
+                    phase = self.phase = nxt
+                    check, wind, guided, after, command, advance = _bind(phase, windy)
+            fields = command(s, nav, air, gout)                      # command
             if k % every == 0:                                       # log
-                log_add(raw, cmd, nav, None if gout is None else guide.log_record())
+                raws(tuple(raw))
+                cmds(fields)
+                errors(nav.errors)
+                records(None if gout is None else guide.log_record())
             if gout is not None and gout.done:
                 return self._end("guidance_complete", "guidance complete")
             if k == n_total:
                 return self._end("duration", "duration flown")
-            why = phase.advance()                                    # advance
+            why = advance()                                          # advance
             if why:
                 return self._end("diverged", why)
             if bar is not None and k % PROGRESS_EVERY == 0:
@@ -300,6 +311,15 @@ class Flight:
             TrimRecord(tr.alt_m, round(tr.tas_mps, 3), round(tr.alpha_deg, 3),
                        round(tr.pitch_deg, 3), round(tr.throttle, 4), round(tr.elevator, 4)),
             Metrics.of(df), takeoff.record() if takeoff is not None else None)
+
+
+def _bind(phase, windy: bool) -> tuple:
+    """The phase's steps as the loop calls them: (check, wind or None when there is no wind,
+    guided or None when it flies every step guided, after_guidance or None when the phase never
+    changes, command, advance)."""
+    return (phase.check, phase.wind if windy else None,
+            None if phase.always_guided else phase.guided,
+            phase.after_guidance if phase.hands_over else None, phase.command, phase.advance)
 
 
 def _on(guidance) -> str:

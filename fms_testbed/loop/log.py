@@ -1,11 +1,13 @@
 """The flight log: which outer steps are logged (the cadence, in one place), what the loop keeps
 of each, and the timeseries built from it once, vectorised, at the end.
 
-Per logged step the loop keeps only references to what it already has — no copy, no
-conversion: the raw JSBSim read (:meth:`~fms_testbed.sim.jsbsim_core.JSBSimAircraft.read_raw`,
-a fresh list of floats in JSBSim units), the commands (a tuple), the navigation solution (its
-:data:`~fms_testbed.core.timeseries.LOG_FIELDS` and error record are read at the end) and the
-guidance's log record (opaque, turned into its columns by the guidance after the flight). The
+Per logged step the loop keeps what it already has as tuples of numbers, converted once at the
+end: the raw JSBSim read (:meth:`~fms_testbed.sim.jsbsim_core.JSBSimAircraft.read_raw`, JSBSim
+units), the commands and the navigation solution (:data:`~fms_testbed.core.timeseries.LOG_FIELDS`),
+the navigation source's error record (the dict it returned, not copied) and the guidance's log
+record (a tuple, turned into its columns by the guidance after the flight). Tuples of numbers
+and dicts of numbers are not tracked by the garbage collector, so a long log adds nothing to
+its walks (a list or an object per row would: a full collection walks every one of them). The
 columns, with their units:
 
 * :data:`~fms_testbed.core.timeseries.COLUMNS` (the contract), then :data:`EXTRA_COLUMNS`;
@@ -53,23 +55,23 @@ class FlightLog:
     def __init__(self, every: int, guidance=None):
         self.every = int(every)
         self.guidance = guidance
-        self.raw: list[list[float]] = []
+        self.raw: list[tuple] = []
         self.cmds: list[tuple] = []
-        self.navs: list = []
+        self.errors: list[dict] = []
         self.records: list = []
 
     def due(self, k: int) -> bool:
         """True when outer step ``k`` (0 at the flight's start) is logged."""
         return k % self.every == 0
 
-    def add(self, raw: list[float], cmd: tuple, nav, record=None) -> None:
-        """Log one step: the raw read, the commands (bank rad, heading rad, n_x g, n_y g,
-        throttle, altitude m, TAS m/s; NaN where inactive), the navigation solution and the
-        guidance's record (None: no guidance this step). The objects are kept, not copied:
-        the caller hands over fresh ones every step."""
-        self.raw.append(raw)
-        self.cmds.append(cmd)
-        self.navs.append(nav)
+    def add(self, raw: list[float], fields: tuple, nav, record=None) -> None:
+        """Log one step: the raw read, the :data:`~fms_testbed.core.timeseries.LOG_FIELDS`
+        (commands and navigation solution; NaN where inactive), the navigation solution's error
+        record and the guidance's record (a tuple of numbers; None: no guidance this step).
+        The flight loop appends the same four itself."""
+        self.raw.append(tuple(raw))
+        self.cmds.append(fields)
+        self.errors.append(nav.errors)
         self.records.append(record)
 
     def __len__(self) -> int:
@@ -88,10 +90,7 @@ class FlightLog:
             return pd.DataFrame({c: pd.Series(dtype=float) for c in names})
         raw = np.array(self.raw, dtype=float)
         r = raw_to_si(raw)
-        cmd = np.array(self.cmds, dtype=float)
-        nav = np.array([(n.lat_rad, n.lon_rad, n.alt_m, n.heading_rad, n.roll_rad, n.pitch_rad)
-                        for n in self.navs], dtype=float)
-        lg = np.concatenate([cmd, nav], axis=1)
+        lg = np.array(self.cmds, dtype=float)
         cols = _base_columns(r, {f: lg[:, j] for j, f in enumerate(LOG_FIELDS)})
         df = pd.DataFrame({**{c: cols[c] for c in names},
                            **{c: r[c] for c, _ in EXTRA_COLUMNS}})
@@ -101,7 +100,7 @@ class FlightLog:
     def _extra_columns(self, raw: np.ndarray) -> dict[str, list]:
         """The navigation-error and guidance columns (NaN where a row has none)."""
         out: dict[str, list] = {}
-        errors = [n.errors for n in self.navs]
+        errors = self.errors
         if any(errors):
             for k in dict.fromkeys(k for e in errors for k in e):
                 out[k] = [e.get(k, _NAN) for e in errors]

@@ -73,6 +73,8 @@ class AirbornePhase:
 
     name = "airborne"
     fires_events = True
+    always_guided = True
+    hands_over = False
 
     def __init__(self, parts: LoopParts, vertical: VerticalStep, config: ConfigStep | None,
                  go_around: Callable[[], bool]):
@@ -99,8 +101,10 @@ class AirbornePhase:
 
     def command(self, s: AircraftState, nav: NavSolution, air: AirData,
                 gout: GuidanceOutput | None) -> tuple:
-        """Lateral, vertical and configuration commands sent for this step; return them for
-        the log: (bank rad, heading target rad, n_x g, n_y g, throttle, altitude m, TAS m/s)."""
+        """Lateral, vertical and configuration commands sent for this step; return them with
+        the navigation solution for the log (:data:`~fms_testbed.core.timeseries.LOG_FIELDS`:
+        bank rad, heading target rad, n_x g, n_y g, throttle, altitude m, TAS m/s, navigation
+        latitude, longitude rad, altitude m, heading, roll, pitch rad; NaN where inactive)."""
         tg = self.tg
         bank = self.lateral(tg, nav, gout is not None)
         nx, ny, alt, tas = self.vertical(s, air, tg, bank)
@@ -108,7 +112,8 @@ class AirbornePhase:
             self.config(s, tg, self.go_around())
         hdg, thr = tg.heading_rad, tg.throttle
         return (bank, _NAN if hdg is None else hdg, nx, ny, _NAN if thr is None else thr, alt,
-                tas)
+                tas, nav.lat_rad, nav.lon_rad, nav.alt_m, nav.heading_rad, nav.roll_rad,
+                nav.pitch_rad)
 
     def advance(self) -> str:
         """Run the JSBSim frames to the next outer step; '' or why the flight must end."""

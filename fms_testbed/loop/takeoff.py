@@ -280,6 +280,8 @@ class TakeoffPhase:
 
     name = "takeoff"
     fires_events = False
+    always_guided = False
+    hands_over = True
 
     def __init__(self, parts: LoopParts, runway: DepartureRunway, guided: bool,
                  airborne: Callable[[ConfigStep | None], AirbornePhase]):
@@ -374,12 +376,14 @@ class TakeoffPhase:
 
     def command(self, s: AircraftState, nav: NavSolution, air: AirData, gout) -> tuple:
         """LNAV's bank command (through the flight's roll-rate limit) when the guidance steers;
-        the log values: (bank rad, runway heading rad until LNAV, -, -, throttle, -, -)."""
+        the log values (:data:`~fms_testbed.core.timeseries.LOG_FIELDS`: bank rad, the runway
+        heading until LNAV rad, -, -, throttle, -, -, the navigation solution)."""
         if gout is not None:
             self.bank_cmd_rad = self.parts.lateral(self.parts.targets, nav, True)
         nan = math.nan
-        return (self.bank_cmd_rad, self.bearing_rad if gout is None else nan, nan, nan, self.throttle, nan,
-                nan)
+        return (self.bank_cmd_rad, self.bearing_rad if gout is None else nan, nan, nan,
+                self.throttle, nan, nan, nav.lat_rad, nav.lon_rad, nav.alt_m, nav.heading_rad,
+                nav.roll_rad, nav.pitch_rad)
 
     def advance(self) -> str:
         """The takeoff control over the JSBSim frames to the next outer step, every
