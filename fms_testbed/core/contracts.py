@@ -227,8 +227,8 @@ OMIT_NONE = {"omit_none": True}
 
 
 def record_dict(obj: Any) -> Any:
-    """The JSON form of a run record: dataclasses as mappings in field order (fields marked
-    :data:`OMIT_NONE` left out while None), lists, tuples and mappings converted item by
+    """The JSON form of a run record ``obj``: dataclasses as mappings in field order (fields
+    marked :data:`OMIT_NONE` left out while None), lists, tuples and mappings converted item by
     item, numbers and strings as they are."""
     if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
         return {f.name: record_dict(v) for f in dataclasses.fields(obj)

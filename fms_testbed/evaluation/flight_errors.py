@@ -69,7 +69,8 @@ def _stats(x: np.ndarray) -> dict[str, float | None]:
 
 
 def error_columns(df: pd.DataFrame) -> pd.DataFrame:
-    """Add ``fte_m`` (= nav_xtk_m), ``tse_m`` (= xtk_m) and ``nse_m`` (nav vs truth) columns;
+    """Add ``fte_m`` (= nav_xtk_m), ``tse_m`` (= xtk_m) and ``nse_m`` (nav vs truth) columns to
+    the timeseries ``df`` (a copy);
     FTE and TSE are NaN on the straight part of heading legs (``heading_leg``), which have no
     defined ground track."""
     df = df.copy()
@@ -82,7 +83,8 @@ def error_columns(df: pd.DataFrame) -> pd.DataFrame:
 
 
 def error_stats(df: pd.DataFrame) -> dict[str, ErrorParts]:
-    """FTE/NSE/PDE/TSE statistics overall, on straight flight and in turns (module docstring)."""
+    """FTE/NSE/PDE/TSE statistics of ``df`` (:func:`error_columns`) overall, on straight flight
+    and in turns (module docstring)."""
     straight = (df["curvature_1pm"].to_numpy() == 0) & (df["straight_m"].to_numpy()
                                                        >= STRAIGHT_MARGIN_M)
     out = {}
@@ -94,7 +96,8 @@ def error_stats(df: pd.DataFrame) -> dict[str, ErrorParts]:
 
 
 def per_leg(df: pd.DataFrame, seq_legs) -> list[LegErrors]:
-    """Per-leg statistics and RNP containment (TSE95 ≤ RNP and max TSE ≤ 2 × RNP)."""
+    """Per-leg statistics of ``df`` (:func:`error_columns`) for the records ``seq_legs`` and
+    RNP containment (TSE95 ≤ RNP and max TSE ≤ 2 × RNP)."""
     rows = []
     for k, rec in enumerate(seq_legs):
         d = df[df["leg_index"] == k]
@@ -121,7 +124,8 @@ aircraft is this much farther from the fix than its closest approach so far, m."
 
 def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf
                       ) -> list[ConstraintCheck]:
-    """Altitude and speed compliance at each constrained fix (module docstring).
+    """Altitude and speed compliance at each constrained fix of the built procedure ``fp`` in
+    the timeseries ``df`` (module docstring).
 
     ``floor_m``: the lowest altitude guidance descends to, m (a circling approach: the airport
     elevation + ``guidance.vnav.CIRCLING_FLOOR_HEIGHT_M``). A coded top below it — the CIFP

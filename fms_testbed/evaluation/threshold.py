@@ -51,9 +51,10 @@ CROSS_TRACK_MAX_M = 1000.0
 
 def along_track_m(lat_deg, lon_deg, thr_lat_deg: float, thr_lon_deg: float,
                   course_deg: float) -> tuple[np.ndarray, np.ndarray]:
-    """(along, cross) track distances from the threshold on ``course_deg`` (deg true): along
-    positive past the threshold, cross positive to the right, m (equirectangular local plane:
-    < 0.1 % error within 20 km)."""
+    """(along, cross) track distances of the positions ``lat_deg``, ``lon_deg`` (deg, arrays)
+    from the threshold at ``thr_lat_deg``, ``thr_lon_deg`` (deg) on ``course_deg`` (deg true):
+    along positive past the threshold, cross positive to the right, m (equirectangular local
+    plane: < 0.1 % error within 20 km)."""
     lat0 = math.radians(thr_lat_deg)
     x = np.radians(np.asarray(lon_deg) - thr_lon_deg) * math.cos(lat0) * MEAN_RADIUS_M
     y = np.radians(np.asarray(lat_deg) - thr_lat_deg) * MEAN_RADIUS_M
@@ -62,7 +63,8 @@ def along_track_m(lat_deg, lon_deg, thr_lat_deg: float, thr_lon_deg: float,
 
 
 def final_course_deg(path, map_leg: int) -> float | None:
-    """Course at the end of the MAP leg's last built segment, deg true (None: no segment)."""
+    """Course at the end of the last built segment of leg ``map_leg`` (the MAP) of the built
+    ``path``, deg true (None: no segment)."""
     segs = [s for s in path.segments if s.leg_index == map_leg]
     return float(segs[-1].geom.end_course_deg) % 360.0 if segs else None
 

@@ -53,7 +53,13 @@ def air_velocity_ned_mps(tas_mps: float, alpha_rad: float, beta_rad: float, roll
     """Velocity of the aircraft relative to the air, NED, m/s: the air-data vector
     V (cos α cos β, sin β, sin α cos β) in body axes turned to NED by the attitude,
     v_n = R_z(ψ) R_y(θ) R_x(φ) v_b (in a banked turn the α part has a horizontal component,
-    which the heading alone would miss)."""
+    which the heading alone would miss).
+
+    Parameters
+    ----------
+    tas_mps : true airspeed V, m/s; alpha_rad, beta_rad : angle of attack and sideslip, rad
+    roll_rad, pitch_rad, heading_rad : attitude φ, θ, ψ (heading true), rad
+    """
     ca, sa, cb, sb = math.cos(alpha_rad), math.sin(alpha_rad), math.cos(beta_rad), math.sin(beta_rad)
     u, v, w = tas_mps * ca * cb, tas_mps * sb, tas_mps * sa * cb
     cf, sf = math.cos(roll_rad), math.sin(roll_rad)
@@ -67,7 +73,7 @@ def air_velocity_ned_mps(tas_mps: float, alpha_rad: float, beta_rad: float, roll
 def measured_params(params, alt_m: float, wind_ne_mps: tuple[float, float], isa_dev_c: float):
     """Build settings for the measured conditions: the planned wind profile shifted by the
     measured − planned wind at ``alt_m`` (m) — a constant planned wind becomes the measured
-    one — and the measured ISA deviation (K). ``params``: the active path's
+    one — and the measured ISA deviation ``isa_dev_c`` (K). ``params``: the active path's
     :class:`~fms_testbed.legs.model.BuildParams`; ``wind_ne_mps``: measured (north, east)
     velocity of the air, m/s."""
     spd, frm = params.wind_at(alt_m)

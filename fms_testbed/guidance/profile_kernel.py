@@ -157,7 +157,15 @@ def _command(rows, windows, s_path_m, gs_mps, lead_s, t2_s2, top_m, approach, v_
 def altitude_command_fast_m(p: ProfileNodes, s_path_m: float, gs_mps: float, lead_s: float,
                             t2_s2: float, top_m: float, approach: bool,
                             lead_speed_mps: float | None = None) -> float:
-    """:func:`.vertical.altitude_command_m` on packed nodes (its parameters; m, m/s, s, s²)."""
+    """:func:`.vertical.altitude_command_m` on the packed nodes ``p``, m.
+
+    Parameters
+    ----------
+    s_path_m : distance along the active path, m; gs_mps : ground speed, m/s
+    lead_s : read-ahead time 2 ξ_H T_H, s; t2_s2 : T_H², s²; top_m : the climb top, m
+    approach : the last slope continues to the runway
+    lead_speed_mps : the speed of the lead term, m/s (None: ``gs_mps``)
+    """
     v_lead = gs_mps if lead_speed_mps is None else lead_speed_mps
     return _command(p.rows, p.windows, s_path_m, gs_mps, lead_s, t2_s2, top_m, approach,
                     v_lead)

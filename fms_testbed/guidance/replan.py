@@ -55,9 +55,10 @@ BROKEN_FINDINGS = ("discontinuity", "loop", "no-intercept")
 
 def passed_direct_legs(whole: FlyablePath, first: int, lat_rad: float, lon_rad: float,
                        track_rad: float, tas_mps: float) -> list[int]:
-    """Indices ``first, first + 1, ...`` of the consecutive DF legs whose fix is already passed
-    (:func:`~.sequencing.direct_fix_passed`) at the navigation position (rad), track (rad) and
-    planned speed (m/s)."""
+    """Indices ``first, first + 1, ...`` of the consecutive DF legs of the whole procedure
+    ``whole`` whose fix is already passed (:func:`~.sequencing.direct_fix_passed`) at the
+    navigation position ``lat_rad``, ``lon_rad`` (rad), track ``track_rad`` (rad) and planned
+    speed ``tas_mps`` (m/s)."""
     out = []
     k = first
     legs = whole.path.legs

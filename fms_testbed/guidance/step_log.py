@@ -40,8 +40,8 @@ def record(path_index: int, w: Where) -> tuple:
 
 
 def log_values(a: ActivePath, rec: tuple, true_lat_rad: float, true_lon_rad: float) -> tuple:
-    """The :data:`LOG_COLUMNS` values of one logged step: its record on active path ``a``
-    (:func:`record`) and the true position (rad)."""
+    """The :data:`LOG_COLUMNS` values of one logged step: its record ``rec`` on active path
+    ``a`` (:func:`record`) and the true position ``true_lat_rad``, ``true_lon_rad`` (rad)."""
     _, i, along_m, xtk_m, leg = rec
     p = a.pieces[i]
     seg = a.segs[p.seg_index]
@@ -57,9 +57,9 @@ def log_values(a: ActivePath, rec: tuple, true_lat_rad: float, true_lon_rad: flo
 
 def log_frame(paths: list[ActivePath], records: list[tuple | None], true_lat_rad: np.ndarray,
               true_lon_rad: np.ndarray) -> dict[str, list]:
-    """The :data:`LOG_COLUMNS` of the logged steps (one :func:`record` per row on the active
-    paths ``paths``, None where guidance located nothing: NaN), given the true position of each
-    row (rad)."""
+    """The :data:`LOG_COLUMNS` of the logged steps: ``records`` (one :func:`record` per row on
+    the active paths ``paths``, None where guidance located nothing: NaN) and the true position
+    of each row, ``true_lat_rad``, ``true_lon_rad`` (rad)."""
     nan_row = (math.nan,) * len(LOG_COLUMNS)
     rows = [nan_row if r is None else log_values(paths[r[0]], r, float(la), float(lo))
             for r, la, lo in zip(records, true_lat_rad, true_lon_rad)]

@@ -34,8 +34,8 @@ DEFAULT_CLIMB_TOP_M = 15000 * FT_M
 
 
 def circling_floor_m(fp: FlyablePath, db) -> float:
-    """Lowest altitude command of the flight, m: for a circling approach the airport elevation
-    plus :data:`CIRCLING_FLOOR_HEIGHT_M`, else −inf."""
+    """Lowest altitude command of a flight of ``fp`` (database ``db``), m: for a circling
+    approach the airport elevation plus :data:`CIRCLING_FLOOR_HEIGHT_M`, else −inf."""
     from fms_testbed.path.runway import approach_runway
 
     if fp.path.proc_type != "F" or db is None or approach_runway(db, fp.seq) is not None:
@@ -47,8 +47,9 @@ def circling_floor_m(fp: FlyablePath, db) -> float:
 
 
 def climb_top_m(fp: FlyablePath, cfg, spec) -> float:
-    """The flight's climb top, m: the spec's (else :data:`DEFAULT_CLIMB_TOP_M`) below the
-    aircraft's ceiling less its margin, raised to every 'at or above' bound of the profile."""
+    """The climb top of a flight of ``fp`` by aircraft ``cfg``, m: the ``spec``'s (else
+    :data:`DEFAULT_CLIMB_TOP_M`) below the aircraft's ceiling less its margin, raised to every
+    'at or above' bound of the profile."""
     top = spec.climb_top_ft * FT_M if spec is not None else DEFAULT_CLIMB_TOP_M
     top = min(top, cfg.limits.alt_max_m - CEILING_MARGIN_M)
     los = [w.lo_m for w in (fp.path.profile.windows if fp.path.profile else ())

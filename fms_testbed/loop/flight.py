@@ -342,9 +342,12 @@ def _progress_bar(scn: Scenario, progress: bool | None):
 def fly(scn: Scenario, cfg: AircraftConfig | None = None, seed: int | None = None,
         guidance: Guidance | None = None, progress: bool | None = None,
         vertical_law=None) -> tuple[pd.DataFrame, FlightRecord]:
-    """Fly a validated scenario and return (timeseries DataFrame, :class:`~.record.FlightRecord`).
+    """Fly a validated scenario and return (timeseries DataFrame, :class:`~.record.FlightRecord`):
+    ``Flight(...).run()``.
 
-    The parameters are :class:`Flight`'s; this is ``Flight(...).run()``.
+    Parameters
+    ----------
+    scn, cfg, seed, guidance, progress, vertical_law : :class:`Flight`'s
     """
     return Flight(scn, cfg=cfg, seed=seed, guidance=guidance, progress=progress,
                   vertical_law=vertical_law).run()

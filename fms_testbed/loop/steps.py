@@ -96,8 +96,8 @@ def apply_event(ev: Event, tg: Targets) -> None:
 
 
 def merge_guidance(gout: GuidanceOutput, tg: Targets) -> None:
-    """Write a guidance output into ``tg``: its bank replaces heading/bank hold, its altitude and
-    TAS engage the vertical law."""
+    """Write the guidance output ``gout`` into the targets ``tg``: its bank replaces heading/bank
+    hold, its altitude and TAS engage the vertical law."""
     if gout.bank_rad is not None:
         tg.bank_rad, tg.heading_rad = gout.bank_rad, None
     if gout.alt_m is not None:
@@ -107,8 +107,8 @@ def merge_guidance(gout: GuidanceOutput, tg: Targets) -> None:
 
 
 def wind_ned_mps(scn: Scenario, alt_m: float = 0.0) -> tuple[float, float, float]:
-    """The scenario's wind at ``alt_m`` (m; a profile is interpolated) as the velocity of the
-    air, NED, m/s."""
+    """The wind of scenario ``scn`` at ``alt_m`` (m; a profile is interpolated) as the velocity
+    of the air, NED, m/s."""
     prof = scn.wind_profile
     if prof is None:
         return (0.0, 0.0, 0.0)

@@ -123,8 +123,9 @@ class DepartureRunway:
 
 
 def departure_runway(db, seq) -> DepartureRunway | None:
-    """The runway of SID sequence ``seq`` (its runway transition's threshold record, the one the
-    airborne start's departure end is computed from), None when it has none or no elevation."""
+    """The runway of SID sequence ``seq`` in database ``db`` (its runway transition's threshold
+    record, the one the airborne start's departure end is computed from), None when it has none
+    or no elevation."""
     from fms_testbed.path.segmentation import runway_record   # the airborne start's look-up
 
     if db is None or seq.proc_type != "D":
@@ -144,7 +145,13 @@ def departure_runway(db, seq) -> DepartureRunway | None:
 
 def check_takeoff(source: str, proc_type: str, rwy: DepartureRunway | None,
                   cfg: AircraftConfig) -> None:
-    """Refuse a takeoff start that cannot be flown: :class:`ConfigError` (file, field, reason)."""
+    """Refuse a takeoff start that cannot be flown: :class:`ConfigError` (file, field, reason).
+
+    Parameters
+    ----------
+    source : the scenario's file (for the message); proc_type : the procedure's type letter
+    rwy : its departure runway (None: none found); cfg : the aircraft (its ``takeoff:`` block)
+    """
     where = f"{source}: field 'procedure.start'"
     if proc_type != "D":
         kind = {"E": "a STAR", "F": "an approach"}.get(proc_type, "this procedure")
@@ -507,8 +514,8 @@ class TakeoffPhase:
 
 
 def start_on_runway(ac, runway: DepartureRunway, cfg: AircraftConfig) -> None:
-    """Put ``ac`` at rest on the threshold of ``runway`` with the takeoff flaps
-    (:func:`~fms_testbed.sim.takeoff.ground_start`)."""
+    """Put ``ac`` at rest on the threshold of ``runway`` with the takeoff flaps of aircraft
+    ``cfg`` (:func:`~fms_testbed.sim.takeoff.ground_start`)."""
     ground_start(ac, runway.lat_deg, runway.lon_deg, runway.elev_m, runway.bearing_deg,
                  cfg.takeoff.flaps_norm)
 

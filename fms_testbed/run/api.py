@@ -175,8 +175,14 @@ def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None =
 def fly_procedure(scn: Scenario, spec, fp, db, out_dir: str | Path | None = None,
                   seed: int | None = None, plots: bool = True, csv: bool = False,
                   progress: bool | None = None) -> Results:
-    """Fly an already built procedure (:func:`fms_testbed.loop.procedure.prepare`'s results);
-    the same as :func:`run_scenario` on its scenario, without building it again."""
+    """Fly an already built procedure; the same as :func:`run_scenario` on its scenario,
+    without building it again.
+
+    Parameters
+    ----------
+    scn, spec, fp, db : :func:`fms_testbed.loop.procedure.prepare`'s results
+    out_dir, seed, plots, csv, progress : :func:`run_scenario`'s
+    """
     flight = Flight(scn, seed=seed, progress=progress, procedure=PreparedProcedure(spec, fp, db))
     flight.run()
     res = results_of(flight)

@@ -65,12 +65,12 @@ def dumps_schema(schema: dict) -> str:
 
 
 def shipped(name: str) -> dict:
-    """A schema shipped in the package (``fms_testbed/data/schemas/NAME``)."""
+    """The schema ``name`` shipped in the package (``fms_testbed/data/schemas/NAME``)."""
     return json.loads(resources.files("fms_testbed.data").joinpath("schemas", name).read_text())
 
 
 def validator(name: str):
-    """A ``jsonschema`` validator of the shipped schema ``name`` (test dependency)."""
+    """A ``jsonschema`` validator of the shipped schema ``name`` (a test dependency)."""
     import jsonschema
 
     schema = shipped(name)
