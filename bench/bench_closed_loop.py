@@ -52,6 +52,32 @@ def bench_scenario(aircraft: str, alt_m: float, tas_mps: float, sim_s: float) ->
                        {"t_s": 200, "heading_deg": 90}]}
 
 
+def python_floor_us(cfg, scn: dict) -> dict[str, float]:
+    """Process time of the Python work no outer step can skip (µs, best of 5 × 20,000): the 37
+    property reads the log needs, the true state, the coupled law, the three inner-loop
+    commands."""
+    import time
+
+    f = Flight(parse_scenario({**scn, "duration_s": 60.0}), cfg=cfg, progress=False)
+    f.step(20)
+    ac, law = f.aircraft, f.vertical_law
+    raw = ac.read_raw()
+    s = ac.state(raw)
+    parts = {"read_raw": ac.read_raw, "state": lambda: ac.state(raw),
+             "law": lambda: law.update(0.1, s, s.alt_m, s.tas_mps),
+             "command": lambda: ac.command(bank_rad=0.0, ny=1.0, nx=0.0)}
+    out = {}
+    for name, fn in parts.items():
+        best = 1e9
+        for _ in range(5):
+            t0 = time.process_time()
+            for _ in range(20000):
+                fn()
+            best = min(best, (time.process_time() - t0) / 20000)
+        out[name] = 1e6 * best
+    return out
+
+
 def measure(cfg, scn: dict, chunk_s: float = CHUNK_S) -> dict:
     """Interleaved ratio of the benchmark flight with aircraft configuration ``cfg``."""
     res = interleaved_ratio(Flight(parse_scenario(scn), cfg=cfg, progress=False), cfg, chunk_s)
@@ -115,6 +141,9 @@ def main() -> None:
     py_us = [1e6 * n_frames * (1.0 / m["closed_fps"] - 1.0 / (m["bare_fps"] * c_med))
              for m in runs["default"]]
     print(f"Python per outer step (default): median {statistics.median(py_us):.1f} us")
+    floor = python_floor_us(cfg, scn)
+    print("Python no outer step can skip: " + ", ".join(f"{k} {v:.2f}" for k, v in floor.items())
+          + f" = {sum(floor.values()):.1f} us")
     b = statistics.median(m["bare_fps"] for m in runs["default"])
     print(f"whole run_scenario (load, trim, loop, DataFrame), not interleaved: {whole:.0f} "
           f"frames/s = {whole / b:.2f} of the median bare rate")
@@ -141,7 +170,11 @@ def main() -> None:
              f"{scn.get('outer_rate_hz', 10)} Hz, logging at 10 Hz; each flight timed "
              f"interleaved with a bare JSBSim instance in {args.chunk_s:g} s chunks. Python work "
              f"per outer step at the default configuration, from the rates: median "
-             f"{statistics.median(py_us):.1f} µs. Load average at the start: {load}.")
+             f"{statistics.median(py_us):.1f} µs; of it no outer step can skip the property reads "
+             f"the log needs, the true state, the coupled law and the commands, "
+             f"{sum(floor.values()):.1f} µs (process time: "
+             + ", ".join(f"{k} {v:.2f}" for k, v in floor.items())
+             + f"). Load average at the start: {load}.")
 
 
 if __name__ == "__main__":
