@@ -67,10 +67,9 @@ class Results:
 
     def inputs(self) -> dict[str, dict]:
         """The files this flight was built from, with their SHA-256 (for ``run.json``)."""
-        files = {"scenario": self.scenario.source_file,
-                 "aircraft": self.summary.get("aircraft_file")}
-        if self.procedure is not None:
-            files["procedure_db"] = getattr(self.procedure.db, "path", None)
+        files = {"scenario": self.scenario.source_file, "aircraft": self.summary.aircraft_file}
+        if self.procedure is not None and self.procedure.db is not None:
+            files["procedure_db"] = self.procedure.db.path
         return {k: {"path": str(v), "sha256": file_sha256(v)} for k, v in files.items()
                 if v and not str(v).startswith("<")}
 
