@@ -1,4 +1,4 @@
-"""Procedure flight speed over bare JSBSim speed, same aircraft, same process (issue 6 goal ≥ 0.5).
+"""Procedure flight speed over bare JSBSim speed, same aircraft, same process (goal ≥ 0.8 at 10 Hz).
 
 Bare: ``fdm.run()`` on the sanitised, trimmed model at 120 Hz with no Python work per frame.
 Procedure flight: the demo SID (KJFK DEEZZ5 RW31L CANDR from the embedded database), 15
@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 import time
 from pathlib import Path
@@ -85,6 +86,7 @@ def main() -> None:
                     help="Markdown table in docs/results/ ('' to skip)")
     args = ap.parse_args()
     logging.basicConfig(level=logging.WARNING)
+    load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     print(f"737, demo SID, {args.sim_s:.0f} s simulated at 120 Hz, each flight interleaved with "
           "bare JSBSim in 10 s chunks")
     build = None
@@ -92,7 +94,7 @@ def main() -> None:
     for r in args.rates:
         res, build, per_call = procedure_ratio(args.sim_s, r)
         print(f"procedure flight @ {r:4.0f} Hz: {res['closed_fps']:9.0f} frames/s "
-              f"(bare {res['bare_fps']:.0f}), ratio {res['ratio']:.2f} (goal >= 0.50); "
+              f"(bare {res['bare_fps']:.0f}), ratio {res['ratio']:.2f}{' (goal >= 0.80)' if r == 10 else ''}; "
               f"guidance {per_call:.1f} µs per call; flew {res['summary']['duration_s']:.0f} s "
               f"({res['summary']['reason']})")
         q = runner_only_ratio(args.sim_s, r)
@@ -102,7 +104,7 @@ def main() -> None:
         rows.append([f"procedure flight, guidance + law at {r:g} Hz{default}",
                      f"{res['closed_fps']:.0f}", f"{res['bare_fps']:.0f}",
                      f"**{res['ratio']:.2f}**" if r == 10 else f"{res['ratio']:.2f}",
-                     f"{per_call:.1f}", "≥ 0.50" if r == 10 else "–"])
+                     f"{per_call:.1f}", "≥ 0.80" if r == 10 else "–"])
         rows.append([f"flight loop alone at {r:g} Hz (law holding, no guidance)",
                      f"{q['closed_fps']:.0f}", f"{q['bare_fps']:.0f}", f"{q['ratio']:.2f}", "",
                      "–"])
@@ -113,7 +115,7 @@ def main() -> None:
         note=f"737, demo SID (KJFK DEEZZ5 RW31L CANDR, embedded database), {args.sim_s:.0f} s "
              f"simulated at 120 Hz, truth navigation, logging at 10 Hz; each flight timed "
              f"interleaved with a bare JSBSim instance in 10 s chunks. The path build "
-             f"({build:.2f} s, once) is excluded.")
+             f"({build:.2f} s, once) is excluded. Load average at the start: {load}.")
 
 
 if __name__ == "__main__":

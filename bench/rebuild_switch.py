@@ -3,8 +3,8 @@
 
 from __future__ import annotations
 
-import fms_testbed.guidance.fms as gfms
-from fms_testbed.guidance.replan import ConditionMonitor, ConditionThresholds
+import fms_testbed.guidance.replan as replan
+from fms_testbed.guidance.conditions import ConditionMonitor, ConditionThresholds
 from fms_testbed.loop.procedure import prepare
 from fms_testbed.run import fly_procedure
 
@@ -16,9 +16,9 @@ def fly(raw: dict, db, rebuild: bool = True):
     scn, spec, fp, d = prepare(raw, db=db)
     th = ConditionThresholds() if rebuild else ConditionThresholds(wind_err_mps=1e9,
                                                                    isa_dev_err_c=1e9)
-    orig = gfms.ConditionMonitor
-    gfms.ConditionMonitor = lambda: ConditionMonitor(th)
+    orig = replan.ConditionMonitor
+    replan.ConditionMonitor = lambda thresholds=None: ConditionMonitor(th)
     try:
         return fly_procedure(scn, spec, fp, d, progress=False, plots=False), fp
     finally:
-        gfms.ConditionMonitor = orig
+        replan.ConditionMonitor = orig

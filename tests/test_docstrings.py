@@ -29,6 +29,11 @@ MODULES = [
     "sensors.imu.kinematics", "sensors.imu.synthesis", "sensors.imu.errors",
     "navigation.bank", "navigation.inertial.strapdown", "navigation.inertial.alignment",
     "navigation.inertial.bank", "navigation.inertial.twin",
+    "loop.flight", "loop.log", "loop.phases", "loop.record", "loop.steps", "loop.takeoff",
+    "guidance.fms", "guidance.locate", "guidance.sequencing", "guidance.conditions",
+    "guidance.replan", "guidance.vnav", "guidance.step_log", "guidance.profile_kernel",
+    "guidance.speed_plan", "guidance.active_path", "run.summary", "run.schemas", "run.api",
+    "evaluation.records", "evaluation.flight_errors", "evaluation.threshold",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")

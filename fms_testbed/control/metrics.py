@@ -148,9 +148,3 @@ def _appearing(df: pd.DataFrame, ccol: str, ycol: str, tol: float = 0.5) -> list
     idx = np.flatnonzero(~np.isfinite(c[:-1]) & np.isfinite(c[1:])) + 1
     return [int(i) for i in idx if abs(c[i] - y[i - 1]) > tol]
 
-
-def relative_difference(a: float, b: float) -> float:
-    """``|a - b| / |b|`` (dimensionless); ``inf`` when b is 0 and a is not."""
-    if b == 0:
-        return 0.0 if a == 0 else float("inf")
-    return abs(a - b) / abs(b)

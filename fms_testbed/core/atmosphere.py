@@ -64,7 +64,12 @@ def pressure_altitude_m(alt_m, isa_dev_c=0.0):
 
 def altitude_of_pressure_m(p_pa):
     """ISA (pressure) altitude, m, of a static pressure ``p_pa`` (Pa): the inverse of the
-    standard day's p(h), troposphere and the isothermal layer above 11 km."""
+    standard day's p(h), troposphere and the isothermal layer above 11 km. A Python float gives
+    a float (the same formula in ``math``: the air-data computer calls it every outer step)."""
+    if type(p_pa) is float:
+        if p_pa >= _P_TROP_PA:
+            return T0_K / LAPSE_KPM * (1.0 - (p_pa / P0_PA) ** (1.0 / _N))
+        return H_TROP_M - R_JPKGK * _T_TROP_K / G0_MPS2 * math.log(p_pa / _P_TROP_PA)
     p = np.asarray(p_pa, dtype=float)
     h_trop = T0_K / LAPSE_KPM * (1.0 - (p / P0_PA) ** (1.0 / _N))
     h_strat = H_TROP_M - R_JPKGK * _T_TROP_K / G0_MPS2 * np.log(p / _P_TROP_PA)

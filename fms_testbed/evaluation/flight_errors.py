@@ -34,12 +34,15 @@ elevation + 591 ft) is checked against that floor (:func:`constraint_checks`).
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.evaluation.records import (ConstraintCheck, ErrorParts, ErrorStat,
+                                            FlightErrors, LegErrors, RnpContainment, Sequencing)
 from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.profile import window
 
@@ -66,7 +69,8 @@ def _stats(x: np.ndarray) -> dict[str, float | None]:
 
 
 def error_columns(df: pd.DataFrame) -> pd.DataFrame:
-    """Add ``fte_m`` (= nav_xtk_m), ``tse_m`` (= xtk_m) and ``nse_m`` (nav vs truth) columns;
+    """Add ``fte_m`` (= nav_xtk_m), ``tse_m`` (= xtk_m) and ``nse_m`` (nav vs truth) columns to
+    the timeseries ``df`` (a copy);
     FTE and TSE are NaN on the straight part of heading legs (``heading_leg``), which have no
     defined ground track."""
     df = df.copy()
@@ -78,20 +82,22 @@ def error_columns(df: pd.DataFrame) -> pd.DataFrame:
     return df
 
 
-def error_stats(df: pd.DataFrame) -> dict:
-    """FTE/NSE/PDE/TSE statistics overall, on straight flight and in turns (module docstring)."""
+def error_stats(df: pd.DataFrame) -> dict[str, ErrorParts]:
+    """FTE/NSE/PDE/TSE statistics of ``df`` (:func:`error_columns`) overall, on straight flight
+    and in turns (module docstring)."""
     straight = (df["curvature_1pm"].to_numpy() == 0) & (df["straight_m"].to_numpy()
                                                        >= STRAIGHT_MARGIN_M)
     out = {}
     for name in ("fte", "nse", "pde", "tse"):
         x = df[f"{name}_m"].to_numpy(dtype=float)
-        out[name] = {"all": _stats(x), "straight": _stats(x[straight]),
-                     "turns": _stats(x[~straight])}
+        out[name] = ErrorParts(ErrorStat(**_stats(x)), ErrorStat(**_stats(x[straight])),
+                               ErrorStat(**_stats(x[~straight])))
     return out
 
 
-def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
-    """Per-leg statistics and RNP containment (TSE95 ≤ RNP and max TSE ≤ 2 × RNP)."""
+def per_leg(df: pd.DataFrame, seq_legs) -> list[LegErrors]:
+    """Per-leg statistics of ``df`` (:func:`error_columns`) for the records ``seq_legs`` and
+    RNP containment (TSE95 ≤ RNP and max TSE ≤ 2 × RNP)."""
     rows = []
     for k, rec in enumerate(seq_legs):
         d = df[df["leg_index"] == k]
@@ -107,7 +113,7 @@ def per_leg(df: pd.DataFrame, seq_legs) -> list[dict]:
             row["rnp_contained"] = (None if row["tse95_m"] is None
                                     else bool(row["tse95_m"] <= rnp
                                               and row["tse_max_m"] <= 2.0 * rnp))
-        rows.append(row)
+        rows.append(LegErrors(**row))
     return rows
 
 
@@ -116,11 +122,13 @@ FIX_LEFT_M = 2000.0
 aircraft is this much farther from the fix than its closest approach so far, m."""
 
 
-def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf) -> list[dict]:
-    """Altitude and speed compliance at each constrained fix (module docstring).
+def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf
+                      ) -> list[ConstraintCheck]:
+    """Altitude and speed compliance at each constrained fix of the built procedure ``fp`` in
+    the timeseries ``df`` (module docstring).
 
     ``floor_m``: the lowest altitude guidance descends to, m (a circling approach: the airport
-    elevation + ``guidance.fms.CIRCLING_FLOOR_HEIGHT_M``). A coded top below it — the CIFP
+    elevation + ``guidance.vnav.CIRCLING_FLOOR_HEIGHT_M``). A coded top below it — the CIFP
     codes a circling MAP at the field elevation, not at an MDA — is checked against the floor
     instead (``floor_ft`` in the row): the aircraft must not descend below the coded bottom
     and must reach the floor, within the tolerance."""
@@ -136,88 +144,93 @@ def constraint_checks(df: pd.DataFrame, fp, floor_m: float = -math.inf) -> list[
         row = {"leg": k + 1, "code": rec.path_term, "fix": rec.fix.ident if rec.fix else "",
                "alt_desc": rec.alt_desc}
         bl = built.get(k)
-        term = bl.termination if bl is not None else None
-        if term is not None and (term.kind == "altitude" or not term.fix_ident and term.kind
-                                 in ("dme", "radial", "intercept", "manual", "distance")):
-            # a leg that ends where a condition is met (an HA at its altitude over its fix):
-            # checked where it ended, not where it first passed the fix
-            sel = np.flatnonzero(leg_col == k)
-            if sel.size:
-                i = int(sel[-1])
-                row["where"] = "leg end"
-            else:
-                # ended between two logged rows (an altitude already reached when the leg
-                # began): check the state when the next leg began
-                after = np.flatnonzero(leg_col > k)
-                if not after.size:
-                    row.update(ok=False, why="leg not flown")
-                    out.append(row)
-                    continue
-                i = int(after[0])
-                row["where"] = "leg end (ended within one logged step)"
-        else:
-            if term is None or term.lat_deg is None or k == 0 and LEG_TYPES[rec.path_term].initial \
-                    and not len(df):
-                row.update(ok=None, why="no fix position to check against")
-                out.append(row)
-                continue
-            sel = np.flatnonzero((leg_col >= k - 1) & (leg_col <= k + 1))
-            if not sel.size:
-                row.update(ok=False, why="fix never approached")
-                out.append(row)
-                continue
-            # a fly-by fix is passed where its fly-by arc is nearest to it (the arc's middle),
-            # up to R (1/cos(Ω/2) − 1) away: the check is against that planned point
-            plat, plon = passing.get(k, (term.lat_deg, term.lon_deg))
-            d = _dist_m(df["lat_deg"].to_numpy()[sel], df["lon_deg"].to_numpy()[sel],
-                        plat, plon)
-            # the first passage: the next leg's samples only until the aircraft has left the
-            # fix (a hold at the fix comes back to it a circuit later, lower)
-            nxt = leg_col[sel] == k + 1
-            left = nxt & (d > np.minimum.accumulate(d) + FIX_LEFT_M)
-            if left.any():
-                cut = int(np.argmax(left))
-                sel, d = sel[:cut], d[:cut]
-            j = int(np.argmin(d))
-            i = int(sel[j])
-            what = "the fix" if k not in passing else "the fly-by point abeam the fix"
-            row["where"] = f"{d[j]:.0f} m from {what}"
-            if d[j] > FIX_PASS_MAX_M:
-                row.update(ok=False, why=f"{what} passed {d[j] / NM_M:.2f} NM away")
-                out.append(row)
-                continue
-        alt_ft = float(df["alt_m"].iloc[i]) / FT_M
-        cas_kt = float(df["cas_mps"].iloc[i]) / KT_MPS
-        ok = True
-        msgs = []
-        row["alt_ft"] = round(alt_ft)
-        if lo is not None or hi is not None:
-            row["window_ft"] = [None if lo is None else round(lo / FT_M),
-                                None if hi is None else round(hi / FT_M)]
-            if hi is not None and hi < floor_m:
-                row["floor_ft"] = round(floor_m / FT_M)
-                hi = floor_m
-            if lo is not None and alt_ft < lo / FT_M - ALT_TOL_FT:
-                ok = False
-                msgs.append(f"{lo / FT_M - alt_ft:.0f} ft below")
-            if hi is not None and alt_ft > hi / FT_M + ALT_TOL_FT:
-                ok = False
-                msgs.append(f"{alt_ft - hi / FT_M:.0f} ft above")
-        if spd:
-            row["cas_kt"] = round(cas_kt, 1)
-            row["speed_limit_kt"] = f"{rec.speed_desc or '@'}{spd / KT_MPS:.0f}"
-            lim = spd / KT_MPS
-            if rec.speed_desc in ("", "@", "-") and cas_kt > lim + SPEED_TOL_KT:
-                ok = False
-                msgs.append(f"{cas_kt - lim:.1f} kt fast")
-            if rec.speed_desc in ("", "@", "+") and cas_kt < lim - SPEED_TOL_KT:
-                ok = False
-                msgs.append(f"{lim - cas_kt:.1f} kt slow")
-        row["ok"] = ok
-        if msgs:
-            row["why"] = ", ".join(msgs)
+        i = _check_row(df, leg_col, k, rec, bl.termination if bl is not None else None,
+                       passing, row)
+        if i is not None:
+            _judge(row, float(df["alt_m"].iloc[i]) / FT_M, float(df["cas_mps"].iloc[i]) / KT_MPS,
+                   lo, hi, spd, rec.speed_desc, floor_m)
         out.append(row)
-    return out
+    return [ConstraintCheck(**r) for r in out]
+
+
+def _check_row(df, leg_col, k: int, rec, term, passing, row: dict) -> int | None:
+    """The timeseries row at which leg ``k``'s constraint is checked (``row['where']`` says
+    where), or None with ``row['ok']``/``row['why']`` set when it cannot be checked."""
+    if term is not None and (term.kind == "altitude" or not term.fix_ident and term.kind
+                             in ("dme", "radial", "intercept", "manual", "distance")):
+        # a leg that ends where a condition is met (an HA at its altitude over its fix):
+        # checked where it ended, not where it first passed the fix
+        sel = np.flatnonzero(leg_col == k)
+        if sel.size:
+            row["where"] = "leg end"
+            return int(sel[-1])
+        # ended between two logged rows (an altitude already reached when the leg began):
+        # check the state when the next leg began
+        after = np.flatnonzero(leg_col > k)
+        if not after.size:
+            row.update(ok=False, why="leg not flown")
+            return None
+        row["where"] = "leg end (ended within one logged step)"
+        return int(after[0])
+    if term is None or term.lat_deg is None or k == 0 and LEG_TYPES[rec.path_term].initial \
+            and not len(df):
+        row.update(ok=None, why="no fix position to check against")
+        return None
+    sel = np.flatnonzero((leg_col >= k - 1) & (leg_col <= k + 1))
+    if not sel.size:
+        row.update(ok=False, why="fix never approached")
+        return None
+    # a fly-by fix is passed where its fly-by arc is nearest to it (the arc's middle), up to
+    # R (1/cos(Ω/2) − 1) away: the check is against that planned point
+    plat, plon = passing.get(k, (term.lat_deg, term.lon_deg))
+    d = _dist_m(df["lat_deg"].to_numpy()[sel], df["lon_deg"].to_numpy()[sel], plat, plon)
+    # the first passage: the next leg's samples only until the aircraft has left the fix (a
+    # hold at the fix comes back to it a circuit later, lower)
+    nxt = leg_col[sel] == k + 1
+    left = nxt & (d > np.minimum.accumulate(d) + FIX_LEFT_M)
+    if left.any():
+        cut = int(np.argmax(left))
+        sel, d = sel[:cut], d[:cut]
+    j = int(np.argmin(d))
+    what = "the fix" if k not in passing else "the fly-by point abeam the fix"
+    row["where"] = f"{d[j]:.0f} m from {what}"
+    if d[j] > FIX_PASS_MAX_M:
+        row.update(ok=False, why=f"{what} passed {d[j] / NM_M:.2f} NM away")
+        return None
+    return int(sel[j])
+
+
+def _judge(row: dict, alt_ft: float, cas_kt: float, lo: float | None, hi: float | None,
+           spd: float | None, speed_desc: str, floor_m: float) -> None:
+    """Set the row's altitude (ft), CAS (kt), window, verdict and why (module docstring)."""
+    ok = True
+    msgs = []
+    row["alt_ft"] = round(alt_ft)
+    if lo is not None or hi is not None:
+        row["window_ft"] = [None if lo is None else round(lo / FT_M),
+                            None if hi is None else round(hi / FT_M)]
+        if hi is not None and hi < floor_m:
+            row["floor_ft"] = round(floor_m / FT_M)
+            hi = floor_m
+        if lo is not None and alt_ft < lo / FT_M - ALT_TOL_FT:
+            ok = False
+            msgs.append(f"{lo / FT_M - alt_ft:.0f} ft below")
+        if hi is not None and alt_ft > hi / FT_M + ALT_TOL_FT:
+            ok = False
+            msgs.append(f"{alt_ft - hi / FT_M:.0f} ft above")
+    if spd:
+        row["cas_kt"] = round(cas_kt, 1)
+        row["speed_limit_kt"] = f"{speed_desc or '@'}{spd / KT_MPS:.0f}"
+        lim = spd / KT_MPS
+        if speed_desc in ("", "@", "-") and cas_kt > lim + SPEED_TOL_KT:
+            ok = False
+            msgs.append(f"{cas_kt - lim:.1f} kt fast")
+        if speed_desc in ("", "@", "+") and cas_kt < lim - SPEED_TOL_KT:
+            ok = False
+            msgs.append(f"{lim - cas_kt:.1f} kt slow")
+    row["ok"] = ok
+    if msgs:
+        row["why"] = ", ".join(msgs)
 
 
 def _passing_points(path) -> dict[int, tuple[float, float]]:
@@ -230,9 +243,16 @@ def _passing_points(path) -> dict[int, tuple[float, float]]:
             for k, sg in last.items() if sg.role == "flyby"}
 
 
-def sequencing(guidance, n_legs: int) -> dict:
-    """Legs entered in order: none skipped, none entered twice."""
-    seq = list(guidance.legs_sequenced)
+def sequencing(legs_sequenced: list[int], completed: bool, n_legs: int) -> Sequencing:
+    """Legs entered in order: none skipped, none entered twice.
+
+    Parameters
+    ----------
+    legs_sequenced : whole-procedure leg indices in the order guidance entered them
+    completed : the path was flown to its end and not abandoned
+    n_legs : legs of the procedure
+    """
+    seq = list(legs_sequenced)
     seen, repeated = set(), []
     for k in seq:
         if k in seen:
@@ -240,33 +260,48 @@ def sequencing(guidance, n_legs: int) -> dict:
         seen.add(k)
     last = max(seq) if seq else -1
     skipped = [k + 1 for k in range(last + 1) if k not in seen]
-    return {"legs": n_legs, "legs_entered": len(seen), "skipped": skipped,
-            "repeated": repeated, "in_order": seq == sorted(seq),
-            "completed": bool(guidance.done and not guidance.abort_reason)}
+    return Sequencing(n_legs, len(seen), skipped, repeated, seq == sorted(seq), bool(completed))
 
 
-def flight_errors(df: pd.DataFrame, fp, guidance) -> dict:
-    """Everything the summary gets: ``errors``, ``rnp``, ``constraints``, ``sequencing``."""
+@dataclass(frozen=True)
+class ProcedureErrors:
+    """What a procedure flight's errors give the summary: ``errors`` (None: nothing flown on a
+    path), ``rnp`` (None: idem), ``constraints``, ``constraints_met``, ``sequencing``."""
+
+    errors: FlightErrors | None
+    rnp: RnpContainment | None
+    constraints: list[ConstraintCheck]
+    constraints_met: bool | None
+    sequencing: Sequencing
+
+
+def flight_errors(df: pd.DataFrame, fp, legs_sequenced: list[int], completed: bool,
+                  floor_m: float = -math.inf) -> ProcedureErrors:
+    """Errors, RNP containment, constraints and sequencing of a procedure flight.
+
+    Parameters
+    ----------
+    df : the timeseries with the guidance columns (``xtk_m``, ``nav_xtk_m``, ``leg_index`` …)
+    fp : the built procedure flown; legs_sequenced, completed : :func:`sequencing`'s
+    floor_m : the lowest altitude guidance descends to, m (:func:`constraint_checks`)
+    """
     if df.empty or "xtk_m" not in df:
-        return {"errors": {}, "constraints": [], "sequencing": sequencing(guidance, 0)}
+        return ProcedureErrors(None, None, [], None, sequencing(legs_sequenced, completed, 0))
     d = error_columns(df)
     legs = per_leg(d, fp.seq.legs)
-    flown = [r for r in legs if r["samples"]]
-    cons = constraint_checks(d, fp, getattr(guidance, "floor_m", -math.inf))
+    flown = [r for r in legs if r.samples]
+    cons = constraint_checks(d, fp, floor_m)
     tse95 = _stats(d["tse_m"].to_numpy(dtype=float))["p95_m"]
-    return {
-        "errors": {**error_stats(d), "per_leg": legs,
-                   "heading_leg_samples": int(d["heading_leg"].sum()) if "heading_leg" in d
-                   else 0},
-        "rnp": {"contained": all(r["rnp_contained"] is not False for r in flown),
-                "legs_not_contained": [r["leg"] for r in flown if r["rnp_contained"] is False],
-                "tse95_m": tse95,
-                "min_rnp_nm": round(min(r["rnp_nm"] for r in flown), 2) if flown else None},
-        "constraints": cons,
-        "constraints_met": all(c.get("ok") is not False for c in cons),
-        "sequencing": sequencing(guidance, len(fp.seq.legs)),
-    }
+    st = error_stats(d)
+    return ProcedureErrors(
+        FlightErrors(st["fte"], st["nse"], st["pde"], st["tse"], legs,
+                     int(d["heading_leg"].sum()) if "heading_leg" in d else 0),
+        RnpContainment(all(r.rnp_contained is not False for r in flown),
+                       [r.leg for r in flown if r.rnp_contained is False], tse95,
+                       round(min(r.rnp_nm for r in flown), 2) if flown else None),
+        cons, all(c.ok is not False for c in cons),
+        sequencing(legs_sequenced, completed, len(fp.seq.legs)))
 
 
-__all__ = ["error_columns", "error_stats", "per_leg", "constraint_checks", "sequencing",
-           "flight_errors"]
+__all__ = ["ProcedureErrors", "error_columns", "error_stats", "per_leg", "constraint_checks",
+           "sequencing", "flight_errors"]

@@ -18,28 +18,43 @@ status                 meaning                                                  
                        NSE > 2 × RNP (other flights with a navigation source);
                        or the on-board RNP alert was raised (ANP > RNP)
 ``constraints_missed`` a coded altitude/speed constraint was missed               1
+``timeout``            stopped from outside before its end (a regression run's    1
+                       ``--case-timeout``); the checks of what was flown are kept
 =====================  =========================================================  =========
 
 A user error (bad file, bad argument) is exit code 2 and no flight. When several apply, the
 status is the first in the table's order (``diverged`` before ``incomplete`` before
-``envelope_exceeded`` ...); the ``reason`` names every one that applies, and ``outcome.checks``
-in the summary holds each check's verdict.
+``envelope_exceeded`` ...; ``timeout`` whatever the checks say); the ``reason`` names every one
+that applies, and ``outcome.checks`` in the summary holds each check's verdict.
+
+:func:`decide` is the one place a flight's status is decided: the flight loop reports how it
+ended (:class:`~fms_testbed.core.contracts.Ending`), the checks here say what that means.
 """
 
 from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
 
 from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.core.contracts import RecordView
 from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.evaluation.records import (AlertCheck, Checks, ConstraintsCheck, EnvelopeCheck,
+                                            NavigationCheck, Outcome, RecordsCheck, RnpCheck)
 
 ORDER = ("diverged", "incomplete", "degraded", "envelope_exceeded", "not_contained",
          "constraints_missed")
 """Statuses other than ``ok``, most severe first."""
 
-EXIT_CODES = {"ok": 0, **{s: 1 for s in ORDER}}
+STOPPED = "timeout"
+"""Status of a flight stopped from outside before its end (a wall-time limit); its checks are
+still recorded."""
+
+EXIT_CODES = {"ok": 0, **{s: 1 for s in ORDER}, STOPPED: 1}
 """Process exit code per status (2 is a user error, never a status)."""
 
 DEFAULT_ENROUTE_RNP_NM = 2.0
@@ -116,65 +131,86 @@ def navigation_containment(df: pd.DataFrame, rnp_nm: float) -> dict:
             "contained": bool(p95 <= rnp and mx <= 2.0 * rnp)}
 
 
-def decide(summary: dict, df: pd.DataFrame, cfg: AircraftConfig,
-           rnp_nm: float | None = None) -> dict:
-    """Set ``status``/``reason`` of a flight's summary from every check; add ``outcome``.
+@dataclass(frozen=True)
+class Decision(RecordView):
+    """The flight's status and reason and the :class:`~.records.Outcome` they come from."""
+
+    status: str
+    reason: str
+    outcome: Outcome
+
+
+def decide(flight: Mapping, df: pd.DataFrame, cfg: AircraftConfig,
+           rnp_nm: float | None = None) -> Decision:
+    """The status of a flight — the one place it is decided — from how its loop ended and every
+    check (module docstring).
 
     Parameters
     ----------
-    summary : the flight's summary (``status``/``reason`` from the flight loop: ``ok``,
-        ``diverged`` or ``incomplete``; a procedure flight's ``rnp`` and ``constraints``)
+    flight : the flight's record so far, in its JSON form: ``status`` / ``reason`` of the loop
+        (:class:`~fms_testbed.core.contracts.Ending`: ``ok``, ``diverged``, ``incomplete`` or
+        ``timeout``), and for a procedure flight ``rnp``, ``constraints`` and ``procedure``
+        (its ``degraded`` records)
     df : the timeseries
     cfg : the aircraft configuration (envelope limits)
     rnp_nm : RNP for the navigation error of a flight without a procedure, NM (None: no check)
 
     Returns
     -------
-    the summary, updated in place
+    :class:`Decision`: the status (``timeout`` for a flight stopped from outside, else the
+    first failing one of :data:`ORDER`, else ``ok``), the reason naming every failure, and
+    the checks
     """
     found: dict[str, list[str]] = {s: [] for s in ORDER}
-    checks: dict = {}
-    if summary["status"] in ("diverged", "incomplete"):
-        found[summary["status"]].append(summary["reason"])
-    degraded = (summary.get("procedure") or {}).get("degraded") or []
-    checks["records"] = {"ok": not degraded, "defects": len(degraded)}
+    if flight["status"] in ("diverged", "incomplete"):
+        found[flight["status"]].append(flight["reason"])
+    degraded = (flight.get("procedure") or {}).get("degraded") or []
+    checks: dict = {"records": RecordsCheck(not degraded, len(degraded))}
     if degraded:
         found["degraded"].append(f"built from a degraded procedure ({len(degraded)} record "
                                  f"defect(s), first: {degraded[0]})")
     env = envelope_violations(df, cfg)
-    checks["envelope"] = {"ok": not env, "violations": env}
+    checks["envelope"] = EnvelopeCheck(not env, env)
     found["envelope_exceeded"] += env
-    if "rnp" in summary:
-        r = summary["rnp"]
-        checks["rnp"] = {"ok": bool(r["contained"]), "legs_not_contained": r["legs_not_contained"]}
-        if not r["contained"]:
-            found["not_contained"].append(f"RNP containment lost on legs {r['legs_not_contained']}")
-    elif rnp_nm is not None:
-        nc = navigation_containment(df, rnp_nm)
-        checks["navigation"] = nc
-        if nc["contained"] is False:
-            found["not_contained"].append(
-                f"navigation error NSE95 {nc['nse95_m']:.0f} m / max {nc['nse_max_m']:.0f} m "
-                f"outside RNP {rnp_nm:g} NM")
-    if "rnp_alert" in df and (df["rnp_alert"].to_numpy() > 0).any():
-        t_alert = float(df["t_s"].to_numpy()[np.argmax(df["rnp_alert"].to_numpy() > 0)])
-        checks["rnp_alert"] = {"ok": False, "first_t_s": round(t_alert, 2)}
-        found["not_contained"].append(f"RNP alert (ANP > RNP) from t={t_alert:.1f} s")
-    if "constraints" in summary:
-        bad = [c for c in summary["constraints"] if c.get("ok") is False]
-        checks["constraints"] = {"ok": not bad, "checked": len(summary["constraints"]),
-                                 "missed": len(bad)}
+    _containment(flight, df, rnp_nm, checks, found["not_contained"])
+    if "constraints" in flight:
+        cons = flight["constraints"]
+        bad = [c for c in cons if c.get("ok") is False]
+        checks["constraints"] = ConstraintsCheck(not bad, len(cons), len(bad))
         if bad:
             found["constraints_missed"].append(
                 f"{len(bad)} constraint(s) missed: "
                 + ", ".join(f"leg {c['leg']} {c['fix']}" for c in bad))
     failed = [s for s in ORDER if found[s]]
-    if failed:
-        summary["status"] = failed[0]
-        summary["reason"] = "; ".join(r for s in failed for r in found[s])
-    summary["outcome"] = {"status": summary["status"], "failed": failed, "checks": checks}
-    return summary
+    status, reason = flight["status"], flight["reason"]
+    if status == STOPPED:
+        pass                                   # stopped from outside: what was flown is judged
+    elif failed:
+        status, reason = failed[0], "; ".join(r for s in failed for r in found[s])
+    return Decision(status, reason, Outcome(status, failed, Checks(**checks)))
 
 
-__all__ = ["ORDER", "EXIT_CODES", "DEFAULT_ENROUTE_RNP_NM", "decide", "envelope_violations",
-           "navigation_containment"]
+def _containment(flight: Mapping, df: pd.DataFrame, rnp_nm: float | None, checks: dict,
+                 found: list[str]) -> None:
+    """RNP containment (a procedure flight's ``rnp``, else the navigation error against
+    ``rnp_nm`` NM) and the on-board RNP alert: their checks into ``checks``, their failures
+    into ``found``."""
+    if flight.get("rnp") is not None:
+        r = flight["rnp"]
+        checks["rnp"] = RnpCheck(bool(r["contained"]), list(r["legs_not_contained"]))
+        if not r["contained"]:
+            found.append(f"RNP containment lost on legs {r['legs_not_contained']}")
+    elif rnp_nm is not None:
+        nc = navigation_containment(df, rnp_nm)
+        checks["navigation"] = NavigationCheck(**nc)
+        if nc["contained"] is False:
+            found.append(f"navigation error NSE95 {nc['nse95_m']:.0f} m / max "
+                         f"{nc['nse_max_m']:.0f} m outside RNP {rnp_nm:g} NM")
+    if "rnp_alert" in df and (df["rnp_alert"].to_numpy() > 0).any():
+        t_alert = float(df["t_s"].to_numpy()[np.argmax(df["rnp_alert"].to_numpy() > 0)])
+        checks["rnp_alert"] = AlertCheck(False, round(t_alert, 2))
+        found.append(f"RNP alert (ANP > RNP) from t={t_alert:.1f} s")
+
+
+__all__ = ["ORDER", "EXIT_CODES", "DEFAULT_ENROUTE_RNP_NM", "STOPPED", "Decision", "decide",
+           "envelope_violations", "navigation_containment"]

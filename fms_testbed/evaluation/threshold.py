@@ -31,6 +31,7 @@ import pandas as pd
 
 from fms_testbed.core.earth import MEAN_RADIUS_M
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.evaluation.records import ThresholdChecks, ThresholdCrossing
 
 CAS_TOL_KT = 5.0
 """Threshold crossing CAS within this of Vapp, kt."""
@@ -50,9 +51,10 @@ CROSS_TRACK_MAX_M = 1000.0
 
 def along_track_m(lat_deg, lon_deg, thr_lat_deg: float, thr_lon_deg: float,
                   course_deg: float) -> tuple[np.ndarray, np.ndarray]:
-    """(along, cross) track distances from the threshold on ``course_deg`` (deg true): along
-    positive past the threshold, cross positive to the right, m (equirectangular local plane:
-    < 0.1 % error within 20 km)."""
+    """(along, cross) track distances of the positions ``lat_deg``, ``lon_deg`` (deg, arrays)
+    from the threshold at ``thr_lat_deg``, ``thr_lon_deg`` (deg) on ``course_deg`` (deg true):
+    along positive past the threshold, cross positive to the right, m (equirectangular local
+    plane: < 0.1 % error within 20 km)."""
     lat0 = math.radians(thr_lat_deg)
     x = np.radians(np.asarray(lon_deg) - thr_lon_deg) * math.cos(lat0) * MEAN_RADIUS_M
     y = np.radians(np.asarray(lat_deg) - thr_lat_deg) * MEAN_RADIUS_M
@@ -61,13 +63,14 @@ def along_track_m(lat_deg, lon_deg, thr_lat_deg: float, thr_lon_deg: float,
 
 
 def final_course_deg(path, map_leg: int) -> float | None:
-    """Course at the end of the MAP leg's last built segment, deg true (None: no segment)."""
+    """Course at the end of the last built segment of leg ``map_leg`` (the MAP) of the built
+    ``path``, deg true (None: no segment)."""
     segs = [s for s in path.segments if s.leg_index == map_leg]
     return float(segs[-1].geom.end_course_deg) % 360.0 if segs else None
 
 
 def threshold_crossing(df: pd.DataFrame, path, runway, vapp_cas_mps: float | None,
-                       approach) -> dict | None:
+                       approach) -> ThresholdCrossing | None:
     """The threshold-crossing record of a flight (module docstring); None when the flight is
     no approach to a known runway.
 
@@ -91,21 +94,48 @@ def threshold_crossing(df: pd.DataFrame, path, runway, vapp_cas_mps: float | Non
                  "vpa_deg": runway.vpa_deg,
                  "tch_ft": None if runway.tch_m is None else round(runway.tch_m / FT_M, 1),
                  "vapp_kt": None if vapp_cas_mps is None else round(vapp_cas_mps / KT_MPS, 1)}
-    # the last crossing over the threshold, heading along the final course, near it
+    crossing = _crossing(s, xt)
+    if crossing is None:
+        out.update(crossed=False, reason=f"threshold not reached: the flight ended "
+                   f"{-s[-1] / NM_M:.2f} NM before it")
+        return ThresholdCrossing(**out)
+    i0, i1, extrap = crossing
+    out.update(_at_threshold(df, s, i0, i1, extrap, runway, vapp_cas_mps, approach))
+    checks = {
+        "cas": None if out["cas_minus_vapp_kt"] is None
+        else abs(out["cas_minus_vapp_kt"]) <= CAS_TOL_KT,
+        "path_angle": None if out["path_angle_minus_vpa_deg"] is None
+        else abs(out["path_angle_minus_vpa_deg"]) <= ANGLE_TOL_DEG,
+        "height": None if out["height_minus_tch_ft"] is None
+        else abs(out["height_minus_tch_ft"]) <= HEIGHT_TOL_FT,
+        "configured": out["configured"],
+    }
+    out["checks"] = ThresholdChecks(**checks)
+    out["ok"] = all(v is not False for v in checks.values()) and \
+        any(v is not None for v in checks.values())
+    return ThresholdCrossing(**out)
+
+
+def _crossing(s: np.ndarray, xt: np.ndarray) -> tuple[int, int, float] | None:
+    """The samples (i0, i1) either side of the threshold and how far past the last sample it
+    is extrapolated (m): the last crossing over it near the extended centre line, else the end
+    of a flight that stops at most :data:`EXTRAPOLATE_MAX_M` short of it; None: neither."""
     cross = np.nonzero((s[1:] >= 0.0) & (s[:-1] < 0.0)
                        & (np.abs(xt[1:]) < CROSS_TRACK_MAX_M))[0] + 1
-    j = int(cross[-1]) if cross.size else None
-    extrap = 0.0
-    if j is None:
-        if s.size < 2 or not -EXTRAPOLATE_MAX_M <= s[-1] < 0.0 or s[-1] <= s[-2] \
-                or abs(xt[-1]) >= CROSS_TRACK_MAX_M:
-            out.update(crossed=False, reason=f"threshold not reached: the flight ended "
-                       f"{-s[-1] / NM_M:.2f} NM before it")
-            return out
-        i0, i1 = s.size - 2, s.size - 1
-        extrap = float(-s[-1])
-    else:
-        i0, i1 = j - 1, j
+    if cross.size:
+        j = int(cross[-1])
+        return j - 1, j, 0.0
+    if s.size < 2 or not -EXTRAPOLATE_MAX_M <= s[-1] < 0.0 or s[-1] <= s[-2] \
+            or abs(xt[-1]) >= CROSS_TRACK_MAX_M:
+        return None
+    return s.size - 2, s.size - 1, float(-s[-1])
+
+
+def _at_threshold(df: pd.DataFrame, s: np.ndarray, i0: int, i1: int, extrap: float, runway,
+                  vapp_cas_mps: float | None, approach) -> dict:
+    """The aircraft over the threshold, interpolated between samples ``i0`` and ``i1`` (along
+    distances ``s``, m): time, CAS, height, γ, the path angle fitted over the last
+    :data:`PATH_FIT_M`, the configuration."""
     f = (0.0 - s[i0]) / (s[i1] - s[i0]) if s[i1] != s[i0] else 0.0
 
     def at(col):
@@ -132,7 +162,7 @@ def threshold_crossing(df: pd.DataFrame, path, runway, vapp_cas_mps: float | Non
         land = approach.flaps[approach.index(approach.landing_flap)]
         flaps_ok = abs(flap - land.cmd_norm) <= FLAP_TOL
         gear_ok = True if approach.fixed_gear else bool(gear is not None and gear >= 0.99)
-    out.update(
+    return dict(
         crossed=True, extrapolated_m=round(extrap, 1), t_s=round(at("t_s"), 2),
         cas_kt=round(cas / KT_MPS, 2),
         cas_minus_vapp_kt=None if vapp_cas_mps is None else round((cas - vapp_cas_mps) / KT_MPS,
@@ -148,19 +178,6 @@ def threshold_crossing(df: pd.DataFrame, path, runway, vapp_cas_mps: float | Non
         gear_pos_norm=None if gear is None else round(gear, 3),
         flaps_landing=flaps_ok, gear_down=gear_ok,
         configured=None if flaps_ok is None else bool(flaps_ok and gear_ok))
-    checks = {
-        "cas": None if out["cas_minus_vapp_kt"] is None
-        else abs(out["cas_minus_vapp_kt"]) <= CAS_TOL_KT,
-        "path_angle": None if out["path_angle_minus_vpa_deg"] is None
-        else abs(out["path_angle_minus_vpa_deg"]) <= ANGLE_TOL_DEG,
-        "height": None if out["height_minus_tch_ft"] is None
-        else abs(out["height_minus_tch_ft"]) <= HEIGHT_TOL_FT,
-        "configured": out["configured"],
-    }
-    out["checks"] = checks
-    out["ok"] = all(v is not False for v in checks.values()) and \
-        any(v is not None for v in checks.values())
-    return out
 
 
 __all__ = ["CAS_TOL_KT", "ANGLE_TOL_DEG", "HEIGHT_TOL_FT", "along_track_m",

@@ -1,3 +1,6 @@
-"""Guidance: lateral path following (:mod:`.lateral`, :mod:`.geometry`), vertical targets
-(:mod:`.vertical`) and the procedure guidance that sequences the legs (:mod:`.fms`). Guidance flies on
-the navigation solution and returns :class:`~fms_testbed.core.contracts.GuidanceOutput`."""
+"""Guidance: the procedure guidance (:mod:`.fms`) flying a built procedure on the navigation
+solution and the air data — never the true state — split by concern: locating the aircraft on
+the path (:mod:`.locate`, :mod:`.geometry`), sequencing the legs (:mod:`.sequencing`), replanning
+(:mod:`.replan`, :mod:`.conditions`), the lateral law (:mod:`.lateral`, :mod:`.steering`), the
+vertical step (:mod:`.vnav`, :mod:`.vertical`, :mod:`.speed_plan`, :mod:`.profile_kernel`) and
+the log (:mod:`.step_log`). Its interface is :class:`~fms_testbed.core.contracts.Guidance`."""

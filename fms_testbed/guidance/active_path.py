@@ -104,7 +104,7 @@ def _straight_runs_m(geoms) -> list[tuple[float, float]]:
     return list(zip(before, after))
 
 
-def activate(fp: FlyablePath, s_base_m: float, tas_mps: float,
+def activate(fp: FlyablePath, s_base_m: float,
              lead_from: tuple[float, float] | None = None) -> ActivePath:
     """Post-process a built procedure and precompute what guidance reads (module docstring).
 
@@ -112,7 +112,6 @@ def activate(fp: FlyablePath, s_base_m: float, tas_mps: float,
     ----------
     fp : the built procedure (or the rest of it, rebuilt in flight)
     s_base_m : path distance flown before this path starts, m
-    tas_mps : planned speed, m/s (kept for callers; the builder plans the turns)
     lead_from : (lat_deg, lon_deg) of the aircraft when the path was rebuilt in flight: a
         straight run-in from there to the path's start is flown first
     """

@@ -1,20 +1,28 @@
-"""Re-planning: the rest of the procedure rebuilt from the aircraft's state when a conditional
-leg ends in flight.
+"""Re-planning: the rest of the procedure rebuilt from the aircraft's state, one API for every
+reason to rebuild.
 
-An altitude, DME or radial leg ends where the aircraft meets its condition, not where the plan
-assumed (:mod:`.sequencing`). The legs after it are then built again by the same builder and
-monitor (:func:`fms_testbed.path.plan.rebuild_from`) from a start one roll-in anticipation
-ahead on the present track, so the first turn's roll is centred on its start as for any planned
-turn; DF legs whose fix is already behind are skipped first (:func:`passed_direct_legs`).
+A :class:`Rebuild` says why and from where; :meth:`Replanner.build` builds it and returns the
+new active path. The reasons (:attr:`Rebuild.kind`):
 
-**Changed conditions.** The path is planned for a wind and a temperature (the scenario's
-forecast, else the actual ones). :class:`ConditionMonitor` measures both in flight; when the
-filtered wind differs from the planned one at the present altitude by more than 10 kt (vector)
-or the ISA deviation by more than 5 °C (:class:`ConditionThresholds`), guidance rebuilds the
-rest of the procedure — the present leg included, from the present position — for the measured
-conditions (:func:`measured_params`), logs a ``rebuild`` event with the reason and draws the
-rebuilt path like any other. A rebuild waits until the aircraft flies a straight part of a leg
-that can be rebuilt from mid-leg (not an arc, hold or procedure turn: :func:`rebuildable_here`).
+* ``leg_end`` — an altitude, DME or radial leg ended where the aircraft met its condition, not
+  where the plan assumed (:mod:`.sequencing`): the legs after it are built again, DF legs whose
+  fix is already behind skipped first (:func:`passed_direct_legs`);
+* ``conditions`` — the measured wind or temperature differ from the planned ones
+  (:mod:`.conditions`): the rest, the present leg included, is built from the present position
+  for the measured conditions (:func:`~.conditions.measured_params`); a rebuilt rest that is not
+  continuous (a discontinuity, a loop or an intercept not found) is refused and the plan kept,
+  since the plan for the old conditions is still a flyable path;
+* ``heading_drift`` — on the straight part of a heading leg the aircraft is more than
+  :data:`HEADING_DRIFT_REBUILD_M` off the track its planned drift predicted (the wind ramped in
+  after a still-air trim, a TAS or wind a little off the plan): the rest, the heading leg
+  included, is built from the present position — as an FMS computes a heading leg's intercept
+  from the present position — at most once every :data:`HEADING_DRIFT_REBUILD_S`.
+
+Every rebuild is made by the same builder and monitor (:func:`fms_testbed.path.plan.rebuild_from`)
+from a start one roll-in anticipation ahead on the present track after the roll-out
+(:func:`roll_out_state`), so the first turn's roll is centred on its start as for any planned
+turn. A rebuild from the present position waits until the aircraft flies a straight part of a
+leg that can be rebuilt from mid-leg (not an arc, hold or procedure turn: :func:`rebuildable_here`).
 """
 
 from __future__ import annotations
@@ -22,22 +30,35 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from fms_testbed.core.atmosphere import isa_dev_from_air_data_c
 from fms_testbed.core.geodesy import direct
-from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS
+from fms_testbed.core.planning import PLANNED_BANK_DEG
+from fms_testbed.core.state import AirData, NavSolution
+from fms_testbed.core.units import G0_MPS2
+from fms_testbed.guidance.active_path import ActivePath, activate
+from fms_testbed.guidance.conditions import ConditionMonitor, ConditionThresholds, measured_params
 from fms_testbed.guidance.lateral import LateralGains, anticipation_m
+from fms_testbed.guidance.locate import Where
 from fms_testbed.guidance.sequencing import direct_fix_passed
+from fms_testbed.guidance.steering import flies_heading
+from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.plan import FlyablePath, rebuild_from
+from fms_testbed.procedures.records import Fix
 
-PLANNED_BANK_DEG = 20.0
-"""The builder's planned bank: sets the roll-in anticipation of the rebuilt start, deg."""
+HEADING_DRIFT_REBUILD_M = 100.0
+"""A heading leg is rebuilt from the present position once the aircraft is this far off the
+track its planned drift predicted, m."""
+HEADING_DRIFT_REBUILD_S = 30.0
+"""At most one such rebuild in this time, s."""
+BROKEN_FINDINGS = ("discontinuity", "loop", "no-intercept")
+"""Monitor findings that make a rebuilt rest not continuous."""
 
 
 def passed_direct_legs(whole: FlyablePath, first: int, lat_rad: float, lon_rad: float,
                        track_rad: float, tas_mps: float) -> list[int]:
-    """Indices ``first, first + 1, ...`` of the consecutive DF legs whose fix is already passed
-    (:func:`~.sequencing.direct_fix_passed`) at the navigation position (rad), track (rad) and
-    planned speed (m/s)."""
+    """Indices ``first, first + 1, ...`` of the consecutive DF legs of the whole procedure
+    ``whole`` whose fix is already passed (:func:`~.sequencing.direct_fix_passed`) at the
+    navigation position ``lat_rad``, ``lon_rad`` (rad), track ``track_rad`` (rad) and planned
+    speed ``tas_mps`` (m/s)."""
     out = []
     k = first
     legs = whole.path.legs
@@ -52,12 +73,10 @@ def roll_out_state(lat_deg: float, lon_deg: float, track_rad: float, gs_mps: flo
                    roll_rad: float, gains: LateralGains) -> tuple[float, float, float]:
     """Where the aircraft is, and its track, once it has rolled wings level from ``roll_rad``.
 
-    A leg that ends on a condition can end in a turn (the previous turn's bank still on). The
-    aircraft goes on turning while it rolls out at the roll rate p_max over t = |φ₀| / p_max;
-    with the bank ramping linearly to zero the track changes by Δψ ≈ g tan φ₀ / V_g · t / 2
-    (the mean turn rate) and the aircraft covers V_g t along a chord on the mean track
-    ψ + Δψ / 2. The rebuilt path starts from there, so a roll reversal is not flown as a
-    cross-track error.
+    The aircraft goes on turning while it rolls out at the roll rate p_max over
+    t = |φ₀| / p_max; with the bank ramping linearly to zero the track changes by
+    Δψ ≈ g tan φ₀ / V_g · t / 2 (the mean turn rate) and the aircraft covers V_g t along a chord
+    on the mean track ψ + Δψ / 2.
 
     Parameters
     ----------
@@ -92,8 +111,7 @@ def rebuild_rest(db, whole: FlyablePath, spec, cfg, gains: LateralGains, next_le
         altitude (m)
     gs_mps : ground speed, m/s, for the roll-out and roll-in distances (default: the planned
         climb speed); roll_rad : bank at the rebuild, rad (+ right): see :func:`roll_out_state`
-    params : build settings for the rest (default: the whole path's; the measured conditions
-        after a change, :func:`measured_params`)
+    params : build settings for the rest (default: the whole path's)
     prev_fix : the fix the leg ``next_leg`` starts from (a TF rebuilt mid-leg rejoins its track
         from it), or None
 
@@ -115,156 +133,125 @@ def rebuild_rest(db, whole: FlyablePath, spec, cfg, gains: LateralGains, next_le
 
 def rebuildable_here(seg, built) -> bool:
     """True when the aircraft, on segment ``seg`` of built leg ``built``, may have its path
-    rebuilt from here for changed conditions: a straight part ('leg' line) of a leg that is
-    not a coded arc, a hold or a procedure turn (those are rebuilt at their end instead)."""
-    from fms_testbed.legs.types import LEG_TYPES
-
+    rebuilt from here: a straight part ('leg' line) of a leg that is not a coded arc, a hold or
+    a procedure turn (those are rebuilt at their end instead)."""
     kind = LEG_TYPES[built.path_term]
     return (seg.role == "leg" and seg.geom.kind == "line" and kind.arc_centre is None
             and not kind.hold and not kind.course_reversal and not kind.initial)
 
 
-# ------------------------------------------------------------ rebuild on changed conditions
+@dataclass(frozen=True)
+class Rebuild:
+    """A reason to rebuild the rest of the procedure (module docstring).
 
-@dataclass(frozen=True, slots=True)
-class ConditionThresholds:
-    """When the measured conditions call for a rebuild (Danilin 2017: the desired trajectory
-    is built for the current conditions; class 1 when they change), in one place.
-
-    wind_err_mps: magnitude of the vector difference measured − planned wind at the present
-    altitude, m/s (10 kt); isa_dev_err_c: |measured − planned| ISA deviation, K (5 °C);
-    tau_s: time constant of the first-order filter on the measurements, s; holdoff_s: no
-    rebuild this long after the start (the wind is ramped in over 20 s) or after a rebuild, s;
-    nav_sigma_k: the wind threshold is at least this many σ of the wind measurement's own error
-    from the navigation's heading uncertainty, k · TAS · σ_ψ (an INS whose heading is not yet
-    observable — 2.8° before the first turn — "measures" a 10 kt crosswind that is not there).
+    Attributes
+    ----------
+    kind : 'leg_end', 'conditions' or 'heading_drift'
+    first_leg : whole-procedure index of the first leg rebuilt
+    from_here : the first leg is the one flown, rebuilt from the present position (its
+        previous fix kept as its origin); False: the legs after a leg that ended
+    params : build settings of the rest (:class:`~fms_testbed.legs.model.BuildParams`)
+    why : the measured conditions that differ ('conditions'), the heading leg's offset
+        ('heading_drift'), '' ('leg_end')
+    keep_plan_if_broken : refuse a rest that is not continuous (:data:`BROKEN_FINDINGS`)
     """
 
-    wind_err_mps: float = 10.0 * KT_MPS
-    nav_sigma_k: float = 3.0
-    isa_dev_err_c: float = 5.0
-    tau_s: float = 15.0
-    holdoff_s: float = 60.0
+    kind: str
+    first_leg: int
+    from_here: bool
+    params: object
+    why: str = ""
+    keep_plan_if_broken: bool = False
+
+    def done_text(self, n_segments: int) -> str:
+        """The ``rebuild`` event's detail once built."""
+        if self.kind == "leg_end":
+            return f"rest of the procedure rebuilt from the aircraft state ({n_segments} segments)"
+        head = (f"conditions changed: {self.why}" if self.kind == "conditions"
+                else f"heading leg {self.why} off its predicted track")
+        return (f"{head}; rest of the procedure rebuilt from the present position "
+                f"({n_segments} segments)")
 
 
-def air_velocity_ned_mps(tas_mps: float, alpha_rad: float, beta_rad: float, roll_rad: float,
-                         pitch_rad: float, heading_rad: float) -> tuple[float, float, float]:
-    """Velocity of the aircraft relative to the air, NED, m/s: the air-data vector
-    V (cos α cos β, sin β, sin α cos β) in body axes turned to NED by the attitude,
-    v_n = R_z(ψ) R_y(θ) R_x(φ) v_b (in a banked turn the α part has a horizontal component:
-    ~1.7° of track at α 4°, φ 25°, which heading alone would miss)."""
-    ca, sa, cb, sb = math.cos(alpha_rad), math.sin(alpha_rad), math.cos(beta_rad), math.sin(beta_rad)
-    u, v, w = tas_mps * ca * cb, tas_mps * sb, tas_mps * sa * cb
-    cf, sf = math.cos(roll_rad), math.sin(roll_rad)
-    ct, st = math.cos(pitch_rad), math.sin(pitch_rad)
-    cp, sp = math.cos(heading_rad), math.sin(heading_rad)
-    v1, w1 = cf * v - sf * w, sf * v + cf * w            # R_x(φ)
-    u2, w2 = ct * u + st * w1, -st * u + ct * w1         # R_y(θ)
-    return cp * u2 - sp * v1, sp * u2 + cp * v1, w2      # R_z(ψ)
+class Replanner:
+    """Builds the rest of the procedure for a :class:`Rebuild` and decides when one is due.
 
+    Parameters
+    ----------
+    fp : the whole built procedure; cfg : the aircraft; db, spec : where it was built from
+        (None: no in-flight rebuild is possible)
+    gains : lateral tuning (roll rate: roll-out and roll-in distances)
+    thresholds : when changed conditions call for a rebuild (:class:`~.conditions.ConditionThresholds`)
 
-def measured_params(params, alt_m: float, wind_ne_mps: tuple[float, float], isa_dev_c: float):
-    """Build settings for the measured conditions: the planned wind profile shifted by the
-    measured − planned wind at ``alt_m`` (m) — a constant planned wind becomes the measured
-    one — and the measured ISA deviation (K). ``params``: the active path's
-    :class:`~fms_testbed.legs.model.BuildParams`; ``wind_ne_mps``: measured (north, east)
-    velocity of the air, m/s."""
-    from dataclasses import replace
-
-    from fms_testbed.core.wind import WindProfile
-
-    spd, frm = params.wind_at(alt_m)
-    plan = WindProfile.constant(spd, frm).ned_at(0.0)
-    dn, de = wind_ne_mps[0] - plan[0], wind_ne_mps[1] - plan[1]
-    prof = params.wind_profile
-    if prof is not None:
-        prof = WindProfile(prof.alt_m, tuple(n + dn for n in prof.north_mps),
-                           tuple(e + de for e in prof.east_mps))
-        w0 = prof.at(prof.alt_m[0])
-    else:
-        w0 = WindProfile((0.0,), (wind_ne_mps[0],), (wind_ne_mps[1],)).at(0.0)
-    return replace(params, wind_profile=prof, wind_speed_mps=w0[0], wind_from_deg=w0[1],
-                   isa_dev_c=float(isa_dev_c))
-
-
-class ConditionMonitor:
-    """Compares the conditions the aircraft measures with the ones its path was planned for.
-
-    The wind is the ground velocity of the navigation solution minus the air velocity
-    (:func:`air_velocity_ned_mps` from the air data — TAS, α, β — and the navigation attitude);
-    the ISA deviation is the static temperature from TAS and Mach minus the ISA's
-    (:func:`~fms_testbed.core.atmosphere.isa_dev_from_air_data_c`). The air data are JSBSim's
-    (an ideal air-data computer: the navigation sources model no air data). Both are filtered
-    (first order, ``tau_s``); :meth:`update` returns the reason for a rebuild once a filtered
-    difference exceeds its threshold (:class:`ConditionThresholds`) outside the hold-off.
+    Attributes
+    ----------
+    conditions : the :class:`~.conditions.ConditionMonitor`
+    rebuilt : the rests built in flight and flown, in order
     """
 
-    def __init__(self, thresholds: ConditionThresholds | None = None):
-        self.th = thresholds or ConditionThresholds()
-        self.wn = self.we = self.dt_c = None
-        self.t_last = None
-        self.quiet_until_s = None
+    def __init__(self, fp: FlyablePath, cfg, db, spec, gains: LateralGains,
+                 thresholds: ConditionThresholds | None = None):
+        self.whole, self.cfg, self.db, self.spec, self.gains = fp, cfg, db, spec, gains
+        self.conditions = ConditionMonitor(thresholds)
+        self.rebuilt: list[FlyablePath] = []
+        self._drift_rebuilt_s = -math.inf
 
-    def measure(self, t_s: float, nav, truth) -> tuple[float, float, float]:
-        """Filter in one measurement; return the filtered (wind north m/s, wind east m/s,
-        ISA deviation K)."""
-        an, ae, _ = air_velocity_ned_mps(truth.tas_mps, truth.alpha_rad, truth.beta_rad,
-                                         nav.roll_rad, nav.pitch_rad, nav.heading_rad)
+    def leg_ended(self, w: Where, nav: NavSolution) -> tuple[list[int], Rebuild | None]:
+        """The conditional leg flown ended: (the DF legs after it already passed, the rebuild
+        of the legs after those — None when nothing is left)."""
+        v = self.cfg.limits.climb_tas_mps
+        passed = passed_direct_legs(self.whole, w.leg + 1, nav.lat_rad, nav.lon_rad, w.trk_rad,
+                                    v)
+        nxt = (passed[-1] if passed else w.leg) + 1
+        if nxt >= len(self.whole.seq.legs):
+            return passed, None
+        return passed, Rebuild("leg_end", nxt, False, w.act.fp.params)
+
+    def due(self, w: Where, nav: NavSolution, air: AirData) -> Rebuild | None:
+        """A rebuild from the present position that is due now: changed conditions (measured
+        every call), else a heading leg drifted off its predicted track; None."""
+        params = w.act.fp.params
+        why = self.conditions.update(nav.t_s, nav, air, params)
+        if why and rebuildable_here(w.seg, w.built) and self.db is not None:
+            (wn, we), dev = self.conditions.measured
+            self.conditions.rebuilt(nav.t_s)
+            return Rebuild("conditions", w.leg, True,
+                           measured_params(params, nav.alt_m, (wn, we), dev), why, True)
+        if (self.db is None or not flies_heading(w.seg, w.p)
+                or abs(w.xtk_m) < HEADING_DRIFT_REBUILD_M
+                or not rebuildable_here(w.seg, w.built)
+                or nav.t_s - self._drift_rebuilt_s < HEADING_DRIFT_REBUILD_S):
+            return None
+        self._drift_rebuilt_s = nav.t_s
+        return Rebuild("heading_drift", w.leg, True, params, f"{w.xtk_m:+.0f} m")
+
+    def build(self, r: Rebuild, w: Where, nav: NavSolution) -> tuple[ActivePath | None, str]:
+        """Build ``r`` from the aircraft at ``w`` (navigation solution ``nav``): (the new active
+        path, '') or (None, why it is refused: '' when it cannot be built, the first finding
+        that breaks it when :attr:`Rebuild.keep_plan_if_broken`)."""
+        k = r.first_leg
+        prev = None
+        if r.from_here and k > 0:
+            t = self.whole.path.legs[k - 1].termination
+            if t.kind == "fix" and t.lat_deg is not None:
+                prev = Fix(ident=t.fix_ident, region="", section="", lat_deg=t.lat_deg,
+                           lon_deg=t.lon_deg)
         v = nav.v_enu_mps
-        wn, we = float(v[1]) - an, float(v[0]) - ae
-        dev = isa_dev_from_air_data_c(truth.tas_mps, truth.mach, nav.alt_m)
-        if self.wn is None:
-            self.wn, self.we, self.dt_c = wn, we, dev
-            self.quiet_until_s = t_s + self.th.holdoff_s
-        else:
-            k = min(1.0, (t_s - self.t_last) / self.th.tau_s)
-            self.wn += k * (wn - self.wn)
-            self.we += k * (we - self.we)
-            self.dt_c += k * (dev - self.dt_c)
-        self.t_last = t_s
-        return self.wn, self.we, self.dt_c
+        gs = math.hypot(float(v[0]), float(v[1]))
+        fp = rebuild_rest(self.db, self.whole, self.spec, self.cfg, self.gains, k, nav.lat_rad,
+                          nav.lon_rad, w.trk_rad, nav.alt_m, gs, nav.roll_rad, params=r.params,
+                          prev_fix=prev)
+        if fp is None:
+            return None, ""
+        if r.keep_plan_if_broken:
+            broken = [f for f in fp.path.findings if f.category in BROKEN_FINDINGS]
+            if broken:
+                return None, f"leg {broken[0].leg_index + w.leg}: {broken[0].message}"
+        self.rebuilt.append(fp)
+        return activate(fp, w.s_flight_m,
+                        lead_from=(math.degrees(nav.lat_rad), math.degrees(nav.lon_rad))), ""
 
-    def update(self, t_s: float, nav, truth, params) -> str:
-        """Measure and compare with ``params`` (the active path's build settings) at the
-        navigation altitude; the rebuild reason ('' when none is due, or when ``truth``
-        carries no air data — TAS, Mach, α, β — to measure with)."""
-        if not all(hasattr(truth, k) for k in ("tas_mps", "mach", "alpha_rad", "beta_rad")) \
-                or not truth.mach > 0.0:
-            return ""
-        wn, we, dev = self.measure(t_s, nav, truth)
-        if params is None or t_s < self.quiet_until_s:
-            return ""
-        from fms_testbed.core.wind import WindProfile
 
-        spd, frm = params.wind_at(nav.alt_m)
-        pn, pe = WindProfile.constant(spd, frm).ned_at(0.0)
-        err = math.hypot(wn - pn, we - pe)
-        why = []
-        if err > self.wind_threshold_mps(nav, truth):
-            ms, mf = WindProfile((0.0,), (wn,), (we,)).at(0.0)
-            why.append(f"wind measured {mf:03.0f}/{ms / KT_MPS:.0f} kt vs planned "
-                       f"{frm:03.0f}/{spd / KT_MPS:.0f} kt at {nav.alt_m / FT_M:.0f} ft "
-                       f"(vector error {err / KT_MPS:.0f} kt > "
-                       f"{self.wind_threshold_mps(nav, truth) / KT_MPS:.0f} kt)")
-        if abs(dev - params.isa_dev_c) > self.th.isa_dev_err_c:
-            why.append(f"temperature measured ISA{dev:+.1f} vs planned "
-                       f"ISA{params.isa_dev_c:+.1f} (> {self.th.isa_dev_err_c:.0f} °C)")
-        return "; ".join(why)
-
-    def wind_threshold_mps(self, nav, truth) -> float:
-        """The wind-change threshold, m/s: ``wind_err_mps``, or ``nav_sigma_k`` σ of the wind
-        error the navigation's heading uncertainty makes (TAS · σ_ψ across the air velocity)
-        when that is larger."""
-        sig = getattr(nav, "heading_sigma_rad", None)
-        if sig is None or not math.isfinite(sig):
-            return self.th.wind_err_mps
-        return max(self.th.wind_err_mps, self.th.nav_sigma_k * truth.tas_mps * sig)
-
-    def rebuilt(self, t_s: float) -> None:
-        """A rebuild was made at ``t_s`` (s): hold off the next one."""
-        self.quiet_until_s = t_s + self.th.holdoff_s
-
-    @property
-    def measured(self) -> tuple[tuple[float, float], float]:
-        """((wind north, east) m/s, ISA deviation K) as filtered so far."""
-        return (self.wn, self.we), self.dt_c
+__all__ = ["BROKEN_FINDINGS", "HEADING_DRIFT_REBUILD_M", "HEADING_DRIFT_REBUILD_S", "Rebuild",
+           "Replanner", "passed_direct_legs", "rebuild_rest", "rebuildable_here",
+           "roll_out_state"]

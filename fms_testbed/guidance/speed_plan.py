@@ -25,6 +25,7 @@ from dataclasses import dataclass
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.guidance.geometry import LocalPiece
+from fms_testbed.guidance.locate import Where
 from fms_testbed.guidance.vertical import SPEED_MARGIN_MPS, SpeedLimit, cas_band, tas_target_mps
 
 ARC_BANK_MARGIN_DEG = 3.0
@@ -40,6 +41,19 @@ SPEED_UPDATE_S = 1.0
 SPEED_LEAD_S = 10.0
 """The planned approach speed is read this far ahead of the aircraft (flight time, s): about
 the coupled law's speed-channel ramp lag 2 ξ_V T_V (10.7 s for the 737)."""
+
+
+def planned_wind_mps(fp, alt_m: float) -> float:
+    """The wind speed the path ``fp`` (:class:`~fms_testbed.path.plan.FlyablePath`) was planned
+    for at ``alt_m`` (m), m/s: the plan's profile there, else its constant wind; 0 in calm or
+    without planning parameters (a measured wind that differs has the path rebuilt for it, so
+    this is the flight's best wind)."""
+    p = fp.params
+    if p is None:
+        return 0.0
+    if p.wind_profile is not None:
+        return float(p.wind_profile.at(alt_m)[0])
+    return float(p.wind_speed_mps)
 
 
 @dataclass(frozen=True)
@@ -68,9 +82,8 @@ def arc_speed_cap_mps(pieces: list[LocalPiece], i: int, along_m: float, v_mps: f
     v_mps : present speed, m/s (deceleration distance (V² − v²) / (2 a) + DECEL_EXTRA_S V,
         a = DECEL_MPS2)
     bank_max_deg : the aircraft's bank limit, deg
-    wind_mps : planned wind speed, m/s (0: calm). Without it a 737 slowed for a fly-by
-        planned for 167 kt in a 30 kt tailwind (KSBY L32) only to its calm-air speed and flew
-        the arc 309 m wide at the bank limit.
+    wind_mps : planned wind speed, m/s (0: calm): the arc's ground-speed limit is a tailwind's
+        worst case, so the TAS cap is that limit less the wind
     """
     g_tan = G0_MPS2 * math.tan(math.radians(bank_max_deg - ARC_BANK_MARGIN_DEG))
     cap = math.inf
@@ -92,14 +105,14 @@ class SpeedPlan:
     """The TAS target and the state it carries from leg to leg (module docstring).
 
     limits: coded speed limit per leg of the whole procedure; descent: STAR/approach (limits
-    carry on); plan_tas_mps: the aircraft's planned speed (flown as a CAS), m/s; cas_min_mps:
+    carry on); plan_cas_mps: the aircraft's planned speed, a CAS, m/s; cas_min_mps:
     its minimum CAS, m/s; tas_cmd_mps: the present target, m/s; carry_max_cas_mps: the lowest
     'at'/'at or below' CAS entered in descent, m/s; next_t_s: when the target is due again, s.
     """
 
     limits: list[SpeedLimit | None]
     descent: bool
-    plan_tas_mps: float
+    plan_cas_mps: float
     cas_min_mps: float
     tas_cmd_mps: float
     carry_max_cas_mps: float | None = None
@@ -112,6 +125,8 @@ class SpeedPlan:
     isa_dev_c: float = 0.0
     """The day's temperature deviation the CAS → TAS conversions use, K (the plan's; after a
     rebuild on changed conditions, the measured one)."""
+    bank_max_deg: float = 25.0
+    """The aircraft's bank limit (arcs ahead are flown below it), deg."""
 
     def enter_leg(self, k: int) -> None:
         """Leg ``k`` (whole-procedure index) is entered: in descent its 'at'/'at or below' limit
@@ -155,53 +170,53 @@ class SpeedPlan:
                 break
         return cap
 
-    def update(self, t_s: float, alt_m: float, leg: int, pieces: list[LocalPiece], i: int,
-               along_m: float, gs_mps: float, bank_max_deg: float,
-               piece_legs: list[int] | None = None, schedule=None,
-               s_sched_m: float | None = None, wind_mps: float = 0.0) -> float:
-        """The TAS target at time ``t_s`` (s), altitude (m), on leg ``leg`` (whole-procedure
-        index), piece ``i`` at ``along_m`` (m), ground speed (m/s), m/s; ``piece_legs``: the
-        whole-procedure leg of each piece (speed limits of fixes ahead planned before them);
-        ``schedule``: the approach's planned speeds (``SpeedProfile``) and ``s_sched_m`` the
-        aircraft's distance along the path they were planned on, m; ``wind_mps``: the
-        wind speed planned for, m/s (:func:`arc_speed_cap_mps`)."""
-        if t_s >= self.next_t_s:
-            ga = self.go_around
-            if ga is not None and leg >= ga.first_leg:
-                return self._go_around_update(t_s, alt_m, leg, pieces, i, along_m, gs_mps,
-                                              bank_max_deg, ga, wind_mps)
-            lim = self.limits[leg] if leg < len(self.limits) else None
-            lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
-            plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
-                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg,
-                                         wind_mps))
-            if piece_legs is not None:
-                plan = min(plan, self.limit_ahead_cap_mps(alt_m, leg, pieces, i, along_m,
-                                                          self.tas_cmd_mps, piece_legs))
-            floor = None
-            if self.vapp_cas_mps is not None and schedule is not None and s_sched_m is not None:
-                c = schedule.cas_at(s_sched_m + SPEED_LEAD_S * gs_mps, self.vapp_cas_mps)
-                if math.isfinite(c):
-                    plan = min(plan, cas_to_tas_scalar(c, alt_m, self.isa_dev_c))
-                floor = self.vapp_cas_mps
-            self.tas_cmd_mps = tas_target_mps(plan, alt_m, lo, hi, self.cas_min_mps,
-                                              self.isa_dev_c, floor)
-            self.next_t_s = t_s + SPEED_UPDATE_S
+    def update(self, t_s: float, alt_m: float, w: Where) -> float:
+        """The TAS target at time ``t_s`` (s) and navigation altitude ``alt_m`` (m) with the
+        aircraft at ``w`` on the active path, m/s (recomputed every :data:`SPEED_UPDATE_S`):
+        the leg's coded band, the arcs ahead (:func:`arc_speed_cap_mps` in the planned wind,
+        :func:`planned_wind_mps`), the limits of fixes ahead planned before them
+        (:meth:`limit_ahead_cap_mps`) and the approach's planned speeds (the profile's
+        ``SpeedProfile``, read :data:`SPEED_LEAD_S` ahead)."""
+        if t_s < self.next_t_s:
+            return self.tas_cmd_mps
+        a, leg, i, along_m, gs_mps = w.act, w.leg, w.i, w.along_m, w.gs_mps
+        wind_mps = planned_wind_mps(a.fp, alt_m)
+        ga = self.go_around
+        if ga is not None and leg >= ga.first_leg:
+            return self._go_around_update(t_s, alt_m, w, ga, wind_mps)
+        lim = self.limits[leg] if leg < len(self.limits) else None
+        lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
+        plan = min(cas_to_tas_scalar(self.plan_cas_mps, alt_m, self.isa_dev_c),
+                   arc_speed_cap_mps(a.pieces, i, along_m, gs_mps, self.bank_max_deg, wind_mps))
+        plan = min(plan, self.limit_ahead_cap_mps(alt_m, leg, a.pieces, i, along_m,
+                                                  self.tas_cmd_mps, a.piece_legs))
+        floor = None
+        prof = a.fp.path.profile
+        schedule = prof.speed
+        if self.vapp_cas_mps is not None and schedule is not None:
+            s_sched_m = w.s_path_m - (a.prof_s[0] - float(prof.along_m[0]))
+            c = schedule.cas_at(s_sched_m + SPEED_LEAD_S * gs_mps, self.vapp_cas_mps)
+            if math.isfinite(c):
+                plan = min(plan, cas_to_tas_scalar(c, alt_m, self.isa_dev_c))
+            floor = self.vapp_cas_mps
+        self.tas_cmd_mps = tas_target_mps(plan, alt_m, lo, hi, self.cas_min_mps,
+                                          self.isa_dev_c, floor)
+        self.next_t_s = t_s + SPEED_UPDATE_S
         return self.tas_cmd_mps
 
-    def _go_around_update(self, t_s, alt_m, leg, pieces, i, along_m, gs_mps, bank_max_deg,
-                          ga: GoAround, wind_mps: float = 0.0) -> float:
+    def _go_around_update(self, t_s: float, alt_m: float, w: Where, ga: GoAround,
+                          wind_mps: float) -> float:
         """The missed approach's TAS target (:class:`GoAround`), m/s: Vapp + the increment up
         to the acceleration height above the runway, then the planned speed in the leg's coded
         band."""
         if not self.accelerated and alt_m - ga.runway_elev_m >= ga.accel_height_m:
             self.accelerated = True
-        lim = self.limits[leg] if leg < len(self.limits) else None
+        lim = self.limits[w.leg] if w.leg < len(self.limits) else None
         lo, hi = cas_band(lim, None)
         if self.accelerated:
-            plan = min(cas_to_tas_scalar(self.plan_tas_mps, alt_m, self.isa_dev_c),
-                       arc_speed_cap_mps(pieces, i, along_m, gs_mps, bank_max_deg,
-                                         wind_mps))
+            plan = min(cas_to_tas_scalar(self.plan_cas_mps, alt_m, self.isa_dev_c),
+                       arc_speed_cap_mps(w.act.pieces, w.i, w.along_m, w.gs_mps,
+                                         self.bank_max_deg, wind_mps))
         else:
             plan = cas_to_tas_scalar(ga.vapp_cas_mps + ga.add_cas_mps, alt_m, self.isa_dev_c)
             lo = hi = None

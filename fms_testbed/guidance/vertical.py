@@ -1,9 +1,9 @@
 """Vertical guidance: the planned profile and the coded speed limits become targets for the
 coupled law (altitude and true airspeed), within the aircraft's performance.
 
-Altitude: the planned profile (``arinc424.profile.VerticalProfile``, which already climbs at the
-aircraft's gradient, levels off under 'at or below' constraints and descends at the coded or
-3° angle into each window) read ahead of the aircraft by the law's ramp lag::
+Altitude: the planned profile (:class:`fms_testbed.path.profile.VerticalProfile`, which already
+climbs at the aircraft's gradient, levels off under 'at or below' constraints and descends at
+the coded or 3° angle into each window) read ahead of the aircraft by the law's ramp lag::
 
     H_cmd = H_plan(s + V_g τ_H),    τ_H = 2 ξ_H T_H
 
@@ -108,6 +108,22 @@ BLEND_S = 6.0
 """Each slope change of the planned profile is blended over ±BLEND_S seconds of flight."""
 
 
+def _slope(ps: list[float], ph: list[float], k: int, extend: bool) -> float:
+    """Slope of profile piece ``k`` (between nodes k-1 and k); 0 before the first node, the last
+    piece's (``extend``) or 0 after the last."""
+    n = len(ps)
+    if k <= 0:
+        return 0.0
+    if k >= n:
+        if not extend:
+            return 0.0
+        k = n - 1
+        if k <= 0:
+            return 0.0
+    d = ps[k] - ps[k - 1]
+    return (ph[k] - ph[k - 1]) / d if d > 1e-6 else 0.0
+
+
 def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
                     extend: bool) -> tuple[float, float, float]:
     """Planned altitude at path distance ``s_m`` with every slope change blended by a parabola
@@ -122,17 +138,8 @@ def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
     n = len(ps)
     if n == 1:
         return ph[0], 0.0, 0.0
-
-    def slope(k: int) -> float:  # slope of piece k (between nodes k-1 and k); 0 off the ends
-        if k <= 0:
-            return 0.0
-        if k >= n:
-            return slope(n - 1) if extend else 0.0
-        d = ps[k] - ps[k - 1]
-        return (ph[k] - ph[k - 1]) / d if d > 1e-6 else 0.0
-
     j = bisect.bisect_right(ps, s_m)
-    m = slope(j)
+    m = _slope(ps, ph, j, extend)
     if j <= 0:
         h = ph[0]
     elif j >= n:
@@ -146,7 +153,7 @@ def blended_profile(ps: list[float], ph: list[float], s_m: float, w_m: float,
         sk = ps[k]
         if abs(s_m - sk) >= w_m:
             continue
-        delta = slope(k + 1) - slope(k)
+        delta = _slope(ps, ph, k + 1, extend) - _slope(ps, ph, k, extend)
         if delta == 0.0:
             continue
         u = s_m - sk + w_m
@@ -249,10 +256,8 @@ def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list
     s_path_m : distance along the active path, m; gs_mps : ground speed, m/s
     lead_s : read-ahead time 2 ξ_H T_H, s (:func:`altitude_lead_s`); t2_s2 : T_H², s²
     lead_speed_mps : the speed of the lead term, m/s (None: ``gs_mps``). Guidance gives the
-        TAS: the coupled law's ramp lag, measured, is 2 ξ_H T_H V_TAS dh/ds — air-relative.
-        With the ground speed instead, a 737 on a 3.4° final crossed the threshold 45 ft low
-        in a 30 kt tailwind and 48 ft high in a 30 kt headwind (KCHA S33); with the TAS at
-        the TCH in both (−0 ft)
+        TAS from the air data: the coupled law's ramp lag is air-relative, 2 ξ_H T_H V_TAS dh/ds
+        (measured in ``docs/flying.md``)
     top_m : the flight's climb top, m; approach : the last slope continues to the runway
     windows : coded (lo, hi) window per node, m: outside climbs the blended profile stays
         above the lower bound of the node ahead until it is passed (the blend of a
@@ -276,6 +281,6 @@ def altitude_command_m(prof_s: list[float], prof_h: list[float], climb_tgt: list
     if 0 < jn < len(prof_s) and climb_tgt[jn] is not None:
         # climb: to the target of the node ahead at the law's rate — never above it, so an
         # 'at or below' cap holds until its fix is passed (the profile's read-ahead and blend
-        # would lift it up to 20 s early: issue 12, class F)
+        # would lift it early)
         alt_cmd = min(climb_tgt[jn], top_m)
     return alt_cmd

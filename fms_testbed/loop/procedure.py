@@ -36,23 +36,17 @@ from fms_testbed.config.procedure import ProcedureSpec, parse_procedure
 from fms_testbed.path.plan import FlyablePath, build_procedure, load_db
 from fms_testbed.config.yamlfile import read_mapping
 from fms_testbed.config.scenario import Scenario, parse_scenario
-from fms_testbed.sim.jsbsim_core import DT_S
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.guidance.vertical import cas_band, planned_limits, tas_target_mps
 from fms_testbed.guidance.lateral import LateralGains, anticipation_m
 from fms_testbed.core.geodesy import direct
+from fms_testbed.core.planning import PLANNED_BANK_DEG, SCREEN_HEIGHT_M
 from fms_testbed.core.units import G0_MPS2
-from fms_testbed.loop.takeoff import TakeoffStart, check_takeoff, departure_runway
+from fms_testbed.loop.takeoff import DepartureRunway, check_takeoff, departure_runway
 
 OUTER_RATE_HZ = 10.0
 """Rate of navigation, guidance and the vertical law in procedure flights, Hz (an FMS runs
 LNAV/VNAV at 5-20 Hz; the same as the scenario default). A scenario's ``outer_rate_hz`` wins."""
-
-
-def runner_log_every(scn: Scenario) -> int:
-    """Outer steps between two logged rows, computed as the runner does (JSBSim at 120 Hz)."""
-    n_outer = max(1, int(round(1.0 / (scn.outer_rate_hz * DT_S))))
-    return max(1, int(round(1.0 / (scn.log_rate_hz * n_outer * DT_S))))
 
 
 def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
@@ -63,7 +57,7 @@ def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
                 if sg.geom.length_m() >= 50.0), seg0.start_course_deg)
     # start one roll-in anticipation before the path start on its initial course, so that a
     # turn beginning at the path start (a fly-by at the DER) is flown like any planned turn
-    lead = anticipation_m(cfg.limits.climb_tas_mps, math.radians(20.0),
+    lead = anticipation_m(cfg.limits.climb_tas_mps, math.radians(PLANNED_BANK_DEG),
                           LateralGains.for_aircraft(cfg))
     lat, lon, _ = direct(seg0.start[0], seg0.start[1], crs + 180.0, lead)
     alt = fp.path.legs[0].start.alt_m
@@ -98,15 +92,14 @@ class PreparedProcedure:
     @cached_property
     def terrain_elev_m(self) -> float:
         """Terrain elevation of the flight, m (module docstring)."""
-        from fms_testbed.core.units import FT_M
         from fms_testbed.path.runway import terrain_elevation_m
 
         if self.spec.start == "takeoff":
             return departure_runway(self.db, self.path.seq).elev_m
         h = terrain_elevation_m(self.db, self.path.seq)
         p = self.path.path
-        if p.proc_type == "D" and p.legs:   # a SID starts 35 ft above its runway's end
-            h = min(h, p.legs[0].start.alt_m - 35 * FT_M)
+        if p.proc_type == "D" and p.legs:   # a SID starts at the screen height over its DER
+            h = min(h, p.legs[0].start.alt_m - SCREEN_HEIGHT_M)
         return h
 
     @cached_property
@@ -117,17 +110,16 @@ class PreparedProcedure:
 
         return approach_runway(self.db, self.path.seq) if self.db is not None else None
 
-    def takeoff_start(self, cfg) -> TakeoffStart | None:
-        """The takeoff phase of a SID flown from the runway (``procedure.start: takeoff``),
-        None for an airborne start."""
+    def takeoff_runway(self) -> DepartureRunway | None:
+        """The runway of a SID flown from a takeoff (``procedure.start: takeoff``), None for an
+        airborne start."""
         if self.spec.start != "takeoff":
             return None
-        return TakeoffStart(departure_runway(self.db, self.path.seq), cfg)
+        return departure_runway(self.db, self.path.seq)
 
     def guidance(self, scn: Scenario, cfg) -> tuple[ProcedureGuidance, Any]:
         """The procedure guidance and the vertical law (None: the scenario's) for a flight."""
-        g = ProcedureGuidance(self.path, cfg, db=self.db, spec=self.spec,
-                              log_every=runner_log_every(scn))
+        g = ProcedureGuidance(self.path, cfg, db=self.db, spec=self.spec)
         law = procedure_law(cfg) if scn.vertical_law == "coupled" and cfg.coupled_law else None
         return g, law
 
@@ -189,7 +181,7 @@ def prepare(raw: dict, source: str = "<scenario>", db=None
     v_min = max(cfg.limits.climb_tas_mps - w_max,
                 0.5 * cfg.limits.climb_tas_mps)   # into the wind
     # + two full turns: a path rebuilt in flight after a conditional leg may loop back
-    r_turn = cfg.limits.climb_tas_mps ** 2 / (G0_MPS2 * math.tan(math.radians(20.0)))
+    r_turn = cfg.limits.climb_tas_mps ** 2 / (G0_MPS2 * math.tan(math.radians(PLANNED_BANK_DEG)))
     raw.setdefault("duration_s", min(6 * 3600.0, (1.6 * fp.path.length_m()
                                                   + 4.0 * math.pi * r_turn) / v_min + 120.0))
     raw.setdefault("name", f"{spec.airport}-{spec.procedure}".lower())

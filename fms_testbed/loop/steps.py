@@ -15,7 +15,7 @@ construction, run-time state lives in the step object.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -23,7 +23,7 @@ from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.config.scenario import Event, Scenario
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.core.contracts import GuidanceOutput
-from fms_testbed.core.state import AircraftState, NavSolution
+from fms_testbed.core.state import AirData, AircraftState, NavSolution
 from fms_testbed.core.units import FT_M
 from fms_testbed.guidance.lateral import heading_hold_bank_rad, wrap_pi
 
@@ -96,8 +96,8 @@ def apply_event(ev: Event, tg: Targets) -> None:
 
 
 def merge_guidance(gout: GuidanceOutput, tg: Targets) -> None:
-    """Write a guidance output into ``tg``: its bank replaces heading/bank hold, its altitude and
-    TAS engage the vertical law."""
+    """Write the guidance output ``gout`` into the targets ``tg``: its bank replaces heading/bank
+    hold, its altitude and TAS engage the vertical law."""
     if gout.bank_rad is not None:
         tg.bank_rad, tg.heading_rad = gout.bank_rad, None
     if gout.alt_m is not None:
@@ -107,8 +107,8 @@ def merge_guidance(gout: GuidanceOutput, tg: Targets) -> None:
 
 
 def wind_ned_mps(scn: Scenario, alt_m: float = 0.0) -> tuple[float, float, float]:
-    """The scenario's wind at ``alt_m`` (m; a profile is interpolated) as the velocity of the
-    air, NED, m/s."""
+    """The wind of scenario ``scn`` at ``alt_m`` (m; a profile is interpolated) as the velocity
+    of the air, NED, m/s."""
     prof = scn.wind_profile
     if prof is None:
         return (0.0, 0.0, 0.0)
@@ -117,23 +117,50 @@ def wind_ned_mps(scn: Scenario, alt_m: float = 0.0) -> tuple[float, float, float
 
 
 class WindRamp:
-    """The scenario's wind in JSBSim: ramped in over :data:`WIND_RAMP_S` after trim, and, for a
+    """The scenario's wind in JSBSim: ramped in linearly over :data:`WIND_RAMP_S` from its
+    start (:meth:`start`: after a trim at once, on a takeoff roll once rolling), and, for a
     profile over altitude, the wind at the aircraft's present altitude set every outer step
-    (``varies``; a steady wind is set only during the ramp)."""
+    (``varies``; a steady wind is set only during the ramp).
 
-    def __init__(self, fdm, scn: Scenario, dt_outer_s: float):
+    Parameters
+    ----------
+    fdm : the JSBSim instance; scn : the scenario (its wind)
+    dt_outer_s : outer-loop period, s (the ramp's last setting is one step past its end)
+    start_s : time the ramp starts, s (None: not yet, :meth:`start` later)
+    """
+
+    def __init__(self, fdm, scn: Scenario, dt_outer_s: float, start_s: float | None = 0.0):
         self.profile = scn.wind_profile
         self.active = self.profile is not None and self.profile.max_speed_mps > 0.0
+        self.max_speed_mps = self.profile.max_speed_mps if self.active else 0.0
         self.varies = self.active and self.profile.layered
         self.end_s = WIND_RAMP_S + dt_outer_s
+        self.t0_s = start_s
         self.wind_ned = wind_ned_mps(scn)
         pm = fdm.get_property_manager()
         self.nodes = [pm.get_node(f"atmosphere/wind-{c}-fps", False)
                       for c in ("north", "east", "down")]
 
+    def start(self, t_s: float) -> None:
+        """Start the ramp at ``t_s`` (s) unless it has started."""
+        if self.t0_s is None:
+            self.t0_s = t_s
+
+    def finish(self, alt_m: float) -> None:
+        """All of the wind from now on (the ramp's end), at altitude ``alt_m`` (m)."""
+        if self.active:
+            self(self.end_s, alt_m)
+        self.t0_s = -math.inf
+
+    def step(self, t_s: float, alt_m: float) -> None:
+        """The wind for this outer step at time ``t_s`` (s) and altitude ``alt_m`` (m)."""
+        if self.active and self.t0_s is not None:
+            tau = t_s - self.t0_s
+            if tau <= self.end_s or self.varies:
+                self(tau, alt_m)
+
     def __call__(self, t_s: float, alt_m: float = 0.0) -> None:
-        """Set the wind for time ``t_s`` (s after trim) at altitude ``alt_m`` (m); call while
-        ``t_s <= end_s``, and every step when :attr:`varies`."""
+        """Set the wind ``t_s`` (s) after the ramp's start at altitude ``alt_m`` (m)."""
         frac = min(1.0, t_s / WIND_RAMP_S)
         if self.varies:
             n, e = self.profile.ned_at(alt_m)
@@ -247,7 +274,13 @@ class LateralStep:
 class VerticalStep:
     """The vertical channel and the command to JSBSim: the vertical law while an altitude/speed
     target is active (the law works in the vertical plane and returns the vertical component of
-    n_y, divided here by cos φ), else the direct n_y/n_x/throttle targets."""
+    n_y, divided here by cos φ), else the direct n_y/n_x/throttle targets.
+
+    The speeds and the altitude the step reads are the air data's: a CAS target is flown as its
+    TAS at the barometric altitude on the day, an unset speed target holds the measured TAS,
+    and the law is handed the true state with the air-data TAS, CAS, Mach and barometric
+    altitude in place of the true ones (the same object when they agree, as with an error-free
+    air-data computer)."""
 
     __slots__ = ("law", "command", "dt_s", "engaged", "isa_dev_c")
 
@@ -255,22 +288,26 @@ class VerticalStep:
         self.law, self.command, self.dt_s = law, aircraft.command, dt_outer_s
         self.engaged = False
         # a CAS target flown as its TAS on the day (the air-data computer's temperature)
-        self.isa_dev_c = getattr(aircraft, "isa_dev_c", 0.0)
+        self.isa_dev_c = aircraft.isa_dev_c
 
-    def __call__(self, s: AircraftState, tg: Targets, bank_rad: float
+    def __call__(self, s: AircraftState, air: AirData, tg: Targets, bank_rad: float
                  ) -> tuple[float, float, float, float]:
         """Compute and send this step's commands; return them: (cmd_nx g, cmd_ny g, altitude
         command m, TAS command m/s), NaN where inactive."""
         if tg.vertical:
             if tg.alt_m is None:
-                tg.alt_m = s.alt_m
+                tg.alt_m = air.baro_alt_m
             alt_cmd = tg.alt_m
             if tg.speed_mps is None:
-                tg.speed_kind, tg.speed_mps = "tas", s.tas_mps
-            tas_cmd = (cas_to_tas_scalar(tg.speed_mps, s.alt_m, self.isa_dev_c)
+                tg.speed_kind, tg.speed_mps = "tas", air.tas_mps
+            tas_cmd = (cas_to_tas_scalar(tg.speed_mps, air.baro_alt_m, self.isa_dev_c)
                        if tg.speed_kind == "cas"
                        else tg.speed_mps)
             law = self.law
+            if not (air.tas_mps == s.tas_mps and air.baro_alt_m == s.alt_m
+                    and air.cas_mps == s.cas_mps and air.mach == s.mach):
+                s = replace(s, tas_mps=air.tas_mps, cas_mps=air.cas_mps, mach=air.mach,
+                            alt_m=air.baro_alt_m)
             if not self.engaged:
                 law.engage(s, alt_cmd, tas_cmd)
                 self.engaged = True
@@ -279,7 +316,7 @@ class VerticalStep:
             self.command(bank_rad=bank_rad, ny=cmd_ny, nx=cmd_nx)
             return cmd_nx, cmd_ny, alt_cmd, tas_cmd
         self.engaged = False
-        nan = float("nan")
+        nan = math.nan
         cmd_ny = tg.ny
         if tg.throttle is not None:
             self.command(bank_rad=bank_rad, ny=cmd_ny, throttle=tg.throttle)

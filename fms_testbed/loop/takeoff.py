@@ -1,68 +1,67 @@
-"""A SID that starts on the runway: the takeoff roll, rotation and initial climb, then the
-handover to the procedure guidance (``procedure.start: takeoff``, ``fms-testbed fly --takeoff``).
+"""The takeoff phase of a SID that starts on the runway: the takeoff roll, rotation and initial
+climb, then the handover to the airborne phase (``procedure.start: takeoff``, ``fms-testbed fly
+--takeoff``).
 
 The aircraft starts at rest on the threshold of the SID's runway (the runway record: threshold
-position and elevation, magnetic bearing + airport variation = true bearing, as the airborne
-start's departure end is found), on the centreline and heading, gear down, flaps at the
-aircraft file's takeoff setting (``takeoff:`` block), JSBSim's terrain at the threshold
-elevation (a flat runway: its slope is not modelled). The takeoff is flown on the true state,
-as a pilot flies it looking out; the navigation source runs (and is logged) from brake
-release, guidance flies on it from the handover. The scenario's wind comes in once the
-aircraft rolls faster than twice the wind speed (at rest a tailwind puts alpha at 180°),
-ramped in as after a trim; scenario events fall due from the handover on. Then:
+position and elevation, magnetic bearing + airport variation = true bearing), on the centreline
+and heading, gear down, flaps at the aircraft file's takeoff setting (``takeoff:`` block),
+JSBSim's terrain at the threshold elevation (a flat runway: its slope is not modelled). The
+takeoff is flown on the true state, as a pilot flies it looking out; the navigation source runs
+(and is logged) from brake release, guidance flies on it from LNAV. The scenario's wind comes
+in once the aircraft rolls faster than twice the wind speed (at rest a tailwind puts α at
+180°), ramped in as after a trim; scenario events fall due from the handover on. The control
+(:class:`TakeoffControl`) runs every :data:`CONTROL_FRAMES` JSBSim frames:
 
 1. **roll** — the throttle goes to ``takeoff.thrust_norm`` over :data:`SPOOL_S`; nose-wheel
    steering (``fcs/steer-cmd-norm``) and rudder hold the centreline: heading error plus the
    angle to a point :data:`LOOKAHEAD_S` ahead on it, with yaw-rate damping.
 2. **rotate** at VR (CAS) at :data:`ROTATE_RATE_DPS` to ``takeoff.pitch_deg`` (elevator on the
    pitch-rate error, proportional + integral, scaled with q̄ like the inner loops).
-3. **climb** after liftoff (no weight on the wheels): wings level on the extended centreline
+3. **climb** after lift-off (no weight on the wheels): wings level on the extended centreline
    through the bank and yaw inner loops, pitch for V2 + ``climb_add_cas_mps`` (never above
-   ``pitch_max_deg``), gear up at a positive rate of climb (> 1 m/s) above 35 ft; from the
-   acceleration height (the approach settings' ``acceleration_height_m``, else 1,000 ft) the
-   pitch target eases (≤ 1 deg/s) to accelerate to the planned climb speed (the guidance's
-   speed target once LNAV is on, else ``limits.climb_tas_mps`` as a CAS) and the flaps come up
-   on the go-around retraction schedule (:class:`~fms_testbed.loop.steps.ConfigStep`).
-4. **LNAV** from :data:`LNAV_HEIGHT_M` (400 ft) above the runway and no earlier than where
-   the airborne start would start (one roll-in anticipation before the DER): the procedure guidance
-   steers (its bank command through the flight's roll-rate limit), the pitch stays the
-   takeoff's — as an FMS engages LNAV in the takeoff climb and VNAV later. 400 ft is the
-   lowest height a departure turn is designed for (120 m, ICAO PANS-OPS Doc 8168, turning
-   departures).
-5. **handover** (VNAV) once at least :data:`HANDOVER_HEIGHT_M` (400 ft) above the runway,
-   past its departure end (DER) and within :data:`HANDOVER_SPEED_MARGIN_MPS` (10 kt) of the
-   planned climb speed, or :data:`HANDOVER_MAX_HEIGHT_M` (3,000 ft) above the runway whatever
-   the speed: the inner-loop trims take the surfaces and throttle of the moment, every loop
-   is engaged and the normal loop (procedure guidance, vertical law, flap retraction on the
-   go-around schedule of the approach settings) flies on. The DER, because the built path
-   and its vertical profile begin there (the airborne start's reference, 35 ft above it):
-   before it the guidance's altitude command is that start height, so a vertical handover
-   short of it dives (measured, KJFK DEEZZ5 RW31L, 737: handed over at 400 ft 2.3 km before
-   the DER, the command was 14.6 m and the aircraft sank from 202 m to 105 m); on a long
-   runway the takeoff climb therefore goes on to the DER (737, KSEA 16L: ~1,600 ft there).
-   The speed, because the vertical law handed an aircraft 30 kt below its planned climb
-   speed pushes to its n_y floor to accelerate (measured: 0.53 g at the 737's handover at
-   KSEA 16L). LNAV before the vertical handover, because a SID's first turn can begin at or
-   soon after the DER (KJFK DEEZZ5: 110° left 971 m past it; handed over whole at the turn's
-   start the 737 overshot it by 172 m).
+   ``pitch_max_deg``), gear up at a positive rate of climb above :data:`GEAR_UP_HEIGHT_M`; from
+   the acceleration height (the approach settings' ``acceleration_height_m``, else
+   :data:`ACCEL_HEIGHT_M`) the pitch target eases (≤ 1 deg/s) to accelerate to the planned
+   climb speed (the guidance's speed target once LNAV is on, else
+   ``limits.climb_tas_mps``, which holds a CAS)
+   and the flaps come up on the go-around retraction schedule
+   (:class:`~fms_testbed.loop.steps.ConfigStep`).
+4. **LNAV** from :data:`LNAV_HEIGHT_M` above the runway and no earlier than where the airborne
+   start would start (one roll-in anticipation before the departure end, DER): the procedure
+   guidance steers (its bank command through the flight's roll-rate limit), the pitch stays
+   the takeoff's. :data:`LNAV_HEIGHT_M` is the lowest height a departure turn is designed for
+   (120 m, ICAO PANS-OPS Doc 8168, turning departures).
+5. **handover** (VNAV) once at least :data:`HANDOVER_HEIGHT_M` above the runway, past the DER
+   (the built path and its vertical profile begin there) and within
+   :data:`HANDOVER_SPEED_MARGIN_MPS` of the planned climb speed, or
+   :data:`HANDOVER_MAX_HEIGHT_M` above the runway whatever the speed: the inner-loop trims take
+   the surfaces and throttle of the moment, every loop is engaged and the airborne phase
+   (procedure guidance, vertical law, flap retraction) flies on from the same step.
 
-A run-away during the takeoff ends the flight ``diverged``: non-finite state, stall,
-leaving the runway (more than :data:`EXCURSION_M` off the centreline or past its end on the
-wheels), ground contact after liftoff, or no handover within :data:`TIMEOUT_S`.
+A run-away during the takeoff ends the flight ``diverged``: non-finite state, stall, leaving
+the runway (more than :data:`EXCURSION_M` off the centreline or past its end on the wheels),
+ground contact after lift-off, or no handover within :data:`TIMEOUT_S`. Why the handover waits
+for the DER and the speed, and LNAV comes first, is measured in ``docs/flying.md``.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from typing import Callable
+
+from pydantic import ConfigDict
 
 from fms_testbed.config.aircraft import AircraftConfig
+from fms_testbed.core.contracts import OMIT_NONE
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.geodesy import inverse
 from fms_testbed.core.units import FT_M, KT_MPS
-from fms_testbed.guidance.lateral import LateralGains, anticipation_m
-from fms_testbed.loop.steps import (POSITIVE_RATE_MPS, ConfigStep, FrameSampling, LateralStep,
-                                    NavHold, WindRamp, merge_guidance)
+from fms_testbed.core.planning import PLANNED_BANK_DEG, SCREEN_HEIGHT_M
+from fms_testbed.core.state import AirData, AircraftState, NavSolution
+from fms_testbed.guidance.lateral import LateralGains, anticipation_m, wrap_pi
+from fms_testbed.loop.phases import AirbornePhase, LoopParts
+from fms_testbed.loop.steps import POSITIVE_RATE_MPS, ConfigStep
 from fms_testbed.sim.divergence import Divergence
 from fms_testbed.sim.jsbsim_core import RAW
 from fms_testbed.sim.takeoff import ground_start, handover, set_controls
@@ -79,8 +78,8 @@ HANDOVER_SPEED_MARGIN_MPS = 10 * KT_MPS
 """The full handover waits for the CAS to be within this of the planned climb speed, m/s."""
 HANDOVER_MAX_HEIGHT_M = 3000 * FT_M
 """... or for this height above the runway, whatever the speed, m."""
-GEAR_UP_HEIGHT_M = 35 * FT_M
-"""The gear comes up at a positive rate of climb above this height, m."""
+GEAR_UP_HEIGHT_M = SCREEN_HEIGHT_M
+"""The gear comes up at a positive rate of climb above this height (the screen height), m."""
 SPOOL_S = 3.0
 """Throttle ramp from idle to takeoff thrust, s."""
 ROTATE_RATE_DPS = 3.0
@@ -124,8 +123,9 @@ class DepartureRunway:
 
 
 def departure_runway(db, seq) -> DepartureRunway | None:
-    """The runway of SID sequence ``seq`` (its runway transition's threshold record, the one the
-    airborne start's departure end is computed from), None when it has none or no elevation."""
+    """The runway of SID sequence ``seq`` in database ``db`` (its runway transition's threshold
+    record, the one the airborne start's departure end is computed from), None when it has none
+    or no elevation."""
     from fms_testbed.path.segmentation import runway_record   # the airborne start's look-up
 
     if db is None or seq.proc_type != "D":
@@ -145,7 +145,13 @@ def departure_runway(db, seq) -> DepartureRunway | None:
 
 def check_takeoff(source: str, proc_type: str, rwy: DepartureRunway | None,
                   cfg: AircraftConfig) -> None:
-    """Refuse a takeoff start that cannot be flown: :class:`ConfigError` (file, field, reason)."""
+    """Refuse a takeoff start that cannot be flown: :class:`ConfigError` (file, field, reason).
+
+    Parameters
+    ----------
+    source : the scenario's file (for the message); proc_type : the procedure's type letter
+    rwy : its departure runway (None: none found); cfg : the aircraft (its ``takeoff:`` block)
+    """
     where = f"{source}: field 'procedure.start'"
     if proc_type != "D":
         kind = {"E": "a STAR", "F": "an approach"}.get(proc_type, "this procedure")
@@ -216,191 +222,258 @@ class TakeoffControl:
         return max(-_BANK_MAX, min(_BANK_MAX, -_BANK_K * track_err_rad - _BANK_KY * cross_m))
 
 
+
 @dataclass
-class TakeoffStart:
-    """The takeoff phase of one flight (module docstring): :meth:`start` puts the aircraft on
-    the runway, :meth:`fly` flies it to the handover, :meth:`summary` says what happened."""
+class TakeoffMark:
+    """The aircraft at one event of the takeoff: along the centreline from the threshold and
+    right of it (m), CAS (m/s), height above the runway (m), pitch (deg)."""
 
-    runway: DepartureRunway
-    cfg: AircraftConfig
-    t_s: dict = field(default_factory=dict)          # event -> time, s
-    at: dict = field(default_factory=dict)           # event -> values at that time
-    max_dev_ground_m: float = 0.0
-    max_dev_air_m: float = 0.0
-    vr_cas_mps: float = 0.0
-    v2_cas_mps: float = 0.0
+    __pydantic_config__ = ConfigDict(extra="forbid")
 
-    def start(self, ac) -> None:
-        """Put ``ac`` at rest on the threshold (:func:`~fms_testbed.sim.takeoff.ground_start`)."""
-        rw = self.runway
-        ground_start(ac, rw.lat_deg, rw.lon_deg, rw.elev_m, rw.bearing_deg,
-                     self.cfg.takeoff.flaps_norm)
+    along_m: float
+    cross_m: float
+    cas_mps: float
+    height_m: float
+    pitch_deg: float
 
-    def fly(self, flight):
-        """Fly the takeoff phase of ``flight`` (a :class:`~fms_testbed.loop.flight.Flight`), one
-        ``yield`` per outer step, logging its rows; return True at the handover, False (with
-        ``flight.status``/``reason`` set) when the takeoff failed."""
-        ac, cfg, rw, to = flight.aircraft, self.cfg, self.runway, self.cfg.takeoff
-        fdm = ac.fdm
+
+@dataclass
+class TakeoffRecord:
+    """The takeoff as flown (the summary's ``takeoff`` block).
+
+    Attributes
+    ----------
+    start : 'takeoff'
+    runway : the runway ident ('RW16L'); vr_cas_mps, v2_cas_mps : VR and V2 of the mass, CAS m/s
+    times_s : time after brake release of each event (rotate, liftoff, v2, gear_up,
+        accelerate, lnav, der, handover), s
+    events : the aircraft at each event (:class:`TakeoffMark`)
+    max_centreline_dev_ground_m, max_centreline_dev_air_m : largest centreline deviation on the
+        wheels and in the air before LNAV, m
+    ground_roll_m : threshold to lift-off, m; time_to_v2_s : s; der_height_m : height at the
+        runway's end, m; handover_s, handover_along_m : when and where the handover came, s, m
+        (None: not reached)
+    """
+
+    __pydantic_config__ = ConfigDict(extra="forbid")
+
+    start: str
+    runway: str
+    vr_cas_mps: float
+    v2_cas_mps: float
+    times_s: dict[str, float]
+    events: dict[str, TakeoffMark]
+    max_centreline_dev_ground_m: float
+    max_centreline_dev_air_m: float
+    ground_roll_m: float | None = field(default=None, metadata=OMIT_NONE)
+    time_to_v2_s: float | None = field(default=None, metadata=OMIT_NONE)
+    der_height_m: float | None = field(default=None, metadata=OMIT_NONE)
+    handover_s: float | None = field(default=None, metadata=OMIT_NONE)
+    handover_along_m: float | None = field(default=None, metadata=OMIT_NONE)
+
+
+class TakeoffPhase:
+    """The takeoff phase of the flight loop (module docstring; the phase steps of
+    :mod:`.phases`).
+
+    Parameters
+    ----------
+    parts : the flight's shared parts (:class:`~.phases.LoopParts`)
+    runway : the departure runway
+    guided : the flight has a guidance (LNAV engages)
+    airborne : builds the airborne phase of the handover from its configuration step (None: an
+        aircraft without approach settings)
+    """
+
+    name = "takeoff"
+    fires_events = False
+    always_guided = False
+    hands_over = True
+
+    def __init__(self, parts: LoopParts, runway: DepartureRunway, guided: bool,
+                 airborne: Callable[[ConfigStep | None], AirbornePhase]):
+        cfg, ac = parts.cfg, parts.aircraft
+        to = cfg.takeoff
+        self.parts, self.runway, self.cfg, self.to, self.ac = parts, runway, cfg, to, ac
+        self.guided_flight, self.airborne = guided, airborne
+        self.times_s: dict[str, float] = {}
+        self.marks: dict[str, TakeoffMark] = {}
+        self.max_dev_ground_m = self.max_dev_air_m = 0.0
         ac.engage(bank=False, yaw=False, ny=False, nx=False)
-        mass_kg = float(ac.state().mass_kg)
-        self.vr_cas_mps, self.v2_cas_mps = to.speeds_cas_mps(mass_kg)
-        v_climb = self.v2_cas_mps + to.climb_add_cas_mps
-        idle = cfg.inner_loops.throttle_min
-        brg = math.radians(rw.bearing_deg)
-        wind = WindRamp(fdm, flight.scn, flight.dt_outer_s)
-        check = Divergence(cfg)
-        n_sub = max(1, flight.n_frames // CONTROL_FRAMES)
-        frames = flight.n_frames // n_sub
-        dt_c = frames * ac.dt_s
-        log_every = max(1, int(round(1.0 / (flight.scn.log_rate_hz * flight.dt_outer_s))))
-        i_wow = RAW["wow"]
-        phase = "roll"
-        pilot = TakeoffControl(math.radians(to.pitch_deg), math.radians(to.pitch_max_deg),
-                               to.pitch_rate_kp, to.pitch_rate_ki)
-        # the wind comes in once the aircraft rolls faster than twice its speed (the relative
-        # wind then blows from ahead: at rest a tailwind puts alpha at 180 deg), ramped over
-        # loop.steps.WIND_RAMP_S from there
-        w_max = flight.scn.wind_profile.max_speed_mps if wind.active else 0.0
-        t_wind = None
-        nav_spec = flight.scn.navigation_spec
-        nav_dt = float(nav_spec.get("dt_s", 0.1)) if nav_spec.get("source") == "sins" else 0.0
-        sampling = FrameSampling(flight.navigation, ac)
-        navigate = (NavHold(flight.navigation, nav_dt) if nav_dt > flight.dt_outer_s + 1e-9
-                    else sampling)   # as the flight loop does
-        gear_up = cfg.approach is not None and cfg.approach.fixed_gear
+        self.vr_cas_mps, self.v2_cas_mps = to.speeds_cas_mps(float(ac.state().mass_kg))
+        self.v_climb_cas_mps = self.v2_cas_mps + to.climb_add_cas_mps
+        self.throttle_idle = cfg.inner_loops.throttle_min
+        self.bearing_rad = math.radians(runway.bearing_deg)
+        self.check_air = Divergence(cfg)
+        self.n_sub = max(1, parts.n_frames // CONTROL_FRAMES)
+        self.frames = parts.n_frames // self.n_sub
+        self.dt_c = self.frames * ac.dt_s
+        self.stage = "roll"
+        self.pilot = TakeoffControl(math.radians(to.pitch_deg), math.radians(to.pitch_max_deg),
+                                    to.pitch_rate_kp, to.pitch_rate_ki)
         ap = cfg.approach
-        h_accel = ap.acceleration_height_m if ap is not None else ACCEL_HEIGHT_M
-        config = self._config_step(flight, ac, gear_up) if ap is not None else None
-        guide, tg = flight.guidance, flight.targets
-        lateral = LateralStep(cfg, flight.dt_outer_s)
-        n_guided = 0                                    # guidance calls (LNAV engaged)
+        self.gear_up = ap is not None and ap.fixed_gear
+        self.h_accel = ap.acceleration_height_m if ap is not None else ACCEL_HEIGHT_M
+        self.config = self._config_step() if ap is not None else None
+        self.n_guided = 0
         # LNAV from where the airborne start starts: one roll-in anticipation before the DER
-        # (the guidance projects an aircraft far before the path start onto its first
-        # segment: a fly-by arc at the DER then reads 1.8 km off, measured)
-        lnav_lead_m = anticipation_m(cfg.limits.climb_tas_mps, math.radians(20.0),
-                                     LateralGains.for_aircraft(cfg))
-        v_plan = cfg.limits.climb_tas_mps     # planned climb speed, CAS (the guidance's, once on)
-        t0 = fdm.get_sim_time()
-        bank_cmd, thr = 0.0, idle
-        k = 0
-        while True:
-            raw = ac.read_raw()
-            s = ac.state(raw)
-            t = s.t_s - t0
-            along, cross = rw.along_cross_m(math.degrees(s.lat_rad), math.degrees(s.lon_rad))
-            wow = raw[i_wow] > 0.5
-            h_m = s.alt_m - rw.elev_m
-            why = self._failure(s, raw[i_wow], check, along, cross, phase, t)
-            if why:
-                flight.status, flight.reason = "diverged", f"takeoff: {why}"
-                return False
-            nav = navigate(s)                 # the navigation source runs from brake release
-            # LNAV: the procedure guidance steers from LNAV_HEIGHT_M (engaged on a logging
-            # step, so that its log records stay in step with the flight's rows)
-            if guide is not None and phase == "climb" and (n_guided or (
-                    h_m >= LNAV_HEIGHT_M and along >= rw.length_m - lnav_lead_m
-                    and k % log_every == 0)):
-                if not n_guided:
-                    self._mark("lnav", s, along, cross, t)
-                    lateral.last_bank_rad = bank_cmd
-                    # steady and wings level on the centreline: the aileron and rudder of the
-                    # moment are the lateral trims (propeller torque: the c172p needs 0.07
-                    # aileron; its bank loop has no integral, measured 0.6 deg off otherwise)
-                    fdm["fms/trim/aileron"] = fdm["fcs/aileron-cmd-norm"]
-                    fdm["fms/trim/rudder"] = fdm["fcs/rudder-cmd-norm"]
-                gout = guide.update(flight.dt_outer_s, nav, s)
-                n_guided += 1
-                merge_guidance(gout, tg)
-                bank_cmd = lateral(tg, nav, True)
-                if gout.tas_mps is not None and s.tas_mps > 1.0:   # the planned speed, CAS
-                    v_plan = gout.tas_mps * s.cas_mps / s.tas_mps
-            else:
-                gout = None
-            if k % log_every == 0:
-                _log_row(flight, raw, nav, gout, bank_cmd, brg, thr)
-            if phase == "climb" and "der" not in self.t_s and along >= rw.length_m:
-                self._mark("der", s, along, cross, t)
-            done = gout is not None and gout.done
-            if done or (phase == "climb" and h_m >= HANDOVER_HEIGHT_M
-                        and along >= rw.length_m and n_guided % log_every == 0 and (
-                            s.cas_mps >= v_plan - HANDOVER_SPEED_MARGIN_MPS
-                            or h_m >= HANDOVER_MAX_HEIGHT_M)):
-                self._mark("handover", s, along, cross, t)
-                if wind.active:
-                    wind(wind.end_s, s.alt_m)         # all of it from here (the ramp's end)
-                handover(ac)
-                if config is not None:
-                    config.gear_down = not gear_up
-                    flight.config_step = config
-                return True
-            if wind.active:
-                if t_wind is None and s.gs_mps > 2.0 * w_max:
-                    t_wind = s.t_s
-                if t_wind is not None and (s.t_s - t_wind <= wind.end_s or wind.varies):
-                    wind(s.t_s - t_wind, s.alt_m)
-            for j in range(n_sub):
-                if j:
-                    raw = ac.read_raw()
-                    s = ac.state(raw)
-                    along, cross = rw.along_cross_m(math.degrees(s.lat_rad),
-                                                    math.degrees(s.lon_rad))
-                    wow = raw[i_wow] > 0.5
-                    h_m = s.alt_m - rw.elev_m
-                t = s.t_s - t0
-                # -- phase changes
-                if phase == "roll" and s.cas_mps >= self.vr_cas_mps:
-                    phase = "rotate"
-                    self._mark("rotate", s, along, cross, t)
-                if phase == "rotate" and not wow and h_m > 0.0:
-                    phase = "climb"
-                    self._mark("liftoff", s, along, cross, t)
-                    fdm["fcs/steer-cmd-norm"] = 0.0
-                    fdm["fms/trim/rudder"] = 0.0       # the yaw loop takes the rudder
-                    fdm["fms/trim/aileron"] = 0.0
-                    ac.engage(bank=True, yaw=True, ny=False, nx=False)
-                if "v2" not in self.t_s and s.cas_mps >= self.v2_cas_mps:
-                    self._mark("v2", s, along, cross, t)
-                if phase == "climb" and not gear_up and s.vs_mps > POSITIVE_RATE_MPS \
-                        and h_m > GEAR_UP_HEIGHT_M:
-                    gear_up = True
-                    ac.configure(gear_down=False)
-                    self._mark("gear_up", s, along, cross, t)
-                # -- controls
-                thr = idle + (to.thrust_norm - idle) * min(1.0, t / SPOOL_S)
-                if phase != "climb":
-                    self.max_dev_ground_m = max(self.max_dev_ground_m, abs(cross))
-                    steer, rudder = pilot.ground(dt_c, _wrap(s.heading_rad - brg), cross,
-                                                 s.gs_mps, s.r_rps)
-                    set_controls(ac, steer=steer, rudder=rudder, throttle=thr)
-                else:
-                    if not n_guided:   # on the extended centreline until LNAV
-                        self.max_dev_air_m = max(self.max_dev_air_m, abs(cross))
-                        bank_cmd = pilot.bank(_wrap(s.track_rad - brg), cross)
-                    ac.command(bank_rad=bank_cmd, throttle=thr)
-                    if h_m >= h_accel and "accelerate" not in self.t_s:
-                        self._mark("accelerate", s, along, cross, t)
-                    if "accelerate" in self.t_s:
-                        v_climb = max(self.v2_cas_mps + to.climb_add_cas_mps, v_plan)
-                    if config is not None and "accelerate" in self.t_s:
-                        config.gear_down = not gear_up
-                        config(s, flight.targets, False)     # flaps up on schedule
-                if phase != "roll":
-                    set_controls(ac, elevator=pilot.pitch(
-                        dt_c, s.pitch_rad, s.q_rps, fdm["fms/sched/qbar-ratio"],
-                        s.cas_mps - v_climb if phase == "climb" else None, s.alpha_rad))
-                if not sampling.run(frames):
-                    flight.status, flight.reason = "diverged", "takeoff: JSBSim stopped"
-                    return False
-            k += 1
-            yield k
+        self.lnav_lead_m = anticipation_m(cfg.limits.climb_tas_mps, math.radians(PLANNED_BANK_DEG),
+                                          LateralGains.for_aircraft(cfg))
+        # planned climb speed, a CAS (limits.climb_tas_mps holds a CAS; the guidance's once on)
+        self.v_plan_cas_mps = cfg.limits.climb_tas_mps
+        self.t0 = ac.fdm.get_sim_time()
+        self.bank_cmd_rad, self.throttle = 0.0, self.throttle_idle
+        self._s, self._wow = None, True           # this step's state, on the wheels
+        self.t_run_s = self.along_m = self.cross_m = self.h_m = 0.0   # s, m, m, m
 
-    def _failure(self, s, wow, check, along, cross, phase, t) -> str | None:
-        if phase == "climb":
-            return check(s, wow)
+    # ------------------------------------------------------------------ the phase steps
+    def check(self, s: AircraftState, raw: list[float]) -> str | None:
+        """Why the takeoff must end now (module docstring), with 'takeoff: ' first."""
+        self._locate(s, raw[RAW["wow"]])
+        why = self._failure(s, raw[RAW["wow"]])
+        return f"takeoff: {why}" if why else None
+
+    def wind(self, s: AircraftState) -> None:
+        """The wind comes in once the aircraft rolls faster than twice its speed."""
+        w = self.parts.wind
+        if w.active and s.gs_mps > 2.0 * w.max_speed_mps:
+            w.start(s.t_s)
+        w.step(s.t_s, s.alt_m)
+
+    def guided(self, s: AircraftState) -> bool:
+        """LNAV: the guidance steers from :data:`LNAV_HEIGHT_M` above the runway and one roll-in
+        anticipation before its end (engaged here, with the lateral trims of the moment)."""
+        if not self.guided_flight or self.stage != "climb":
+            return False
+        if self.n_guided:
+            return True
+        if self.h_m < LNAV_HEIGHT_M or self.along_m < self.runway.length_m - self.lnav_lead_m:
+            return False
+        self._mark("lnav", s)
+        self.parts.lateral.last_bank_rad = self.bank_cmd_rad
+        # steady and wings level on the centreline: the aileron and rudder of the moment are
+        # the lateral trims (the bank loop has no integral for a propeller's torque)
+        fdm = self.ac.fdm
+        fdm["fms/trim/aileron"] = fdm["fcs/aileron-cmd-norm"]
+        fdm["fms/trim/rudder"] = fdm["fcs/rudder-cmd-norm"]
+        return True
+
+    def after_guidance(self, s: AircraftState, gout):
+        """The DER mark, then the handover (module docstring) — the airborne phase flies the
+        rest of this step — or the takeoff goes on."""
+        if gout is not None:
+            self.n_guided += 1
+            if gout.tas_mps is not None and s.tas_mps > 1.0:    # the planned speed, as a CAS
+                self.v_plan_cas_mps = gout.tas_mps * s.cas_mps / s.tas_mps
+        length, h_m = self.runway.length_m, self.h_m
+        if self.stage == "climb" and "der" not in self.times_s and self.along_m >= length:
+            self._mark("der", s)
+        done = gout is not None and gout.done
+        if not (done or (self.stage == "climb" and h_m >= HANDOVER_HEIGHT_M
+                         and self.along_m >= length
+                         and (s.cas_mps >= self.v_plan_cas_mps - HANDOVER_SPEED_MARGIN_MPS
+                              or h_m >= HANDOVER_MAX_HEIGHT_M))):
+            return self
+        self._mark("handover", s)
+        self.parts.wind.finish(s.alt_m)          # all of the wind from here (the ramp's end)
+        handover(self.ac)
+        if self.config is not None:
+            self.config.gear_down = not self.gear_up
+        return self.airborne(self.config)
+
+    def command(self, s: AircraftState, nav: NavSolution, air: AirData, gout) -> tuple:
+        """LNAV's bank command (through the flight's roll-rate limit) when the guidance steers;
+        the log values (:data:`~fms_testbed.core.timeseries.LOG_FIELDS`: bank rad, the runway
+        heading until LNAV rad, -, -, throttle, -, -, the navigation solution)."""
+        if gout is not None:
+            self.bank_cmd_rad = self.parts.lateral(self.parts.targets, nav, True)
+        nan = math.nan
+        return (self.bank_cmd_rad, self.bearing_rad if gout is None else nan, nan, nan,
+                self.throttle, nan, nan, nav.lat_rad, nav.lon_rad, nav.alt_m, nav.heading_rad,
+                nav.roll_rad, nav.pitch_rad)
+
+    def advance(self) -> str:
+        """The takeoff control over the JSBSim frames to the next outer step, every
+        :data:`CONTROL_FRAMES` frames; '' or why the flight must end."""
+        ac, s, wow = self.ac, self._s, self._wow
+        for j in range(self.n_sub):
+            if j:
+                raw = ac.read_raw()
+                s = ac.state(raw)
+                wow = self._locate(s, raw[RAW["wow"]])
+            self._control(s, wow)
+            if not self.parts.sampling.run(self.frames):
+                return "takeoff: JSBSim stopped"
+        return ""
+
+    # ------------------------------------------------------------------ the takeoff control
+    def _locate(self, s: AircraftState, wow: float) -> bool:
+        """The aircraft on the runway now (``t_s`` after brake release, ``along_m`` /
+        ``cross_m`` on the centreline, ``h_m`` above the runway); True on the wheels."""
+        self._s, self._wow = s, wow > 0.5
+        rw = self.runway
+        self.t_run_s = s.t_s - self.t0
+        self.along_m, self.cross_m = rw.along_cross_m(math.degrees(s.lat_rad),
+                                                     math.degrees(s.lon_rad))
+        self.h_m = s.alt_m - rw.elev_m
+        return self._wow
+
+    def _control(self, s: AircraftState, wow: bool) -> None:
+        """One takeoff-control update (module docstring, steps 1-3)."""
+        ac, to, h_m, cross = self.ac, self.to, self.h_m, self.cross_m
+        if self.stage == "roll" and s.cas_mps >= self.vr_cas_mps:
+            self.stage = "rotate"
+            self._mark("rotate", s)
+        if self.stage == "rotate" and not wow and h_m > 0.0:
+            self.stage = "climb"
+            self._mark("liftoff", s)
+            fdm = ac.fdm
+            fdm["fcs/steer-cmd-norm"] = 0.0
+            fdm["fms/trim/rudder"] = 0.0       # the yaw loop takes the rudder
+            fdm["fms/trim/aileron"] = 0.0
+            ac.engage(bank=True, yaw=True, ny=False, nx=False)
+        if "v2" not in self.times_s and s.cas_mps >= self.v2_cas_mps:
+            self._mark("v2", s)
+        if self.stage == "climb" and not self.gear_up and s.vs_mps > POSITIVE_RATE_MPS \
+                and h_m > GEAR_UP_HEIGHT_M:
+            self.gear_up = True
+            ac.configure(gear_down=False)
+            self._mark("gear_up", s)
+        self.throttle = self.throttle_idle + (to.thrust_norm - self.throttle_idle) * min(1.0, self.t_run_s / SPOOL_S)
+        if self.stage != "climb":
+            self.max_dev_ground_m = max(self.max_dev_ground_m, abs(cross))
+            steer, rudder = self.pilot.ground(self.dt_c, wrap_pi(s.heading_rad - self.bearing_rad),
+                                              cross, s.gs_mps, s.r_rps)
+            set_controls(ac, steer=steer, rudder=rudder, throttle=self.throttle)
+        else:
+            self._climb_out(s, cross, h_m)
+        if self.stage != "roll":
+            set_controls(ac, elevator=self.pilot.pitch(
+                self.dt_c, s.pitch_rad, s.q_rps, ac.fdm["fms/sched/qbar-ratio"],
+                s.cas_mps - self.v_climb_cas_mps if self.stage == "climb" else None, s.alpha_rad))
+
+    def _climb_out(self, s: AircraftState, cross: float, h_m: float) -> None:
+        """After lift-off: wings level on the extended centreline until LNAV, the acceleration
+        from the acceleration height, flaps up on schedule."""
+        if not self.n_guided:   # on the extended centreline until LNAV
+            self.max_dev_air_m = max(self.max_dev_air_m, abs(cross))
+            self.bank_cmd_rad = self.pilot.bank(wrap_pi(s.track_rad - self.bearing_rad), cross)
+        self.ac.command(bank_rad=self.bank_cmd_rad, throttle=self.throttle)
+        if h_m >= self.h_accel and "accelerate" not in self.times_s:
+            self._mark("accelerate", s)
+        if "accelerate" in self.times_s:
+            self.v_climb_cas_mps = max(self.v2_cas_mps + self.to.climb_add_cas_mps, self.v_plan_cas_mps)
+            if self.config is not None:
+                self.config.gear_down = not self.gear_up
+                self.config(s, self.parts.targets, False)     # flaps up on schedule
+
+    def _failure(self, s: AircraftState, wow: float) -> str | None:
+        t, along, cross = self.t_run_s, self.along_m, self.cross_m
+        if self.stage == "climb":
+            return self.check_air(s, wow)
         if not math.isfinite(s.alt_m + s.tas_mps + s.pitch_rad + s.alpha_rad):
             return "non-finite state (JSBSim diverged)"
-        if s.alpha_rad > check.stall_rad:
+        if s.alpha_rad > self.check_air.stall_rad:
             return f"stall: alpha {math.degrees(s.alpha_rad):.1f} deg at t={t:.1f} s"
         if abs(cross) > EXCURSION_M:
             return f"runway excursion: {cross:+.0f} m off the centreline at t={t:.1f} s"
@@ -411,58 +484,42 @@ class TakeoffStart:
             return f"no handover within {TIMEOUT_S:.0f} s"
         return None
 
-    def _mark(self, name, s, along, cross, t) -> None:
-        self.t_s[name] = round(t, 2)
-        self.at[name] = {"along_m": round(along, 1), "cross_m": round(cross, 2),
-                         "cas_mps": round(s.cas_mps, 2), "height_m": round(s.alt_m -
-                                                                           self.runway.elev_m, 1),
-                         "pitch_deg": round(math.degrees(s.pitch_rad), 2)}
+    def _mark(self, name: str, s: AircraftState) -> None:
+        self.times_s[name] = round(self.t_run_s, 2)
+        self.marks[name] = TakeoffMark(round(self.along_m, 1), round(self.cross_m, 2),
+                                    round(s.cas_mps, 2), round(s.alt_m - self.runway.elev_m, 1),
+                                    round(math.degrees(s.pitch_rad), 2))
 
-    def _config_step(self, flight, ac, gear_up: bool) -> ConfigStep:
+    def _config_step(self) -> ConfigStep:
         """Flaps retracted on the go-around schedule of the approach settings, from the
         takeoff detent (the approach detent nearest ``takeoff.flaps_norm``)."""
         ap = self.cfg.approach
         k = min(range(len(ap.flaps)),
-                key=lambda j: abs(ap.flaps[j].cmd_norm - self.cfg.takeoff.flaps_norm))
-        cs = ConfigStep(ap, ac, k, not gear_up, getattr(flight.guidance, "events", None))
+                key=lambda j: abs(ap.flaps[j].cmd_norm - self.to.flaps_norm))
+        cs = ConfigStep(ap, self.ac, k, not self.gear_up, self.parts.events)
         cs.go_around = True      # retract mode: each detent up above its speed + margin
         return cs
 
-    def summary(self) -> dict:
-        """The takeoff as flown: times after brake release (s), ground roll (threshold to
-        liftoff, m), speeds (CAS, m/s), largest centreline deviations (m), the handover."""
-        out = {"start": "takeoff", "runway": self.runway.ident,
-               "vr_cas_mps": round(self.vr_cas_mps, 2), "v2_cas_mps": round(self.v2_cas_mps, 2),
-               "times_s": dict(self.t_s), "events": dict(self.at),
-               "max_centreline_dev_ground_m": round(self.max_dev_ground_m, 2),
-               "max_centreline_dev_air_m": round(self.max_dev_air_m, 2)}
-        if "liftoff" in self.at:
-            out["ground_roll_m"] = self.at["liftoff"]["along_m"]
-        if "v2" in self.t_s:
-            out["time_to_v2_s"] = self.t_s["v2"]
-        if "der" in self.at:
-            out["der_height_m"] = self.at["der"]["height_m"]
-        if "handover" in self.t_s:
-            out["handover_s"] = self.t_s["handover"]
-            out["handover_along_m"] = self.at["handover"]["along_m"]
-        return out
+    def record(self) -> TakeoffRecord:
+        """The takeoff as flown (:class:`TakeoffRecord`)."""
+        at, ts = self.marks, self.times_s
+        return TakeoffRecord(
+            "takeoff", self.runway.ident, round(self.vr_cas_mps, 2), round(self.v2_cas_mps, 2), dict(ts),
+            dict(at), round(self.max_dev_ground_m, 2), round(self.max_dev_air_m, 2),
+            ground_roll_m=at["liftoff"].along_m if "liftoff" in at else None,
+            time_to_v2_s=ts.get("v2"),
+            der_height_m=at["der"].height_m if "der" in at else None,
+            handover_s=ts.get("handover"),
+            handover_along_m=at["handover"].along_m if "handover" in at else None)
 
 
-def _log_row(flight, raw, nav, gout, bank_cmd: float, brg_rad: float, thr: float) -> None:
-    """One timeseries row of the takeoff, in the flight loop's layout: no vertical commands;
-    the heading target is the runway's until LNAV; the guidance's log record once it steers."""
-    flight.raw_log.extend(raw)
-    hdg = brg_rad if gout is None else math.nan
-    flight.rows.append((bank_cmd, hdg, math.nan, math.nan, thr, math.nan, math.nan,
-                        nav.lat_rad, nav.lon_rad, nav.alt_m, nav.heading_rad, nav.roll_rad,
-                        nav.pitch_rad))
-    flight.extra_rows.append({**nav.errors, **gout.log} if gout is not None
-                             else dict(nav.errors))
+def start_on_runway(ac, runway: DepartureRunway, cfg: AircraftConfig) -> None:
+    """Put ``ac`` at rest on the threshold of ``runway`` with the takeoff flaps of aircraft
+    ``cfg`` (:func:`~fms_testbed.sim.takeoff.ground_start`)."""
+    ground_start(ac, runway.lat_deg, runway.lon_deg, runway.elev_m, runway.bearing_deg,
+                 cfg.takeoff.flaps_norm)
 
 
-def _wrap(a: float) -> float:
-    return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-__all__ = ["DepartureRunway", "HANDOVER_HEIGHT_M", "TakeoffControl", "TakeoffStart",
-           "check_takeoff", "departure_runway"]
+__all__ = ["DepartureRunway", "HANDOVER_HEIGHT_M", "TakeoffControl", "TakeoffMark",
+           "TakeoffPhase", "TakeoffRecord", "check_takeoff", "departure_runway",
+           "start_on_runway"]

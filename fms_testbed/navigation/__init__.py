@@ -2,9 +2,12 @@
 
 A source turns the true state (and, on the truth side, its sensors' errors) into a
 :class:`~fms_testbed.core.state.NavSolution`. Sources are registered by name in :data:`SOURCES`;
-a scenario picks one with ``navigation: {source: NAME, ...}``. A new source is a class with
-``from_spec(spec, seed)`` and ``update(truth) -> NavSolution``, added to :data:`SOURCES` — nothing
-else changes.
+a scenario picks one with ``navigation: {source: NAME, ...}``. A new source is a subclass of
+:class:`~fms_testbed.core.contracts.NavigationSourceBase` with ``from_spec(spec, seed)`` and
+``update(truth, frames=None) -> NavSolution`` (and, where it has them, ``frame_properties``,
+``events``, ``check_fault`` and ``inject``: the
+:class:`~fms_testbed.core.contracts.NavigationSource` protocol), added to :data:`SOURCES` —
+nothing else changes.
 """
 
 from __future__ import annotations

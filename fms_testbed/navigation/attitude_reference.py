@@ -55,6 +55,7 @@ from pydantic import ValidationError
 
 from fms_testbed.config.navigation import AttitudeReferenceBlock
 from fms_testbed.config.yamlfile import validation_message
+from fms_testbed.core.contracts import NavigationSourceBase
 from fms_testbed.core.earth import radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
@@ -182,7 +183,7 @@ def reference_spec(block) -> AttitudeReferenceSpec:
         rps(block.drift_dph))
 
 
-class AttitudeReferenceNavigation:
+class AttitudeReferenceNavigation(NavigationSourceBase):
     """Navigation source of the flight-test mode; see the module docstring for the keys.
 
     Parameters

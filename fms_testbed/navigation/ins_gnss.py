@@ -42,6 +42,7 @@ from pydantic import ValidationError
 
 from fms_testbed.config.navigation import InsGnssBlock
 from fms_testbed.config.yamlfile import validation_message
+from fms_testbed.core.contracts import NavigationSourceBase
 from fms_testbed.core.earth import radii_and_derivatives, radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
@@ -161,7 +162,7 @@ def _mean_solution(C: np.ndarray, units: list[int]) -> tuple:
     return c[0], c[1], c[2], c[3:6], c[6], c[7], c[8]
 
 
-class InsGnssNavigation:
+class InsGnssNavigation(NavigationSourceBase):
     """INS/GNSS navigation source; see the module docstring for the scenario keys.
 
     Parameters

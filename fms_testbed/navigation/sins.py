@@ -33,6 +33,7 @@ from numba import njit
 
 import fms_testbed.core.earth as _earth
 import fms_testbed.sensors.sins as _sins_pkg
+from fms_testbed.core.contracts import NavigationSourceBase
 from fms_testbed.core._numba_cache import invalidate_if_sources_changed
 
 # this module's kernel inlines the SINS package's kernels and the Earth model's: clear its cache
@@ -138,7 +139,7 @@ def output_solution(t_s: float, o: np.ndarray, errors: dict | None = None) -> Na
                        {} if errors is None else errors)
 
 
-class SinsNavigation:
+class SinsNavigation(NavigationSourceBase):
     """Navigation source with SINS errors; see the module docstring for the scenario keys."""
 
     #: per-frame JSBSim samples the truth side needs (none: it reads the outer-step state)

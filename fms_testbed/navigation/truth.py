@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+from fms_testbed.core.contracts import NavigationSourceBase
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 
 _NO_ERRORS: dict[str, float] = {}  # shared; nobody writes into a solution's errors
 
 
-class TruthNavigation:
+class TruthNavigation(NavigationSourceBase):
     """Navigation solution equal to truth (no navigation-system error)."""
 
     #: per-frame JSBSim samples the truth side needs (none: it reads the outer-step state)

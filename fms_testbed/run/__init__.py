@@ -8,7 +8,7 @@ the CLI makes before any work) loads without the flight machinery.
 from __future__ import annotations
 
 _NAMES = {"fly_procedure": "api", "load": "api", "results_of": "api", "run_scenario": "api",
-          "Results": "results", "Summary": "results"}
+          "Results": "results", "Summary": "summary"}
 
 
 def __getattr__(name: str):

@@ -7,13 +7,13 @@ it, so a scenario flies the same from Python and from the command line.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.config.scenario import Scenario, parse_scenario
 from fms_testbed.config.yamlfile import read_mapping
-from fms_testbed.core.contracts import Guidance
+from fms_testbed.core.contracts import Guidance, record_dict
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.planning import PROC_TYPE_NAMES
 from fms_testbed.core.units import NM_M
 from fms_testbed.evaluation.flight_errors import error_columns, flight_errors
 from fms_testbed.evaluation.outcome import DEFAULT_ENROUTE_RNP_NM, decide
@@ -21,9 +21,8 @@ from fms_testbed.loop.flight import Flight
 from fms_testbed.loop.procedure import PreparedProcedure, prepare_procedure
 from fms_testbed.navigation.attitude_reference import attitude_reference_summary
 from fms_testbed.navigation.monitor import monitor_flight
-from fms_testbed.run.results import Results, Summary
-
-_PROC_TYPE = {"D": "SID", "E": "STAR", "F": "APPROACH"}
+from fms_testbed.run.results import Results
+from fms_testbed.run.summary import ProcedureInfo, assemble
 
 
 def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedProcedure | None]:
@@ -90,51 +89,51 @@ def _relative_to(raw: dict, source: str) -> None:
         raw["navigation"] = {**nav, "imu": fix(nav["imu"])}
 
 
-def _procedure_summary(scn: Scenario, proc: PreparedProcedure) -> dict[str, Any]:
+def _procedure_info(scn: Scenario, proc: PreparedProcedure) -> ProcedureInfo:
     p = proc.path.path
-    return {
-        "name": p.name, "airport": p.airport, "type": _PROC_TYPE.get(p.proc_type),
-        "procedure": p.proc_id, "transition": p.transition, "start": p.start_kind,
-        "legs": p.leg_types(), "length_nm": round(p.length_m() / NM_M, 2),
-        "monitor_status": p.status, "navigation": scn.navigation_spec["source"],
-        "findings": [f"leg {f.leg_index + 1}: {f.category}: {f.message}" for f in p.findings],
-        "degraded": list(getattr(proc.path, "degraded", ())),
-    }
+    return ProcedureInfo(
+        p.name, p.airport, PROC_TYPE_NAMES.get(p.proc_type), p.proc_id, p.transition,
+        p.start_kind, p.leg_types(), round(p.length_m() / NM_M, 2), p.status,
+        scn.navigation_spec["source"],
+        [f"leg {f.leg_index + 1}: {f.category}: {f.message}" for f in p.findings],
+        list(proc.path.degraded))
 
 
 def results_of(flight: Flight) -> Results:
     """The :class:`Results` of a (finished or stopped) :class:`Flight`: its timeseries and summary,
     and for a procedure flight the errors, RNP containment, constraints and sequencing."""
-    df, summary = flight.result()
-    summary = Summary(summary)
+    df, record = flight.result()
     proc, g = flight.procedure, flight.guidance
+    blocks: dict = {}
     rebuilt: list = []
+    rnp_nm = None
     if proc is not None:
-        summary["procedure"] = _procedure_summary(flight.scn, proc)
-        summary.update(flight_errors(df, proc.path, g))
+        blocks["procedure"] = _procedure_info(flight.scn, proc)
+        pe = flight_errors(df, proc.path, g.seq.legs_sequenced, g.done and not g.abort_reason,
+                           g.vnav.floor_m)
+        blocks.update(errors=pe.errors, rnp=pe.rnp, constraints=pe.constraints,
+                      constraints_met=pe.constraints_met, sequencing=pe.sequencing)
         if proc.path.path.proc_type == "F":            # approaches: the threshold crossing
             from fms_testbed.evaluation.threshold import threshold_crossing
-            summary["threshold"] = threshold_crossing(
-                df, proc.path.path, proc.runway, getattr(g.speed, "vapp_cas_mps", None),
-                flight.cfg.approach)
-        summary["guidance_events"] = g.events
+            blocks["threshold"] = threshold_crossing(df, proc.path.path, proc.runway,
+                                                     g.vnav.speed.vapp_cas_mps,
+                                                     flight.cfg.approach)
+        blocks["guidance_events"] = g.events
         if "xtk_m" in df:
             df = error_columns(df)
-        rebuilt = list(g.rebuilt)
-        rnp_nm = None
+        rebuilt = list(g.replan.rebuilt)
     else:
         scn = flight.scn
         rnp_nm = scn.rnp_nm if scn.rnp_nm is not None else (
             DEFAULT_ENROUTE_RNP_NM if scn.navigation_spec["source"] != "truth" else None)
-    df, nav_block = monitor_flight(df, flight.navigation, None if rnp_nm is None else rnp_nm * NM_M)
-    if nav_block is not None:
-        summary["navigation"] = nav_block
-    att_block = attitude_reference_summary(df)      # flight-test attitude-reference mode
-    if att_block is not None:
-        summary["attitude_reference"] = att_block
-    decide(summary, df, flight.cfg, rnp_nm)
-    return Results(df=df, summary=summary, scenario=flight.scn, procedure=proc,
-                   flown_paths=rebuilt)
+    df, blocks["navigation"] = monitor_flight(df, flight.navigation,
+                                              None if rnp_nm is None else rnp_nm * NM_M)
+    blocks["attitude_reference"] = attitude_reference_summary(df)   # flight-test mode
+    so_far = {**record_dict(record), **record_dict({k: v for k, v in blocks.items()
+                                                     if v is not None})}
+    decision = decide(so_far, df, flight.cfg, rnp_nm)
+    return Results(df=df, summary=assemble(record, decision, **blocks), scenario=flight.scn,
+                   procedure=proc, flown_paths=rebuilt)
 
 
 def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None = None,
@@ -173,14 +172,17 @@ def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None =
     return res
 
 
-
-
-
 def fly_procedure(scn: Scenario, spec, fp, db, out_dir: str | Path | None = None,
                   seed: int | None = None, plots: bool = True, csv: bool = False,
                   progress: bool | None = None) -> Results:
-    """Fly an already built procedure (:func:`fms_testbed.loop.procedure.prepare`'s results);
-    the same as :func:`run_scenario` on its scenario, without building it again."""
+    """Fly an already built procedure; the same as :func:`run_scenario` on its scenario,
+    without building it again.
+
+    Parameters
+    ----------
+    scn, spec, fp, db : :func:`fms_testbed.loop.procedure.prepare`'s results
+    out_dir, seed, plots, csv, progress : :func:`run_scenario`'s
+    """
     flight = Flight(scn, seed=seed, progress=progress, procedure=PreparedProcedure(spec, fp, db))
     flight.run()
     res = results_of(flight)

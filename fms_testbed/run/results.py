@@ -16,55 +16,15 @@ import pandas as pd
 
 from fms_testbed.config.scenario import Scenario
 from fms_testbed.core.errors import UserError
-from fms_testbed.core.jsonio import dumps
 from fms_testbed.loop.procedure import PreparedProcedure
 from fms_testbed.run.outputs import OutputFolder, file_sha256
+from fms_testbed.run.summary import Summary
 from fms_testbed.viz.attitude_reference import plot_attitude_reference_run
 from fms_testbed.viz.figure import save as save_figure
 from fms_testbed.viz.geojson import write_track_geojson
 from fms_testbed.viz.kml import write_track_kml
 from fms_testbed.viz.procedure import plot_procedure
 from fms_testbed.viz.run import plot_run
-
-
-class Summary(dict):
-    """The summary of a flight: a mapping (as written to ``summary.json``) with typed accessors.
-
-    Keys of every flight: ``scenario``, ``aircraft``, ``jsbsim_model``, ``status``, ``reason``,
-    ``seed``, ``duration_s`` (simulated, s), ``wall_time_s``, ``real_time_factor``,
-    ``loop_wall_time_s``, ``loop_steps_per_s``, ``trim`` and ``metrics``. A procedure flight
-    adds ``procedure``, ``errors`` (FTE/NSE/PDE/TSE, m), ``rnp``, ``constraints``,
-    ``sequencing`` and ``guidance_events``.
-    """
-
-    @property
-    def status(self) -> str:
-        """Outcome of the flight (``ok``, ``diverged``, ``incomplete``)."""
-        return self["status"]
-
-    @property
-    def reason(self) -> str:
-        """Why the flight ended as it did."""
-        return self["reason"]
-
-    @property
-    def ok(self) -> bool:
-        """True only for status ``ok``."""
-        return self["status"] == "ok"
-
-    @property
-    def seed(self) -> int:
-        """The seed actually used for every stochastic part of the flight."""
-        return self["seed"]
-
-    @property
-    def duration_s(self) -> float:
-        """Simulated time flown, s."""
-        return self["duration_s"]
-
-    def to_json(self) -> str:
-        """Strict JSON (non-finite numbers as null), indented."""
-        return dumps(dict(self))
 
 
 @dataclass
@@ -107,10 +67,9 @@ class Results:
 
     def inputs(self) -> dict[str, dict]:
         """The files this flight was built from, with their SHA-256 (for ``run.json``)."""
-        files = {"scenario": self.scenario.source_file,
-                 "aircraft": self.summary.get("aircraft_file")}
-        if self.procedure is not None:
-            files["procedure_db"] = getattr(self.procedure.db, "path", None)
+        files = {"scenario": self.scenario.source_file, "aircraft": self.summary.aircraft_file}
+        if self.procedure is not None and self.procedure.db is not None:
+            files["procedure_db"] = self.procedure.db.path
         return {k: {"path": str(v), "sha256": file_sha256(v)} for k, v in files.items()
                 if v and not str(v).startswith("<")}
 
@@ -135,17 +94,17 @@ class Results:
                 self.df.to_parquet(tmp / "timeseries.parquet", index=False)
                 if csv:
                     self.df.to_csv(tmp / "timeseries.csv", index=False, float_format="%.7g")
+                names = tracks = None
                 if plots:
-                    names = []
-                    for stem, fig in self.plot().items():
-                        names.append(save_figure(fig, tmp / f"{stem}.png").name)
-                    self.summary["plots"] = names
+                    names = [save_figure(fig, tmp / f"{stem}.png").name
+                             for stem, fig in self.plot().items()]
                 if not self.df.empty:   # tracks for Google Earth / QGIS (viz.geojson, viz.kml)
                     path = self.procedure.path.path if self.procedure is not None else None
-                    self.summary["tracks"] = [
+                    tracks = [
                         w(tmp / name, self.df, self.summary, path, tuple(self.flown_paths)).name
                         for w, name in ((write_track_geojson, "track.geojson"),
                                         (write_track_kml, "track.kml"))]
+                self.summary = self.summary.with_outputs(names, tracks)
                 (tmp / "summary.json").write_text(self.summary.to_json())
                 folder.set_run_info(**({"command": command} if command is not None else {}),
                                     scenario=self.summary.get("scenario"),

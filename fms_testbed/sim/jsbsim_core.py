@@ -101,12 +101,6 @@ def cleanup() -> None:
             _sandbox = None
 
 
-def count_engines(model: str) -> int:
-    """Number of ``<engine>`` elements in the wheel's model ``model``."""
-    root = ET.parse(Path(jsbsim.get_default_root_dir()) / "aircraft" / model / f"{model}.xml").getroot()
-    return len(root.findall("./propulsion/engine"))
-
-
 def has_piston_engines(model: str) -> bool:
     """Whether the wheel's model ``model`` is powered by JSBSim piston engines.
 

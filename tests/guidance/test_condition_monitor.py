@@ -1,19 +1,19 @@
-"""Measured vs planned conditions (guidance/replan): the air-velocity vector, the filtered wind
-and temperature, the rebuild reason and the build settings for the measured conditions."""
+"""Measured vs planned conditions (guidance/conditions): the air-velocity vector, the filtered
+wind and temperature from the air data and the navigation solution, the rebuild reason and the
+build settings for the measured conditions."""
 
 from __future__ import annotations
 
 import math
-from types import SimpleNamespace
-
 import numpy as np
 import pytest
 
 from fms_testbed.core.atmosphere import GAMMA, R_JPKGK, isa
 from fms_testbed.core.units import KT_MPS
 from fms_testbed.core.wind import WindProfile
-from fms_testbed.guidance.replan import (ConditionMonitor, ConditionThresholds,
-                                         air_velocity_ned_mps, measured_params)
+from fms_testbed.core.state import AirData, NavSolution
+from fms_testbed.guidance.conditions import (ConditionMonitor, ConditionThresholds,
+                                             air_velocity_ned_mps, measured_params)
 from fms_testbed.legs.model import BuildParams
 
 
@@ -33,10 +33,10 @@ def _sample(t_s, wind_ne, dev, alt_m=3000.0, tas=130.0, hdg=math.radians(60.0)):
     t = float(isa(alt_m, dev)[0])
     mach = tas / math.sqrt(GAMMA * R_JPKGK * t)
     an, ae = tas * math.cos(hdg), tas * math.sin(hdg)
-    nav = SimpleNamespace(t_s=t_s, alt_m=alt_m, roll_rad=0.0, pitch_rad=0.0, heading_rad=hdg,
-                          v_enu_mps=np.array([ae + wind_ne[1], an + wind_ne[0], 0.0]))
-    truth = SimpleNamespace(tas_mps=tas, mach=mach, alpha_rad=0.0, beta_rad=0.0)
-    return nav, truth
+    nav = NavSolution(t_s, 0.8, 0.1, alt_m, np.array([ae + wind_ne[1], an + wind_ne[0], 0.0]),
+                      0.0, 0.0, hdg)
+    air = AirData(t_s, tas, tas, mach, alt_m, alt_m, 0.0, 70000.0, t, 0.0, 0.0)
+    return nav, air
 
 
 def test_monitor_triggers_on_wind_and_on_temperature_after_the_holdoff():
@@ -60,10 +60,12 @@ def test_monitor_triggers_on_wind_and_on_temperature_after_the_holdoff():
     assert m.update(0.1 * k + 1.0, *_sample(0.1 * k + 1, w2, 8.0), planned) == ""   # held off
 
 
-def test_no_air_data_no_measurement():
+def test_no_valid_air_data_no_measurement():
     m = ConditionMonitor()
-    nav, _ = _sample(100.0, (0.0, 0.0), 0.0)
-    assert m.update(100.0, nav, SimpleNamespace(), BuildParams()) == ""
+    nav, air = _sample(100.0, (0.0, 0.0), 0.0)
+    air.valid = False
+    assert m.update(100.0, nav, air, BuildParams()) == ""
+    assert m.measured == ((None, None), None)
 
 
 def test_measured_params_shift_the_planned_profile():
@@ -88,10 +90,10 @@ def test_a_heading_error_the_navigation_declares_is_not_taken_for_a_wind_change(
     def run(sigma_rad, true_wind=(0.0, 0.0)):
         m = ConditionMonitor(ConditionThresholds())
         for k in range(1500):
-            nav, truth = _sample(0.1 * k, true_wind, 0.0)
+            nav, air = _sample(0.1 * k, true_wind, 0.0)
             nav.heading_rad += math.radians(2.6)        # the navigation's heading error
             nav.heading_sigma_rad = sigma_rad
-            why = m.update(0.1 * k, nav, truth, planned)
+            why = m.update(0.1 * k, nav, air, planned)
             if why:
                 return why
         return ""

@@ -29,13 +29,15 @@ class Recorder(TruthNavigation):
         return super().update(truth)
 
 
-def test_every_frame_is_sampled_once_and_the_last_at_the_navigation_step():
-    scn = parse_scenario(BASE)
-    fl = Flight(scn, cfg=load_aircraft("737"), progress=False)
+def _fly_on_recorder(monkeypatch, scn, **kw):
     rec = Recorder()
-    fl.navigation = rec
-    fl._steps = fl._loop()       # rebuild the loop on the recorder
+    monkeypatch.setattr("fms_testbed.loop.flight.make_source", lambda spec, seed=None: rec)
+    fl = Flight(scn, cfg=load_aircraft("737"), progress=False, **kw)
     fl.run()
+    return fl, rec
+
+
+def _check_blocks(fl, rec):
     assert rec.calls[0][2] is None                      # the first call: nothing sampled yet
     dt = fl.aircraft.dt_s
     t_all = []
@@ -47,3 +49,25 @@ def test_every_frame_is_sampled_once_and_the_last_at_the_navigation_step():
         assert frames[0, 0] == pytest.approx(t_prev + dt, abs=1e-9)
         t_all.extend(frames[:, 0])
     assert np.allclose(np.diff(t_all), dt)               # no frame missed or repeated
+    return t_all
+
+
+def test_every_frame_is_sampled_once_and_the_last_at_the_navigation_step(monkeypatch):
+    fl, rec = _fly_on_recorder(monkeypatch, parse_scenario(BASE))
+    _check_blocks(fl, rec)
+
+
+def test_the_takeoff_and_the_airborne_phase_sample_one_stream_of_frames(monkeypatch):
+    """A SID flown from the runway: the source sees every frame of the roll, the climb-out
+    and the airborne phase after the handover, each once (the takeoff control runs its frames
+    in chunks, the airborne phase in one block per outer step)."""
+    from fms_testbed.loop.procedure import prepare_procedure
+
+    scn, proc = prepare_procedure({"aircraft": "737", "duration_s": 110, "procedure": {
+        "airport": "KJFK", "procedure": "DEEZZ5", "runway": "31L", "transition": "CANDR",
+        "start": "takeoff"}})
+    fl, rec = _fly_on_recorder(monkeypatch, scn, procedure=proc)
+    handover = fl.takeoff.times_s["handover"]
+    assert fl.phase.name == "airborne" and 0.0 < handover < 100.0
+    t_all = _check_blocks(fl, rec)
+    assert t_all[0] < handover < t_all[-1]

@@ -103,3 +103,22 @@ def test_relative_paths_in_a_scenario_resolve_against_its_folder(tmp_path, monke
     monkeypatch.chdir(tmp_path)                      # not the scenario's folder
     scn, _ = load(str(sub / "s.yaml"))
     assert scn.aircraft == str(sub / "my737.yaml")
+
+
+def test_a_flight_stopped_from_outside_is_a_timeout_with_its_checks():
+    """Flight.stop (a wall-time limit): status timeout, the reason says where, the checks of
+    what was flown are kept (evaluation.outcome.decide is the one place of the status)."""
+    from fms_testbed.evaluation.outcome import EXIT_CODES
+    from fms_testbed.loop.procedure import prepare_procedure
+    from fms_testbed.run import results_of
+
+    scn, proc = prepare_procedure({"aircraft": "737", "procedure": {
+        "airport": "KJFK", "procedure": "DEEZZ5", "runway": "31L", "transition": "CANDR"}})
+    f = Flight(scn, procedure=proc, progress=False)
+    f.step(300)
+    f.stop("--case-timeout 5 s reached")
+    assert not f.step(1)
+    s = results_of(f).summary
+    assert s.status == "timeout" and EXIT_CODES["timeout"] == 1
+    assert s.reason.startswith("--case-timeout 5 s reached after 30 s simulated, on leg ")
+    assert s.outcome.checks.envelope.ok and s.sequencing.legs_entered >= 1

@@ -1,0 +1,77 @@
+"""The shape of the code: no module over :data:`MODULE_MAX_LINES` lines, no class with more than
+:data:`CLASS_MAX_METHODS` methods, no function over :data:`FUNCTION_MAX_LINES` lines — checked
+on the modules listed in :data:`CHECKED` (the lanes reshaped so far; extend the list as the
+others are), and the package-wide count of long functions held at :data:`LONG_FUNCTIONS_MAX`.
+
+A function's length is its lines from the ``def`` to its last line, docstring included; a
+class's methods are the functions defined in its body (properties included)."""
+
+from __future__ import annotations
+
+import ast
+from pathlib import Path
+
+import pytest
+
+PACKAGE = Path(__file__).resolve().parents[1] / "fms_testbed"
+MODULE_MAX_LINES = 600
+CLASS_MAX_METHODS = 15
+FUNCTION_MAX_LINES = 60
+LONG_FUNCTIONS_MAX = 12
+"""Functions over :data:`FUNCTION_MAX_LINES` lines allowed in the whole package (the goal)."""
+
+CHECKED = (
+    "loop/", "guidance/active_path.py", "guidance/conditions.py", "guidance/fms.py",
+    "guidance/geometry.py", "guidance/locate.py", "guidance/replan.py",
+    "guidance/sequencing.py", "guidance/speed_plan.py", "guidance/step_log.py",
+    "guidance/vertical.py", "guidance/vnav.py", "run/", "evaluation/outcome.py",
+    "evaluation/records.py", "evaluation/flight_errors.py", "evaluation/threshold.py",
+    "core/contracts.py", "core/state.py", "navigation/__init__.py",
+)
+"""Modules (or folders, ending in '/') whose shape is enforced, relative to the package."""
+
+
+def _modules(prefixes=("",)) -> list[Path]:
+    return sorted(p for p in PACKAGE.rglob("*.py")
+                  if any(str(p.relative_to(PACKAGE)).startswith(x) for x in prefixes))
+
+
+def shape(path: Path) -> tuple[int, list[tuple[str, int]], list[tuple[str, int]]]:
+    """(module lines, [(class, methods)], [(function, lines)]) of one module."""
+    text = path.read_text()
+    tree = ast.parse(text)
+    classes, functions = [], []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ClassDef):
+            n = sum(isinstance(b, (ast.FunctionDef, ast.AsyncFunctionDef)) for b in node.body)
+            classes.append((node.name, n))
+        elif isinstance(node, (ast.FunctionDef, ast.AsyncFunctionDef)):
+            functions.append((node.name, node.end_lineno - node.lineno + 1))
+    return len(text.splitlines()), classes, functions
+
+
+@pytest.mark.parametrize("path", _modules(CHECKED), ids=lambda p: str(p.relative_to(PACKAGE)))
+def test_checked_module_shape(path):
+    lines, classes, functions = shape(path)
+    assert lines <= MODULE_MAX_LINES, f"{lines} lines"
+    big = [c for c in classes if c[1] > CLASS_MAX_METHODS]
+    assert not big, f"classes with more than {CLASS_MAX_METHODS} methods: {big}"
+    long = [f for f in functions if f[1] > FUNCTION_MAX_LINES]
+    assert not long, f"functions over {FUNCTION_MAX_LINES} lines: {long}"
+
+
+def long_functions() -> list[tuple[str, str, int]]:
+    """Every function of the package over :data:`FUNCTION_MAX_LINES` lines: (module, name, lines)."""
+    out = []
+    for p in _modules():
+        for name, n in shape(p)[2]:
+            if n > FUNCTION_MAX_LINES:
+                out.append((str(p.relative_to(PACKAGE)), name, n))
+    return out
+
+
+@pytest.mark.xfail(reason="the package-wide goal: the lanes not yet reshaped hold the rest",
+                   strict=False)
+def test_package_long_functions_within_the_goal():
+    long = long_functions()
+    assert len(long) <= LONG_FUNCTIONS_MAX, sorted(long, key=lambda f: -f[2])
