@@ -30,6 +30,7 @@ import statistics
 import sys
 import time
 from pathlib import Path
+from unittest.mock import patch
 
 import numpy as np
 
@@ -66,11 +67,11 @@ class TimedProbe(BankProbe):
 
 
 def _flight(sim_s: float, source=None) -> Flight:
-    fl = Flight(parse_scenario(scenario(sim_s)), cfg=load_aircraft("737"), progress=False)
-    if source is not None:
-        fl.navigation = source
-        fl._steps = fl._loop()
-    return fl
+    scn, cfg = parse_scenario(scenario(sim_s)), load_aircraft("737")
+    if source is None:
+        return Flight(scn, cfg=cfg, progress=False)
+    with patch("fms_testbed.loop.flight.make_source", lambda spec, seed=None: source):
+        return Flight(scn, cfg=cfg, progress=False)
 
 
 def speed(sim_s: float) -> dict:

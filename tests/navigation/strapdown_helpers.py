@@ -4,6 +4,7 @@ the per-frame samples (the bank sees only what its IMU would; the flight is not 
 from __future__ import annotations
 
 from functools import lru_cache
+from unittest.mock import patch
 
 import numpy as np
 
@@ -53,10 +54,10 @@ class BankProbe(TruthNavigation):
 
 def fly_with(bank, duration_s: float, keep_frames: bool = False) -> BankProbe:
     """Fly :func:`scenario` on truth with ``bank`` riding along; returns the probe."""
-    fl = Flight(parse_scenario(scenario(duration_s)), cfg=load_aircraft("737"), progress=False)
     probe = BankProbe(bank, keep_frames=keep_frames)
-    fl.navigation = probe
-    fl._steps = fl._loop()
+    with patch("fms_testbed.loop.flight.make_source", lambda spec, seed=None: probe):
+        fl = Flight(parse_scenario(scenario(duration_s)), cfg=load_aircraft("737"),
+                    progress=False)
     fl.run()
     return probe
 
