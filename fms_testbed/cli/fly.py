@@ -23,6 +23,9 @@ from fms_testbed.run.outputs import check_out_dir
 from fms_testbed.core.errors import UserError
 from fms_testbed.data import results_dir
 
+KIND = "fly"
+"""``run.json`` ``kind`` of a ``fly`` output folder."""
+
 
 def scenario_from_args(args) -> dict:
     """The procedure scenario mapping the command-line options describe."""
@@ -49,7 +52,8 @@ def cmd_fly(args) -> int:
         scenario = scenario_from_args(args)
         default = scenario["name"]
     out = Path(args.out) if args.out else results_dir() / default
-    check_out_dir(out, args.overwrite)                          # before any work
+    inputs = [args.scenario or (scenario["procedure"]["db"] if args.db else None)]
+    check_out_dir(out, args.overwrite, KIND, inputs)            # before any work
     from fms_testbed.evaluation.outcome import EXIT_CODES
     from fms_testbed.run.api import run_scenario
 
@@ -57,7 +61,7 @@ def cmd_fly(args) -> int:
     if args.takeoff:
         overrides.setdefault("procedure", {})["start"] = "takeoff"
     res = run_scenario(scenario, seed=args.seed, overrides=overrides, progress=None)
-    res.save(out, csv=args.csv, plots=not args.no_plots, overwrite=args.overwrite)
+    res.save(out, csv=args.csv, plots=not args.no_plots, overwrite=args.overwrite, kind=KIND)
     print_results(res)
     if res.summary.get("takeoff"):
         print(takeoff_line(res.summary["takeoff"]))

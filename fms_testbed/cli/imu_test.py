@@ -39,7 +39,9 @@ def cmd_imu_test(args) -> int:
     if not args.duration_h > 0:
         raise UserError(f"--duration-h must be > 0 h, got {args.duration_h}")
     out = Path(args.out) if args.out else results_dir() / f"imu-test-{Path(args.imu).stem}"
-    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
+    profile = args.temperature_profile
+    inputs = [f for f in (args.imu, profile) if f and Path(f).suffix]
+    folder = OutputFolder(out, getattr(args, "overwrite", False), "imu-test", inputs)  # first
     res = run_static_test(args.imu, args.duration_h * 3600.0, args.temperature_profile, stages,
                           args.seed, allan=args.allan)
     tmp = folder.open()

@@ -57,6 +57,9 @@ def _faults(texts, t_s: float):
             sizes = [float(x) for x in parts[2].split(",")]
         except ValueError:
             raise UserError(f"--fault {t!r}: sizes must be numbers") from None
+        if not all(math.isfinite(s) for s in sizes):
+            raise UserError(f"--fault {t!r}: sizes must be finite numbers (a NaN or infinite "
+                            "bias is not a fault size)")
         for s in sizes:
             try:
                 out.append(McFault(parts[0], s, t_s, 1, parts[1]))
@@ -89,7 +92,8 @@ def cmd_montecarlo(args) -> int:
     faults = _faults(args.fault, args.fault_at_s)
     if args.runs == 0 and not faults:
         raise UserError("nothing to run: --runs 0 and no --fault")
-    folder = OutputFolder(Path(args.out), getattr(args, "overwrite", False))
+    folder = OutputFolder(Path(args.out), getattr(args, "overwrite", False), "montecarlo",
+                          [args.trajectory] if args.trajectory else [])
     dur, fdur = args.duration_min * 60.0, args.fault_duration_min * 60.0
     if args.trajectory:
         states = flown_states(args.trajectory, duration_s=dur)
