@@ -28,7 +28,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from fms_testbed.campaign.rows import SCHEMA
-from fms_testbed.campaign.store import FLIGHTS, RUN_JSON, part_files
+from fms_testbed.campaign.store import RUN_JSON, part_files
 from fms_testbed.core.errors import UserError
 
 PLAN = "plan.parquet"
@@ -241,9 +241,6 @@ def read_checked(out: str | Path, refuse_damage: bool = False):
     """
     out = Path(out)
     info = load_run_json(out)
-    if not (out / FLIGHTS).is_dir() and info.get("status") == "complete":
-        raise UserError(f"{out}: run.json says complete but there is no flights/ folder: the "
-                        "dataset is gone")
     found = audit(out)
     if refuse_damage and found.damaged:
         raise UserError(found.damage_line(out))

@@ -234,7 +234,7 @@ def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
             return f
 
         first = [submit(c) for _, c in zip(range(chunk), it)]
-        ac = as_completed(first)
+        ac = as_completed(first, loop=client.loop)
         for f in ac:
             c = held.pop(f.key)
             row = _dask_row(client, address, f, c)

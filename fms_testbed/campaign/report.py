@@ -298,6 +298,8 @@ def written_status(found, info: dict) -> tuple[str, str]:
     text = f"{n} of {n_plan if n_plan is not None else '?'} planned cases written"
     if missing:
         text += f"; {len(missing)} missing (e.g. {', '.join(missing[:3])})"
+    elif n_plan is not None and n < n_plan:
+        text += f"; {n_plan - n} missing (the folder has no plan.parquet to name them)"
     if found.damaged:
         text += (f"; {len(found.damaged)} damaged part file(s) set aside ("
                  + ", ".join(f"{d.path.name}: {d.reason}" for d in found.damaged[:3])
