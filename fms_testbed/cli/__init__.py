@@ -45,9 +45,16 @@ COMMAND_MODULES = (
 )
 
 
+class _Parser(argparse.ArgumentParser):
+    """A parser whose usage errors are one line on stderr (exit 2), naming ``--help``."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
     """Build the argument parser with every available command group."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="fms-testbed",
         description="Flight-management-system testbed on JSBSim.")
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
