@@ -204,11 +204,12 @@ def _dask_row(client, address: str, f, c) -> dict:
     except Exception as exc:  # noqa: BLE001 -- the cluster could not run it: an 'error' row
         if client.status not in ("running", "connecting"):
             raise _lost(client, address) from None
-        return failed_row(c, "error", f"dask: {type(exc).__name__}: {exc}", type(exc).__name__)
+        text = " ".join(str(exc).split())
+        return failed_row(c, "error", f"dask: {type(exc).__name__}: {text}", type(exc).__name__)
 
 
 def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
-             chunk: int = DASK_CHUNK) -> None:
+             chunk: int = DASK_CHUNK, fly: Callable = fly_case) -> None:
     """Fly ``cases`` on the dask.distributed cluster at ``address`` (module docstring).
 
     Parameters
@@ -218,6 +219,7 @@ def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
     opts : what every case shares (:class:`~fms_testbed.campaign.worker.FlyOptions`)
     on_row : called with each row as it arrives
     chunk : futures held at a time at most
+    fly : the function a worker calls per case (as :func:`run_local`'s)
     """
     from distributed import as_completed
 
@@ -229,7 +231,7 @@ def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
         held: dict = {}
 
         def submit(c):
-            f = client.submit(fly_case, c, opts, key=f"fly-{c.case_id}-{token}", pure=False)
+            f = client.submit(fly, c, opts, key=f"fly-{c.case_id}-{token}", pure=False)
             held[f.key] = c
             return f
 
