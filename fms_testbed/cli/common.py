@@ -262,6 +262,25 @@ def print_results(res) -> None:
                         + s.get("tracks", [])))
 
 
+def out_path(value: str | None, default=None):
+    """The ``--out`` folder of a command: ``value``, or ``default`` when it is not given; an
+    empty or blank value is refused (a one-line :class:`UserError`), never taken as ``.``.
+
+    Parameters
+    ----------
+    value : the ``--out`` text (None: not given); default : the folder used then
+    """
+    from pathlib import Path
+
+    if value is None:
+        if default is None:
+            raise UserError("--out: give the output folder")
+        return Path(default)
+    if not value.strip():
+        raise UserError(f"--out {value!r}: give a folder name")
+    return Path(value)
+
+
 def add_overwrite_option(p) -> None:
     """``--overwrite``: replace an ``--out`` folder that holds other files than a previous run
     (a previous run of the testbed is always replaced as a whole)."""

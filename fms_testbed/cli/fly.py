@@ -17,8 +17,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fms_testbed.cli.common import (add_override_options, add_overwrite_option, overrides_from_args,
-                                    print_results)
+from fms_testbed.cli.common import (add_override_options, add_overwrite_option, out_path,
+                                    overrides_from_args, print_results)
 from fms_testbed.run.outputs import check_out_dir
 from fms_testbed.core.errors import UserError
 from fms_testbed.data import results_dir
@@ -51,7 +51,7 @@ def cmd_fly(args) -> int:
     else:
         scenario = scenario_from_args(args)
         default = scenario["name"]
-    out = Path(args.out) if args.out else results_dir() / default
+    out = out_path(args.out, results_dir() / default)
     inputs = [args.scenario or (scenario["procedure"]["db"] if args.db else None)]
     check_out_dir(out, args.overwrite, KIND, inputs)            # before any work
     from fms_testbed.evaluation.outcome import EXIT_CODES

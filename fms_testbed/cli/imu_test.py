@@ -18,7 +18,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from fms_testbed.cli.common import SEED, add_overwrite_option
+from fms_testbed.cli.common import SEED, add_overwrite_option, out_path
 from fms_testbed.core.errors import UserError
 from fms_testbed.run.outputs import OutputFolder
 from fms_testbed.data import results_dir
@@ -103,7 +103,7 @@ def cmd_imu_test(args) -> int:
     stages = parse_stages(args.stages)
     duration_s = check_duration(args.duration_h, load_mems(args.imu).sample_rate_hz,
                                 available_memory_b())
-    out = Path(args.out) if args.out else results_dir() / f"imu-test-{Path(args.imu).stem}"
+    out = out_path(args.out, results_dir() / f"imu-test-{Path(args.imu).stem}")
     inputs = [f for f in (args.imu, args.temperature_profile) if f and Path(f).suffix]
     folder = OutputFolder(out, getattr(args, "overwrite", False), "imu-test", inputs)  # first
     res = run_static_test(args.imu, duration_s, args.temperature_profile, stages,

@@ -24,7 +24,7 @@ import time
 from pathlib import Path
 
 from fms_testbed.cli.common import (SEED, add_overwrite_option, bounded_float, bounded_int,
-                                    markdown_table)
+                                    markdown_table, out_path)
 from fms_testbed.core.errors import UserError
 from fms_testbed.core.units import NM_M
 
@@ -112,7 +112,7 @@ def _check(args):
                         "fewer or shorter realisations, or more --workers")
     if est > 60.0:
         print(f"montecarlo: estimated {est / 60.0:.0f} min of wall time", file=sys.stderr)
-    folder = OutputFolder(Path(args.out), getattr(args, "overwrite", False), "montecarlo",
+    folder = OutputFolder(out_path(args.out), getattr(args, "overwrite", False), "montecarlo",
                           [args.trajectory] if args.trajectory else [])
     return outages, faults, folder
 

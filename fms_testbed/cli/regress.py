@@ -28,8 +28,8 @@ import os
 import sys
 from pathlib import Path
 
-from fms_testbed.cli.common import (SEED, WIND_HELP, bounded_int, bounded_float, parse_isa_dev,
-                                    parse_wind)
+from fms_testbed.cli.common import (SEED, WIND_HELP, bounded_float, bounded_int, out_path,
+                                    parse_isa_dev, parse_wind)
 
 MAX_CASES = 10_000_000
 """Largest ``--limit``, cases."""
@@ -92,7 +92,7 @@ def config_from_args(args):
                                          or args.sample_min_transitions is not None):
         raise UserError("--sample-seed/--sample-min-transitions need --sample-airports N")
     return RunConfig(
-        out=Path(args.out), conditions=sets, db=args.db, airports=args.airports,
+        out=out_path(args.out), conditions=sets, db=args.db, airports=args.airports,
         sample_airports=args.sample_airports, sample_seed=args.sample_seed or 0,
         sample_min_transitions=args.sample_min_transitions or 1,
         types=parse_types(args.types), aircraft=_split(args.aircraft) or ["737"],
