@@ -235,15 +235,21 @@ def _fuzz(n: int, seed0: int, tmp_path, regress_case, capsys, monkeypatch) -> Co
     counts: Counter = Counter()
     by_cmd: Counter = Counter()
     t0 = time.monotonic()
+    failures = []
     for seed in range(seed0, seed0 + n):
-        outcome, cmd = one_run(seed, tmp_path, regress_case, capsys, monkeypatch)
+        try:
+            outcome, cmd = one_run(seed, tmp_path, regress_case, capsys, monkeypatch)
+        except AssertionError as exc:
+            failures.append(str(exc).splitlines()[0][:400])
+            outcome, cmd = "FAILED", "?"
         counts[outcome] += 1
         by_cmd[cmd] += 1
     counts["wall_s"] = round(time.monotonic() - t0)
     if os.environ.get("FUZZ_REPORT"):
         Path(os.environ["FUZZ_REPORT"]).write_text(json.dumps(
-            {"runs": n, "seeds": [seed0, seed0 + n - 1], **counts, "commands": by_cmd},
-            indent=1))
+            {"runs": n, "seeds": [seed0, seed0 + n - 1], **counts, "commands": by_cmd,
+             "failures": failures}, indent=1))
+    assert not failures, "\n".join(failures)
     return counts
 
 
