@@ -26,7 +26,7 @@ CHECKED = (
     "guidance/sequencing.py", "guidance/speed_plan.py", "guidance/step_log.py",
     "guidance/vertical.py", "guidance/vnav.py", "run/", "evaluation/outcome.py",
     "evaluation/records.py", "evaluation/flight_errors.py", "evaluation/threshold.py",
-    "core/contracts.py", "core/state.py", "navigation/__init__.py", "sensors/sins/",
+    "core/contracts.py", "core/state.py", "navigation/__init__.py", "sensors/sins/", "viz/",
 )
 """Modules (or folders, ending in '/') whose shape is enforced, relative to the package."""
 
