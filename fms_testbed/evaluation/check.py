@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from fms_testbed.core.processes import die_with_parent
 from fms_testbed.core.geodesy import gravity_mps2, inverse
 from fms_testbed.core.segments import Arc
-from fms_testbed.core.units import NM_M
+from fms_testbed.core.units import FT_M, KT_MPS, NM_M
 from fms_testbed.procedures.database import Database, load_database
 from fms_testbed.procedures.legrecord import PATH_TERMINATORS, PROC_TYPES
 from fms_testbed.legs.model import BuildParams, Performance, ProcedurePath
@@ -136,7 +136,7 @@ def check_transition(db: Database, seq, perf: Performance, params: BuildParams):
 ROW_COLUMNS = ("airport", "order", "procedure", "transition", "type", "route_type", "legs",
                "n_legs", "status", "findings", "branches", "flags", "n_segments", "length_nm",
                "max_gap_m", "fix_excess_m", "rf_radius_err_nm", "turn_mismatch", "built_legs",
-               "monitor_status", "defects", "lines")
+               "monitor_status", "defects", "lines", "max_plan_alt_ft", "max_plan_tas_kt")
 """Columns of a check row (:func:`check_airport`), in order."""
 
 
@@ -187,6 +187,8 @@ def check_airport(db: Database, airport: str, perf: Performance,
             "turn_mismatch": -1 if inv is None else inv.turn_mismatch,
             "built_legs": "" if path is None else " ".join(lg.path_term for lg in path.legs),
             "monitor_status": monitor, "defects": ",".join(kinds), "lines": _lines(seq),
+            "max_plan_alt_ft": math.nan if path is None else path.max_plan_alt_m() / FT_M,
+            "max_plan_tas_kt": math.nan if path is None else path.max_plan_tas_mps() / KT_MPS,
         })
     return rows
 

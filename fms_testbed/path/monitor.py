@@ -20,7 +20,7 @@ from fms_testbed.core.segments import Arc, project
 from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
 from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
-from fms_testbed.path.profile import plan_profile, sid_join_required_alt_m
+from fms_testbed.path.profile import path_climb_top_m, plan_profile, sid_join_required_alt_m
 from fms_testbed.path.segmentation import planned_conditions
 
 #: Tolerances: fly-over pass, gaps (the coded-arc radius tolerances are the leg classes'
@@ -186,8 +186,11 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
             out.append(Finding(-1, "impossible", f"aircraft climb gradient "
                                f"{100 * theta_perf:.1f}% below the 3.3% minimum"))
     g_desc = perf.descent_rate_max_mps / perf.tas_plan_mps
+    top = path_climb_top_m(path.proc_type, params.climb_top_m)
     prof = plan_profile(path, theta_perf, start_alt_m, params.descent_angle_deg,
-                        descent_gradient_max=g_desc, descent_rate_mps=perf.descent_rate_max_mps)
+                        climb_top_m=top, descent_gradient_max=g_desc,
+                        descent_rate_mps=perf.descent_rate_max_mps,
+                        alt_max_m=perf.alt_plan_max_m)
     if path.proc_type == "D" and path.start_kind != "runway" and prof.windows:
         # joined at a fix away from the runway: the planned start must make every climb
         # constraint ahead at the aircraft's gradient; a start below that is flagged and the
@@ -200,8 +203,9 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                                f"at {100 * theta_perf:.1f}%: joined at {a0 / FT_M:.0f} ft",
                                "V,Θ"))
             prof = plan_profile(path, theta_perf, a0, params.descent_angle_deg,
-                                descent_gradient_max=g_desc,
-                                descent_rate_mps=perf.descent_rate_max_mps)
+                                climb_top_m=top, descent_gradient_max=g_desc,
+                                descent_rate_mps=perf.descent_rate_max_mps,
+                                alt_max_m=perf.alt_plan_max_m)
     for w in prof.windows:
         k = w.leg_index + 1
         if not prof.climb[k] or w.lo_m is None or prof.alt_m[k] >= w.lo_m - 1.0:
