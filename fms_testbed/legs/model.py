@@ -235,7 +235,7 @@ class Finding:
         upstream); 3 — the coding itself (a path flown twice, a fix missing, a coded radius
         the fixes contradict) — not correctable by the monitor, for the crew to judge."""
         m = self.message
-        if self.category == "loop" or "not in the database" in m or "coded" in m and \
+        if self.category in ("loop", "coding") or "not in the database" in m or "coded" in m and \
                 "fixes give" in m or "arc angle built" in m:
             return 3
         if self.category in ("discontinuity", "no-intercept") or "joined" in m and \
@@ -260,6 +260,13 @@ class BuiltLeg:
     seg_first: int = 0
     seg_count: int = 0
     coded: CodedPath | None = None
+    resolved: object = None
+    """The :class:`~fms_testbed.legs.builder.ResolvedLeg` it was built from (fixes looked up,
+    course turned true, the variation used): the coded-numbers check reads the record's
+    fields against its fixes from it."""
+    from_fix: object = None
+    """The :class:`~fms_testbed.procedures.records.Fix` the leg starts from (the previous
+    leg's fix when that leg ends there), or None."""
 
 
 @dataclass(frozen=True)

@@ -20,6 +20,7 @@ from fms_testbed.core.segments import Arc, project
 from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
 from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
+from fms_testbed.path.coding import hold_checks, record_checks
 from fms_testbed.path.profile import path_climb_top_m, plan_profile, sid_join_required_alt_m
 from fms_testbed.path.segmentation import planned_conditions
 
@@ -343,14 +344,43 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
     return out
 
 
+STATUSES = ("ok", "corrected", "coding_suspect", "impossible")
+"""The monitor's outcomes of a transition, from best to worst (:func:`outcome`)."""
+
+
 def outcome(findings) -> str:
-    """'impossible' if any finding says so, 'corrected' if the plan was changed, else 'ok'."""
+    """The monitor's outcome (:data:`STATUSES`) from its findings.
+
+    'impossible' if a finding says so or the built path is not continuous (a
+    ``discontinuity``: a gap bridged or a track jump, the path is not the coded one);
+    'coding_suspect' if a record's coded numbers disagree with its fixes (category
+    ``coding``, :mod:`.coding`) or the path loops or is flown twice (``loop``, Danilin's
+    Fig. 4): class 3, the database's coding; 'corrected' if the plan was changed to fly it
+    (``correction``, ``no-intercept``); else 'ok'.
+    """
     cats = {f.category for f in findings}
-    if "impossible" in cats:
+    if cats & {"impossible", "discontinuity"}:
         return "impossible"
-    if cats & {"correction", "no-intercept", "discontinuity"}:
+    if cats & {"coding", "loop"}:
+        return "coding_suspect"
+    if cats & {"correction", "no-intercept"}:
         return "corrected"
     return "ok"
+
+
+def coding_findings(path: ProcedurePath, params: BuildParams) -> list[Finding]:
+    """Class-3 findings of the coded numbers (:mod:`.coding`) of the legs built from
+    resolved records, and of the holds' built leg lengths.
+
+    Parameters
+    ----------
+    path : the built transition; params : build settings (the timed-leg speed, m/s)
+    """
+    legs = [lg for lg in path.legs if lg.resolved is not None]
+    if len(legs) != len(path.legs):
+        return []
+    out = record_checks([lg.resolved for lg in legs], [lg.from_fix for lg in legs])
+    return out + hold_checks(path, params.timed_speed_mps)
 
 
 def check_path(path: ProcedurePath, perf: Performance, params: BuildParams | None = None,
@@ -374,4 +404,5 @@ def check_path(path: ProcedurePath, perf: Performance, params: BuildParams | Non
     grad, prof = _gradient_checks(path, perf, params, path.legs[0].start.alt_m)
     findings += grad
     findings += _topology_checks(path)
+    findings += coding_findings(path, params)
     return replace(path, findings=tuple(findings), profile=prof, status=outcome(findings))

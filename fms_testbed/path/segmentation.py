@@ -255,7 +255,8 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
             state = replace(state, alt_m=_descent_target(leg))
         built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps,
-                              coded=leg_cls.coded_path(b, term)))
+                              coded=leg_cls.coded_path(b, term), resolved=leg,
+                              from_fix=prev_fixes[i]))
     segs = round_corners(b, perf, params, bank)
     built = _attach_segments(built, segs)
     status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
