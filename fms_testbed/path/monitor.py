@@ -344,6 +344,46 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
     return out
 
 
+CF_OFF_COURSE_DEG = 20.0
+"""A CF's own straight (role 'leg') more than this off its coded course is not the coded leg,
+deg."""
+CF_AGAINST_COURSE_DEG = 90.0
+"""A CF's own straight more than this off its coded course is flown against it, deg."""
+
+
+def cf_course_checks(path: ProcedurePath) -> list[Finding]:
+    """Every straight a CF leg flies as its own path (role 'leg') against its coded course
+    (from the record, turned true with the leg's variation).
+
+    More than :data:`CF_AGAINST_COURSE_DEG` off (the course flown backwards): the transition
+    is impossible, with the reason. More than :data:`CF_OFF_COURSE_DEG` off (the fix reached
+    direct where the course cannot be joined at the planned radius, the corner flown over
+    and the fix rejoined): a correction of branch V,γ,φ,λ (the position changed, class 1)
+    that says the coded course is not flown. The turns and intercepts onto the course (roles
+    'turn', 'flyby') are transitions and not checked."""
+    out = []
+    for lg in path.legs:
+        if lg.path_term != "CF" or lg.resolved is None or lg.resolved.course_true_deg is None:
+            continue
+        crs = lg.resolved.course_true_deg
+        offs = [max(abs(wrap180(s.geom.start_course_deg - crs)),
+                    abs(wrap180(s.geom.end_course_deg - crs))) for s in path.segments
+                if s.leg_index == lg.index and s.role == "leg" and s.geom.kind == "line"
+                and s.geom.length_m() >= 1.0]
+        off = max(offs, default=0.0)
+        if off <= CF_OFF_COURSE_DEG:
+            continue
+        ident = lg.record.fix.ident if lg.record.fix else ""
+        what = (f"CF {ident} built {off:.0f}° off its coded course {crs:.1f}° "
+                f"(line {lg.record.line})")
+        if off > CF_AGAINST_COURSE_DEG:
+            out.append(Finding(lg.index, "impossible", f"{what}: flown against the course"))
+        else:
+            out.append(Finding(lg.index, "correction", f"{what}: the fix is reached without "
+                               "flying the coded course", "V,γ,φ,λ"))
+    return out
+
+
 STATUSES = ("ok", "corrected", "coding_suspect", "impossible")
 """The monitor's outcomes of a transition, from best to worst (:func:`outcome`)."""
 
@@ -405,4 +445,5 @@ def check_path(path: ProcedurePath, perf: Performance, params: BuildParams | Non
     findings += grad
     findings += _topology_checks(path)
     findings += coding_findings(path, params)
+    findings += cf_course_checks(path)
     return replace(path, findings=tuple(findings), profile=prof, status=outcome(findings))
