@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 from pathlib import Path
-from typing import Annotated
+from typing import Annotated, Literal
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -138,6 +138,24 @@ class CoupledLawGains(_Frozen):
     T_H_s: Pos = Field(description="altitude-channel time constant, s")
     xi_H: Pos = Field(description="altitude-channel damping ratio")
     dH_limit_m: Pos = Field(100.0, description="altitude-error limit (level-change mode), m")
+
+
+class ScheduleTerm(_Frozen):
+    """One scheduled parameter: ``c0 + c1 ln(q̄/q̄_ref) + c2 (m/m_ref - 1)`` clipped to
+    ``[lo, hi]`` (the parameter's unit)."""
+
+    c: tuple[float, float, float] = Field(description="coefficients c0, c1, c2")
+    lo: float = Field(description="lower clip")
+    hi: float = Field(description="upper clip")
+
+
+class CoupledLawSchedule(_Frozen):
+    """Gain schedule of the coupled law in dynamic pressure and mass (``fms-testbed tune
+    --envelope``; :mod:`fms_testbed.control.schedule`)."""
+
+    qbar_ref_pa: Pos = Field(description="reference dynamic pressure, Pa")
+    mass_ref_kg: Pos = Field(description="reference mass, kg")
+    terms: dict[Literal["T_V_s", "xi_V", "T_H_s", "xi_H"], ScheduleTerm]
 
 
 class FlapDetent(_Frozen):
@@ -283,6 +301,9 @@ class AircraftConfig(_Frozen):
     inner_loops: InnerLoopGains
     inner_spec: InnerLoopSpec = Field(default_factory=InnerLoopSpec)
     coupled_law: CoupledLawGains | None = None
+    coupled_law_schedule: CoupledLawSchedule | None = Field(
+        None, description="gains of the coupled law scheduled in dynamic pressure and mass "
+                          "(replace T_V_s, xi_V, T_H_s, xi_H of coupled_law in flight)")
     approach: ApproachSettings | None = Field(
         None, description="approach speeds and configuration (None: flown clean at the "
                           "planned approach speed)")
