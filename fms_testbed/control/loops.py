@@ -125,10 +125,29 @@ def path_block(law: LateralLaw, V0_mps: float) -> ct.StateSpace:
 
 
 def law_block(p: CoupledLawParams, V0_mps: float) -> ct.StateSpace:
-    """The linearised coupled law with its θ input fed by the flight-path angle γ."""
+    """The linearised coupled law with its θ input fed by the flight-path angle γ, and (when
+    ``p.ny_trim_tau_s`` > 0) its n_y tracking-error integrator::
+
+        ṅ_m = (Δn_y,law - n_m) / τ_m,   ṫ = (n_m - Δn_y) / τ_t,   Δn_y,cmd = Δn_y,law + t
+
+    with the thrust channel's cross term on the command including ``t``.
+    """
     s = law_ss(p, V0_mps)
-    return ct.ss(s.A, s.B, s.C, s.D, inputs=["V_cmd", "H_cmd", "V", "gamma", "h", "nx"],
-                 outputs=["nx_cmd", "dny_cmd"], states=["nxa_int"], name="coupled_law")
+    ins = ["V_cmd", "H_cmd", "V", "gamma", "h", "nx", "ny"]
+    B0 = np.hstack([np.asarray(s.B), np.zeros((1, 1))])
+    D0 = np.hstack([np.asarray(s.D), np.zeros((2, 1))])
+    if p.ny_trim_tau_s <= 0:
+        return ct.ss(s.A, B0, s.C, D0, inputs=ins, outputs=["nx_cmd", "dny_cmd"],
+                     states=["nxa_int"], name="coupled_law")
+    tm, tt = max(p.ny_model_tau_s, 1e-3), p.ny_trim_tau_s
+    A = np.zeros((3, 3))
+    A[0, 0], A[0, 2] = float(np.asarray(s.A)[0, 0]), G0_MPS2 / V0_mps
+    A[1, 1], A[2, 1] = -1.0 / tm, 1.0 / tt
+    B = np.vstack([B0, D0[1] / tm, np.zeros(7)])
+    B[2, 6] = -1.0 / tt
+    C = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+    return ct.ss(A, B, C, D0, inputs=ins, outputs=["nx_cmd", "dny_cmd"],
+                 states=["nxa_int", "ny_model", "ny_trim"], name="coupled_law")
 
 
 def delay_block(signal: str, delay_s: float) -> ct.StateSpace:
