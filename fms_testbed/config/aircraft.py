@@ -155,7 +155,7 @@ class CoupledLawSchedule(_Frozen):
 
     qbar_ref_pa: Pos = Field(description="reference dynamic pressure, Pa")
     mass_ref_kg: Pos = Field(description="reference mass, kg")
-    terms: dict[Literal["T_V_s", "xi_V", "T_H_s", "xi_H"], ScheduleTerm]
+    terms: dict[Literal["T_V_s", "xi_V", "T_H_s", "xi_H", "ny_trim_tau_s"], ScheduleTerm]
 
 
 class FlapDetent(_Frozen):

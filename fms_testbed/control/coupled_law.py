@@ -310,7 +310,7 @@ class CoupledLaw:
         self.state = CoupledLawState()
 
     def _follow_schedule(self, state: AircraftState) -> None:
-        """Take the scheduled (T_V, ξ_V, T_H, ξ_H) at the measured q̄ and mass when one of
+        """Take the scheduled (T_V, ξ_V, T_H, ξ_H, τ_ny-trim) at the measured q̄ and mass when one of
         them moved by more than ``REFRESH_REL`` (:mod:`fms_testbed.control.schedule`)."""
         ps, ts = float(state.p_static_pa), float(state.t_static_k)
         if not (math.isfinite(ps) and math.isfinite(ts)):

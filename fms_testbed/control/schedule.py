@@ -1,6 +1,6 @@
 """Gain schedule of the coupled law in dynamic pressure and mass.
 
-Each scheduled parameter (T_V_s, xi_V, T_H_s, xi_H) is a smooth function of the scheduling
+Each scheduled parameter (T_V_s, xi_V, T_H_s, xi_H, ny_trim_tau_s) is a smooth function of the scheduling
 variables, fitted by least squares over the tuned design points::
 
     p(q̄, m) = c0 + c1 ln(q̄ / q̄_ref) + c2 (m / m_ref - 1)
@@ -19,8 +19,8 @@ import numpy as np
 
 from fms_testbed.core.atmosphere import R_JPKGK
 
-SCHEDULED = ("T_V_s", "xi_V", "T_H_s", "xi_H")
-"""Coupled-law parameters the schedule sets (s, -, s, -)."""
+SCHEDULED = ("T_V_s", "xi_V", "T_H_s", "xi_H", "ny_trim_tau_s")
+"""Coupled-law parameters the schedule sets (s, -, s, -, s)."""
 REFRESH_REL = 0.005
 """Relative change of a scheduled parameter that makes the law take the new tuning."""
 

@@ -3,9 +3,9 @@ nonlinear check.
 
 At each design point (:class:`~fms_testbed.sim.linearise.DesignPoint`) the JSBSim aircraft is
 trimmed and linearised and the loops of :mod:`fms_testbed.control.loops` are built. The
-coupled law's (T_V, ξ_V, T_H, ξ_H) are tuned there with SLSQP (scipy) against
+coupled law's (T_V, ξ_V, T_H, ξ_H) and its n_y-trim time constant are tuned there with SLSQP (scipy) against
 
-* hard goals (constraints), on the loops broken at the thrust (n_x) and elevator (n_y)
+* hard goals (constraints, with the buffers :data:`TUNE_BUFFER`), on the loops broken at the thrust (n_x) and elevator (n_y)
   channels and at the inner loops' actuators: gain margin ≥ :data:`GM_MIN_DB`, phase margin ≥
   :data:`PM_MIN_DEG`, disk margin ≥ :data:`DM_MIN`, closed-loop damping ≥ :data:`ZETA_MIN`;
 * soft goals (cost), on the linear closed loop's responses to an altitude step ``dH`` and a
@@ -43,8 +43,14 @@ DM_MIN = 0.67
 """Hard goal: balanced disk margin α of every loop (α = 2/3 guarantees ±6 dB alone)."""
 ZETA_MIN = 0.4
 """Hard goal: damping ratio of every oscillatory closed-loop pole."""
-BOUNDS = {"T_V_s": (4.0, 15.0), "xi_V": (0.6, 1.5), "T_H_s": (5.0, 20.0), "xi_H": (0.6, 1.5)}
-"""Tuning box: time constants in s, damping ratios dimensionless."""
+TUNE_BUFFER = {"gm_db": 1.0, "pm_deg": 5.0, "dm": 0.05, "zeta": 0.05}
+"""The tuner's constraints are the hard goals plus these buffers (dB, deg, α, -): the schedule's
+fit residual and the nonlinear loop must not take a point below the goals."""
+BOUNDS = {"T_V_s": (4.0, 15.0), "xi_V": (0.6, 1.5), "T_H_s": (5.0, 20.0), "xi_H": (0.6, 1.5),
+          "ny_trim_tau_s": (1.0, 8.0)}
+"""Tuning box: time constants in s, damping ratios dimensionless (``ny_trim_tau_s``: the law's
+n_y tracking-error integrator, the element that sets the elevator channel's phase margin at
+low dynamic pressure)."""
 NAMES = tuple(BOUNDS)
 DH_STEP_M = 100.0
 """Altitude step of the soft goals and of the nonlinear check, m (inside the ±dH limit)."""
@@ -158,9 +164,11 @@ def linear_goals(pl: PointLoops) -> LinearGoals:
 
 
 def _constraints(g: LinearGoals) -> np.ndarray:
-    """Hard goals as ``c ≥ 0`` (each scaled to about one unit)."""
-    return np.array([(g.gm_db - GM_MIN_DB) / 6.0, (g.pm_deg - PM_MIN_DEG) / 45.0,
-                     (g.dm - DM_MIN) / DM_MIN, (g.zeta - ZETA_MIN) / ZETA_MIN])
+    """Hard goals plus :data:`TUNE_BUFFER` as ``c ≥ 0`` (each scaled to about one unit)."""
+    b = TUNE_BUFFER
+    return np.array([(g.gm_db - GM_MIN_DB - b["gm_db"]) / 6.0,
+                     (g.pm_deg - PM_MIN_DEG - b["pm_deg"]) / 45.0,
+                     (g.dm - DM_MIN - b["dm"]) / DM_MIN, (g.zeta - ZETA_MIN - b["zeta"]) / ZETA_MIN])
 
 
 @dataclass(frozen=True)
@@ -176,7 +184,11 @@ class PointTuning:
 
 def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParams,
                max_iter: int = 30) -> PointTuning:
-    """Tune (T_V, ξ_V, T_H, ξ_H) at one design point with SLSQP (module docstring).
+    """Tune (T_V, ξ_V, T_H, ξ_H, τ_ny-trim) at one design point (module docstring).
+
+    From an infeasible start a Nelder-Mead search first maximises the smallest scaled hard-goal
+    slack; SLSQP then minimises the soft cost with the hard goals as constraints. The result is
+    the cheapest feasible tuning evaluated (else the least infeasible one).
 
     Parameters
     ----------
@@ -185,31 +197,35 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
     """
     lo = np.array([BOUNDS[n][0] for n in NAMES])
     hi = np.array([BOUNDS[n][1] for n in NAMES])
-    cache: dict[tuple, LinearGoals] = {}
+    cache: dict[tuple, tuple[np.ndarray, LinearGoals]] = {}
 
     def params(u):
         x = lo + np.clip(u, 0.0, 1.0) * (hi - lo)
-        return replace(start, **{n: float(v) for n, v in zip(NAMES, x)})
+        return replace(start, **{n: round(float(v), 3) for n, v in zip(NAMES, x)})
 
     def goals(u) -> LinearGoals:
-        key = tuple(np.round(u, 10))
+        key = tuple(np.round(np.clip(u, 0.0, 1.0), 4))
         if key not in cache:
-            cache[key] = linear_goals(point_loops(cfg, model, params(u)))
-        return cache[key]
+            cache[key] = (np.array(key), linear_goals(point_loops(cfg, model, params(u))))
+        return cache[key][1]
 
     u0 = (np.clip([getattr(start, n) for n in NAMES], lo, hi) - lo) / (hi - lo)
     g0 = goals(u0)
-    res = minimize(lambda u: goals(u).cost, u0, method="SLSQP", bounds=[(0.0, 1.0)] * 4,
-                   constraints=[{"type": "ineq", "fun": lambda u: _constraints(goals(u))}],
-                   options={"maxiter": max_iter, "ftol": 1e-4, "eps": 1e-3})
-    best_u = res.x if np.all(_constraints(goals(res.x)) >= -1e-6) else u0
-    gb = goals(best_u)
-    feasible = bool(np.all(_constraints(gb) >= -1e-6))
-    if gb.cost > g0.cost and np.all(_constraints(g0) >= 0):
-        best_u, gb = u0, g0
-    p = params(best_u)
-    p = replace(p, **{n: round(getattr(p, n), 3) for n in NAMES})
-    return PointTuning(p, gb, g0, len(cache), feasible)
+    u = u0
+    if np.min(_constraints(g0)) < 0:
+        r = minimize(lambda v: -min(np.min(_constraints(goals(v))), 0.2), u0,
+                     method="Nelder-Mead", options={"maxfev": 80, "xatol": 0.01, "fatol": 1e-3})
+        u = np.clip(r.x, 0.0, 1.0)
+    minimize(lambda v: goals(v).cost, u, method="SLSQP", bounds=[(0.0, 1.0)] * len(NAMES),
+             constraints=[{"type": "ineq", "fun": lambda v: _constraints(goals(v))}],
+             options={"maxiter": max_iter, "ftol": 1e-4, "eps": 1e-3})
+    done = list(cache.values())
+    feas = [(uu, g) for uu, g in done if np.min(_constraints(g)) >= 0]
+    if feas:
+        best_u, gb = min(feas, key=lambda e: e[1].cost)
+    else:
+        best_u, gb = max(done, key=lambda e: np.min(_constraints(e[1])))
+    return PointTuning(params(best_u), gb, g0, len(cache), bool(feas))
 
 
 @dataclass(frozen=True, slots=True)

@@ -55,7 +55,7 @@ class DesignPoint:
     ----------
     alt_m : altitude, m;  tas_mps : true airspeed, m/s
     mass_kg : gross mass, kg (None: the model's loaded mass)
-    config : ``"clean"`` or ``"approach"`` (the aircraft file's go-around flap, gear up)
+    config : ``"clean"`` or ``"approach"`` (the aircraft file's landing flap, gear down)
     cg_shift_m : centre-of-gravity shift aft (+) or forward (-), m
     """
 
@@ -154,7 +154,7 @@ def _ballast_index(fdm) -> int | None:
 
 def trim_point(cfg: AircraftConfig, point: DesignPoint) -> tuple[JSBSimAircraft, TrimResult]:
     """A fresh aircraft at ``point``'s mass and CG, trimmed level at its altitude, TAS and
-    configuration (approach: the file's go-around flap, gear up).
+    configuration (approach: the file's landing flap, gear down).
 
     Parameters
     ----------
@@ -166,17 +166,17 @@ def trim_point(cfg: AircraftConfig, point: DesignPoint) -> tuple[JSBSimAircraft,
         When JSBSim cannot trim there.
     """
     ac = JSBSimAircraft(cfg)
-    flap = 0.0
+    flap, gear = 0.0, False
     if point.config == "approach":
         if cfg.approach is None:
             raise UserError(f"{cfg.name}: no approach block, no approach configuration to tune")
-        ga = cfg.approach.go_around_flap
-        flap = next(f.cmd_norm for f in cfg.approach.flaps if f.name == ga)
+        flap = next(f.cmd_norm for f in cfg.approach.flaps if f.name == cfg.approach.landing_flap)
+        gear = True
     elif point.config != "clean":
         raise UserError(f"design point config {point.config!r}: expected clean or approach")
     set_mass_and_cg(ac, point.mass_kg, point.cg_shift_m)
     tr = ac.trim(point.alt_m, point.tas_mps, heading_deg=90.0, lat_deg=45.0,
-                 flap_cmd_norm=flap)
+                 flap_cmd_norm=flap, gear_down=gear)
     return ac, tr
 
 
