@@ -2,7 +2,8 @@
 the point-mass approximation (``fms-testbed analyse --plant jsbsim``).
 
 The nonlinear reference: from the trim, inner loops off, an elevator pulse (+0.02 for 1 s)
-with the other controls held; the free response is flown for 150 s. A damped sinusoid
+with the other controls held; the free response is flown for 150 s, minus the same run
+without the pulse (the trim's own drift). A damped sinusoid
 ``y = a e^{-σ t} cos(ω_d t + φ) + b + c t`` is fitted (scipy ``curve_fit``) to the pitch rate
 over 2-10 s (short period) and to the airspeed over 10-150 s (phugoid); their ω_n = sqrt(σ² +
 ω_d²) and ζ = σ / ω_n are compared with the eigenvalues of the linear model, and the linear
@@ -30,13 +31,8 @@ PULSE_S = (1.0, 2.0)
 DURATION_S = 150.0
 
 
-def nonlinear_pulse(cfg, point: DesignPoint) -> np.ndarray:
-    """Free response to the elevator pulse on the nonlinear JSBSim model (inner loops off).
-
-    Returns
-    -------
-    array (time × 4): t_s, q_rps, tas_mps, alpha_rad (deviations from trim except t)
-    """
+def _free_run(cfg, point: DesignPoint, pulse: float) -> np.ndarray:
+    """t_s, q_rps, tas_mps, alpha_rad of a free run from the trim with an elevator pulse."""
     ac, tr = trim_point(cfg, point)
     fdm = ac.fdm
     fdm["fms/ap/master"] = 0.0
@@ -44,15 +40,27 @@ def nonlinear_pulse(cfg, point: DesignPoint) -> np.ndarray:
         fdm[f"fcs/throttle-cmd-norm[{i}]"] = tr.throttle
     n = int(DURATION_S / ac.dt_s)
     out = np.empty((n, 4))
-    st = ac.state()
-    ref = (st.q_rps, st.tas_mps, st.alpha_rad)
     for k in range(n):
         t = (k + 1) * ac.dt_s
-        fdm["fcs/elevator-cmd-norm"] = tr.elevator + (PULSE if PULSE_S[0] <= t < PULSE_S[1] else 0.0)
+        fdm["fcs/elevator-cmd-norm"] = tr.elevator + (pulse if PULSE_S[0] <= t < PULSE_S[1] else 0.0)
         fdm.run()
         st = ac.state()
-        out[k] = (t, st.q_rps - ref[0], st.tas_mps - ref[1], st.alpha_rad - ref[2])
+        out[k] = (t, st.q_rps, st.tas_mps, st.alpha_rad)
     return out
+
+
+def nonlinear_pulse(cfg, point: DesignPoint) -> np.ndarray:
+    """Response to the elevator pulse on the nonlinear JSBSim model (inner loops off): the run
+    with the pulse minus the run without it (which removes the trim's own slow drift).
+
+    Returns
+    -------
+    array (time × 4): t_s, q_rps, tas_mps, alpha_rad (differences except t)
+    """
+    a, b = _free_run(cfg, point, PULSE), _free_run(cfg, point, 0.0)
+    d = a - b
+    d[:, 0] = a[:, 0]
+    return d
 
 
 def linear_pulse(model, t_s: np.ndarray) -> np.ndarray:
