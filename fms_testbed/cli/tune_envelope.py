@@ -58,13 +58,15 @@ def goal_lines(df: pd.DataFrame) -> list[tuple[bool, str]]:
 
 def _schedule_curves(res) -> dict[str, pd.DataFrame]:
     """The schedule evaluated along q̄ at each design mass (figure data)."""
+    from fms_testbed.control.schedule import SCHEDULED
+
     df = res.points[res.points["qbar_pa"].notna()]
     q = np.linspace(df.qbar_pa.min() * 0.9, df.qbar_pa.max() * 1.1, 60)
     masses = sorted({round(m, -2) for m in df.mass_kg})
     rows = [{"qbar_pa": qq, "mass_kg": m, **res.schedule.values(qq, m)} for m in masses for qq in q]
     tab = pd.DataFrame(rows)
     return {k: tab[["qbar_pa", "mass_kg", k]].rename(columns={k: "value"})
-            for k in res.schedule.coeffs}
+            for k in SCHEDULED}
 
 
 def write_figures(res, name: str, tmp: Path) -> None:
@@ -91,15 +93,14 @@ def write_figures(res, name: str, tmp: Path) -> None:
                     f"{name}: nonlinear JSBSim steps at the points with the largest cross "
                     f"deviations\nmax|ΔV| {df.max_dv_kmh.max():.2f} km/h, max|ΔH| "
                     f"{df.max_dh_m.max():.2f} m (schedule)"), tmp / "steps.png")
-    save(plot_schedule(df, _schedule_curves(res), f"{name}: tuned gains and the schedule "
-                       "c0 + c1 ln(q̄/q̄ref) + c2 (m/mref - 1)"), tmp / "schedule.png")
+    save(plot_schedule(df, _schedule_curves(res), f"{name}: tuned gains at the design points "
+                       "and the schedule (piecewise linear in ln q̄, linear in mass)"),
+         tmp / "schedule.png")
 
 
 def _report(cfg, res, goals, args, points_md: str) -> str:
     load = os.getloadavg()
-    s = res.schedule
-    terms = "\n".join(f"| {k} | {c[0]:.4g} | {c[1]:.4g} | {c[2]:.4g} | {s.bounds[k][0]:g}-"
-                      f"{s.bounds[k][1]:g} |" for k, c in s.coeffs.items())
+    terms = markdown_table(pd.DataFrame(res.schedule.table()))
     gl = "\n".join(f"- {'PASS' if ok else 'FAIL'}: {t}" for ok, t in goals)
     figs = "\n".join(f"![{f}]({f})" for f in FIGURES)
     return (f"# Envelope tuning of the coupled law — {cfg.name}\n\n"
@@ -112,8 +113,8 @@ def _report(cfg, res, goals, args, points_md: str) -> str:
             f"Wall time: tuning {res.tune_wall_s:.0f} s, checks {res.check_wall_s:.0f} s on "
             f"{res.workers} workers (load average at the end {load[0]:.1f} / {load[1]:.1f} / "
             f"{load[2]:.1f}, {os.cpu_count()} cores).\n\n## Goals\n\n{gl}\n\n## Schedule\n\n"
-            f"q̄_ref {s.qbar_ref_pa:.0f} Pa, m_ref {s.mass_ref_kg:.0f} kg\n\n"
-            f"| parameter | c0 | c1 (ln q̄) | c2 (mass) | clip |\n|---|---|---|---|---|\n{terms}\n\n"
+            "Piecewise linear in ln q̄ per mass level, linear in mass between levels:\n\n"
+            f"{terms}\n\n"
             f"## Points\n\n{points_md}\n\n## Figures\n\n{figs}\n")
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from functools import lru_cache
 from pathlib import Path
-from typing import Annotated, Literal
+from typing import Annotated
 
 from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
 
@@ -140,22 +140,24 @@ class CoupledLawGains(_Frozen):
     dH_limit_m: Pos = Field(100.0, description="altitude-error limit (level-change mode), m")
 
 
-class ScheduleTerm(_Frozen):
-    """One scheduled parameter: ``c0 + c1 ln(q̄/q̄_ref) + c2 (m/m_ref - 1)`` clipped to
-    ``[lo, hi]`` (the parameter's unit)."""
+class SchedulePoint(_Frozen):
+    """One row of the coupled law's gain schedule: the scheduling variables and the tuning."""
 
-    c: tuple[float, float, float] = Field(description="coefficients c0, c1, c2")
-    lo: float = Field(description="lower clip")
-    hi: float = Field(description="upper clip")
+    qbar_pa: Pos = Field(description="dynamic pressure, Pa")
+    mass_kg: Pos = Field(description="mass, kg")
+    T_V_s: Pos = Field(description="speed-channel time constant, s")
+    xi_V: Pos = Field(description="speed-channel damping ratio")
+    T_H_s: Pos = Field(description="altitude-channel time constant, s")
+    xi_H: Pos = Field(description="altitude-channel damping ratio")
+    ny_trim_tau_s: Pos = Field(description="n_y tracking-error integrator time constant, s")
 
 
 class CoupledLawSchedule(_Frozen):
     """Gain schedule of the coupled law in dynamic pressure and mass (``fms-testbed tune
-    --envelope``; :mod:`fms_testbed.control.schedule`)."""
+    --envelope``): a table, piecewise linear in ln q̄ per mass level and linear in mass
+    (:mod:`fms_testbed.control.schedule`)."""
 
-    qbar_ref_pa: Pos = Field(description="reference dynamic pressure, Pa")
-    mass_ref_kg: Pos = Field(description="reference mass, kg")
-    terms: dict[Literal["T_V_s", "xi_V", "T_H_s", "xi_H", "ny_trim_tau_s"], ScheduleTerm]
+    points: list[SchedulePoint] = Field(min_length=1)
 
 
 class FlapDetent(_Frozen):

@@ -50,7 +50,8 @@ from fms_testbed.core.state import AircraftState
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.atmosphere import isa
-from fms_testbed.control.schedule import REFRESH_REL, GainSchedule, qbar_from_state
+from fms_testbed.control.schedule import (REFRESH_REL, GainSchedule, qbar_from_state,
+                                          schedule_from_points)
 
 _SAT_EPS = 0.005
 """Throttle within this of a limit counts as saturated (normalised throttle)."""
@@ -121,8 +122,7 @@ def schedule_from_config(cfg: AircraftConfig) -> GainSchedule | None:
     sc = cfg.coupled_law_schedule
     if sc is None:
         return None
-    return GainSchedule(sc.qbar_ref_pa, sc.mass_ref_kg, {k: t.c for k, t in sc.terms.items()},
-                        {k: (t.lo, t.hi) for k, t in sc.terms.items()})
+    return schedule_from_points([p.model_dump() for p in sc.points])
 
 
 def params_from_config(cfg: AircraftConfig, **overrides) -> CoupledLawParams:

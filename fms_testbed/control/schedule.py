@@ -1,19 +1,20 @@
-"""Gain schedule of the coupled law in dynamic pressure and mass.
+"""Gain schedule of the coupled law in dynamic pressure and mass: a table over the design points.
 
-Each scheduled parameter (T_V_s, xi_V, T_H_s, xi_H, ny_trim_tau_s) is a smooth function of the scheduling
-variables, fitted by least squares over the tuned design points::
+The tuned parameters (T_V_s, xi_V, T_H_s, xi_H, ny_trim_tau_s) are tabulated at the design
+points. The points are grouped by mass (masses within :data:`MASS_LEVEL_REL` of each other form
+one level); the schedule is piecewise linear in ln q̄ within a level and linear in mass between
+the two levels around the query, held constant beyond the table's ends::
 
-    p(q̄, m) = c0 + c1 ln(q̄ / q̄_ref) + c2 (m / m_ref - 1)
+    p(q̄, m) = (1 - w) p_i(ln q̄) + w p_(i+1)(ln q̄),   w = (m - m_i) / (m_(i+1) - m_i)
 
-clipped to the tuning box. The law evaluates it in flight from the measured state
-(q̄ = ½ ρ V², ρ = p_s / (R T_s)) and swaps its tuning when a parameter moves by more than
-:data:`REFRESH_REL`.
+so it passes through every tuned point and is continuous in both variables. The law evaluates
+it in flight from the measured state (q̄ = ½ ρ V², ρ = p_s / (R T_s)) and takes the new tuning
+when a parameter moves by more than :data:`REFRESH_REL`.
 """
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -23,57 +24,77 @@ SCHEDULED = ("T_V_s", "xi_V", "T_H_s", "xi_H", "ny_trim_tau_s")
 """Coupled-law parameters the schedule sets (s, -, s, -, s)."""
 REFRESH_REL = 0.005
 """Relative change of a scheduled parameter that makes the law take the new tuning."""
+MASS_LEVEL_REL = 0.02
+"""Design masses closer than this fraction are one mass level of the table."""
+
+
+@dataclass(frozen=True)
+class MassLevel:
+    """One mass level: its mass (kg), the ln q̄ of its points (sorted) and each parameter's
+    values there."""
+
+    mass_kg: float
+    ln_qbar: np.ndarray
+    values: dict[str, np.ndarray]
 
 
 @dataclass(frozen=True)
 class GainSchedule:
-    """Fitted schedule (module docstring).
+    """The schedule table (module docstring), mass levels sorted by mass."""
 
-    Attributes
-    ----------
-    qbar_ref_pa : reference dynamic pressure, Pa;  mass_ref_kg : reference mass, kg
-    coeffs : parameter → (c0, c1, c2) in the parameter's unit
-    bounds : parameter → (lower, upper) clip
-    """
-
-    qbar_ref_pa: float
-    mass_ref_kg: float
-    coeffs: dict[str, tuple[float, float, float]]
-    bounds: dict[str, tuple[float, float]]
+    levels: tuple[MassLevel, ...]
 
     def values(self, qbar_pa: float, mass_kg: float) -> dict[str, float]:
         """Scheduled parameters at dynamic pressure ``qbar_pa`` (Pa) and mass ``mass_kg`` (kg)."""
-        x = (1.0, math.log(max(qbar_pa, 1.0) / self.qbar_ref_pa), mass_kg / self.mass_ref_kg - 1.0)
-        out = {}
-        for name, c in self.coeffs.items():
-            lo, hi = self.bounds.get(name, (-math.inf, math.inf))
-            out[name] = min(max(c[0] * x[0] + c[1] * x[1] + c[2] * x[2], lo), hi)
-        return out
+        lq = float(np.log(max(qbar_pa, 1.0)))
+        at = [{k: float(np.interp(lq, lv.ln_qbar, v)) for k, v in lv.values.items()}
+              for lv in self.levels]
+        ms = [lv.mass_kg for lv in self.levels]
+        if len(ms) == 1 or mass_kg <= ms[0]:
+            return at[0]
+        if mass_kg >= ms[-1]:
+            return at[-1]
+        i = int(np.searchsorted(ms, mass_kg)) - 1
+        w = (mass_kg - ms[i]) / (ms[i + 1] - ms[i])
+        return {k: (1 - w) * at[i][k] + w * at[i + 1][k] for k in at[i]}
 
-    def regressors(self, qbar_pa: np.ndarray, mass_kg: np.ndarray) -> np.ndarray:
-        """Design matrix [1, ln(q̄/q̄_ref), m/m_ref - 1] (rows: points); q̄ in Pa, m in kg."""
-        q, m = np.asarray(qbar_pa, float), np.asarray(mass_kg, float)
-        return np.column_stack([np.ones_like(q), np.log(q / self.qbar_ref_pa),
-                                m / self.mass_ref_kg - 1.0])
+    def table(self) -> list[dict]:
+        """The table as plain rows (qbar_pa, mass_kg and the parameters) for the aircraft file."""
+        return [{"qbar_pa": round(float(np.exp(q)), 1), "mass_kg": round(lv.mass_kg, 1),
+                 **{k: round(float(v[j]), 4) for k, v in lv.values.items()}}
+                for lv in self.levels for j, q in enumerate(lv.ln_qbar)]
 
 
-def fit_schedule(qbar_pa, mass_kg, table: dict[str, np.ndarray],
-                 bounds: dict[str, tuple[float, float]]) -> GainSchedule:
-    """Least-squares fit of :class:`GainSchedule` to tuned values at design points.
+def schedule_from_points(rows: list[dict]) -> GainSchedule:
+    """Build the table from rows ``{qbar_pa, mass_kg, <parameter>: value}`` (Pa, kg).
 
-    Parameters
-    ----------
-    qbar_pa, mass_kg : scheduling variables of the points, Pa and kg
-    table : parameter → tuned values at the points;  bounds : clip of each parameter
+    Points of one mass level at the same q̄ (within 0.1 %) are averaged.
     """
-    q, m = np.asarray(qbar_pa, float), np.asarray(mass_kg, float)
-    s = GainSchedule(float(np.exp(np.mean(np.log(q)))), float(np.mean(m)), {}, dict(bounds))
-    X = s.regressors(q, m)
-    coeffs = {}
-    for name, y in table.items():
-        c, *_ = np.linalg.lstsq(X, np.asarray(y, float), rcond=None)
-        coeffs[name] = tuple(float(v) for v in c)
-    return replace(s, coeffs=coeffs)
+    rows = sorted(rows, key=lambda r: r["mass_kg"])
+    groups: list[list[dict]] = []
+    for r in rows:
+        if groups and abs(r["mass_kg"] / groups[-1][0]["mass_kg"] - 1) <= MASS_LEVEL_REL:
+            groups[-1].append(r)
+        else:
+            groups.append([r])
+    names = [k for k in rows[0] if k not in ("qbar_pa", "mass_kg")]
+    levels = []
+    for g in groups:
+        g = sorted(g, key=lambda r: r["qbar_pa"])
+        lq, vals = [], {k: [] for k in names}
+        for r in g:
+            q = float(np.log(r["qbar_pa"]))
+            if lq and q - lq[-1] < 1e-3:
+                n = len([x for x in g if abs(np.log(x["qbar_pa"]) - q) < 1e-3])
+                for k in names:
+                    vals[k][-1] += (r[k] - vals[k][-1]) / n
+                continue
+            lq.append(q)
+            for k in names:
+                vals[k].append(float(r[k]))
+        levels.append(MassLevel(float(np.mean([r["mass_kg"] for r in g])), np.array(lq),
+                                {k: np.array(v) for k, v in vals.items()}))
+    return GainSchedule(tuple(levels))
 
 
 def qbar_from_state(tas_mps: float, p_static_pa: float, t_static_k: float) -> float:

@@ -2,8 +2,8 @@
 checks (margins on every loop, robustness, nonlinear JSBSim steps).
 
 1. every design point is trimmed, linearised and tuned (:func:`.envelope_points.tune_point`);
-2. the tuned (T_V, ξ_V, T_H, ξ_H, τ_ny-trim) are fitted as a schedule smooth in dynamic pressure and mass
-   (:func:`fms_testbed.control.schedule.fit_schedule`);
+2. the tuned (T_V, ξ_V, T_H, ξ_H, τ_ny-trim) become the schedule: a table continuous in dynamic
+   pressure and mass through every tuned point (:mod:`fms_testbed.control.schedule`);
 3. every point is checked with the *scheduled* gains — the ones the law flies: margins of the six
    broken loops (python-control ``stability_margins`` and ``disk_margins``), the same margins
    under the robustness set (mass ±:data:`ROBUST_MASS_FRAC`, CG ±:data:`ROBUST_CG_M`, an
@@ -22,6 +22,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 import multiprocessing
+import control as ct
 import numpy as np
 import pandas as pd
 import yaml
@@ -31,11 +32,10 @@ from fms_testbed.config.aircraft import AircraftConfig, load_aircraft
 from fms_testbed.config.yamlfile import read_mapping, validation_message
 from fms_testbed.control.coupled_law import CoupledLaw, params_from_config
 from fms_testbed.control.loops import BREAKS, margins
-from fms_testbed.control.schedule import SCHEDULED, GainSchedule, fit_schedule
+from fms_testbed.control.schedule import SCHEDULED, GainSchedule, schedule_from_points
 from fms_testbed.core.atmosphere import cas_to_tas
 from fms_testbed.core.errors import ConfigError, TrimError
-from fms_testbed.evaluation.envelope_points import (BOUNDS, freq_response, point_loops,
-                                                    tune_point, verify)
+from fms_testbed.evaluation.envelope_points import point_loops, tune_point, verify
 from fms_testbed.sim.linearise import DesignPoint, linearise
 
 MASS_FACTORS = (0.9, 1.1)
@@ -142,7 +142,11 @@ def _loop_columns(pl, prefix: str = "") -> dict:
 
 def loop_responses(pl, omega_rps: np.ndarray = FIG_OMEGA_RPS) -> dict[str, np.ndarray]:
     """L(jω) of every broken loop of ``pl`` on ``omega_rps`` (rad/s), for the figures."""
-    return {b: freq_response(pl.loop(b), omega_rps) for b in BREAKS}
+    out = {}
+    for b in BREAKS:
+        fr = ct.frequency_response(pl.loop(b), omega_rps)
+        out[b] = np.asarray(fr.complex).ravel()
+    return out
 
 
 def _mins(row: dict, prefix: str = "") -> tuple[float, float, float]:
@@ -160,22 +164,29 @@ def robustness_set(point: DesignPoint, mass_kg: float) -> list[tuple[DesignPoint
             + [(replace(point, mass_kg=mass_kg), ROBUST_DELAY_S)])
 
 
+ROBUST_NAMES = ("mass_lo", "mass_hi", "cg_fwd", "cg_aft", "delay")
+"""Members of :func:`robustness_set`, in its order (column suffixes)."""
+
+
 def _robust_columns(cfg, point: DesignPoint, mass_kg: float, law_at, nominal) -> dict:
-    """Smallest margins over :func:`robustness_set` (each member re-trimmed and linearised)."""
-    gms, pms, dms, bad = [], [], [], []
-    for pt, delay in robustness_set(point, mass_kg):
+    """Smallest margins of each member of :func:`robustness_set` (each re-trimmed and
+    linearised; the delay member on the nominal model) and over the set."""
+    row = {}
+    for name, (pt, delay) in zip(ROBUST_NAMES, robustness_set(point, mass_kg)):
         try:
             model = nominal if delay else linearise(cfg, pt)
         except TrimError:
-            bad.append(pt.label())
+            row[f"robust_pm_{name}_deg"] = math.nan
             continue
-        row = _loop_columns(point_loops(cfg, model, law_at(model), delay_s=delay))
-        gm, pm, dm = _mins(row)
-        gms.append(gm), pms.append(pm), dms.append(dm)
-    return {"robust_gm_min_db": min(gms, default=math.nan),
-            "robust_pm_min_deg": min(pms, default=math.nan),
-            "robust_disk_margin": min(dms, default=math.nan),
-            "robust_untrimmed": "; ".join(bad)}
+        gm, pm, dm = _mins(_loop_columns(point_loops(cfg, model, law_at(model), delay_s=delay)))
+        row.update({f"robust_gm_{name}_db": gm, f"robust_pm_{name}_deg": pm,
+                    f"robust_dm_{name}": dm})
+    for key, col in (("gm", "robust_gm_min_db"), ("pm", "robust_pm_min_deg"),
+                     ("dm", "robust_disk_margin")):
+        vals = [v for k, v in row.items() if k.startswith(f"robust_{key}_") and
+                math.isfinite(v)]
+        row[col] = min(vals, default=math.nan)
+    return row
 
 
 def _check_job(ref: str, point: DesignPoint, schedule: GainSchedule, robust: bool,
@@ -251,9 +262,8 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
     if len(ok) < 3:
         raise ConfigError(f"{cfg.name}: only {len(ok)} design points trimmed; a schedule "
                           "needs at least 3")
-    sched = fit_schedule([r["qbar_pa"] for r in ok], [r["mass_kg"] for r in ok],
-                         {n: np.array([r[f"tuned_{n}"] for r in ok]) for n in SCHEDULED},
-                         {n: BOUNDS[n] for n in SCHEDULED})
+    sched = schedule_from_points([{"qbar_pa": r["qbar_pa"], "mass_kg": r["mass_kg"],
+                                   **{n: r[f"tuned_{n}"] for n in SCHEDULED}} for r in ok])
     checks = _pool_map(_check_job, [(ref, r["point"], sched, robust, duration_s) for r in tuned
                                     if "qbar_pa" in r], workers)
     t2 = time.perf_counter()
@@ -290,9 +300,7 @@ def points_table(res: EnvelopeResult) -> pd.DataFrame:
 
 def schedule_block(s: GainSchedule) -> dict:
     """The ``coupled_law_schedule`` block of an aircraft file (plain YAML types)."""
-    return {"qbar_ref_pa": round(s.qbar_ref_pa, 1), "mass_ref_kg": round(s.mass_ref_kg, 1),
-            "terms": {k: {"c": [round(v, 5) for v in c], "lo": s.bounds[k][0],
-                          "hi": s.bounds[k][1]} for k, c in s.coeffs.items()}}
+    return {"points": s.table()}
 
 
 def aircraft_with_schedule(cfg: AircraftConfig, s: GainSchedule) -> str:

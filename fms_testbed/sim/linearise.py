@@ -101,9 +101,10 @@ def _tanks(fdm) -> list[float]:
 
 def set_mass_and_cg(ac: JSBSimAircraft, mass_kg: float | None, cg_shift_m: float) -> float:
     """Set the gross mass and shift the CG before a trim: mass removed from the fuel (all tanks
-    scaled by one factor), mass added as ballast (:data:`BALLAST`); for a CG shift the ballast
-    is at least 5 % of the weight, placed at ``x_b = x_cg + Δx W / w_b`` (fuel reduced to keep
-    the mass), which moves the CG by ``Δx`` (first moment).
+    scaled by one factor; the CG moves with the fuel, as when it burns), mass added as ballast
+    (:data:`BALLAST`); for a CG shift the ballast is at least 5 % of the weight (fuel reduced to
+    keep the mass). A ballast is placed where the first moment puts the CG at ``x_cg0 + Δx``:
+    ``x_b = ((x_cg0 + Δx)(W1 + w_b) - W1 x1) / w_b`` (W1, x1: weight and CG after the fuel).
 
     Parameters
     ----------
@@ -136,9 +137,12 @@ def set_mass_and_cg(ac: JSBSimAircraft, mass_kg: float | None, cg_shift_m: float
         idx = _ballast_index(fdm)
         if idx is None:
             raise UserError(f"{ac.cfg.jsbsim_model}: the sanitised model has no ballast point mass")
+        fdm.run_ic()
+        w1, x1 = fdm["inertia/weight-lbs"], fdm["inertia/cg-x-in"]
+        # (W1 x1 + w_b x_b) / (W1 + w_b) = x0 + Δx
+        x_b = ((cg0_in + cg_shift_m / 0.0254) * (w1 + ballast) - w1 * x1) / ballast
         fdm[f"inertia/pointmass-weight-lbs[{idx}]"] = ballast
-        fdm[f"inertia/pointmass-location-X-inches[{idx}]"] = (
-            cg0_in + (cg_shift_m / 0.0254) * target / ballast)
+        fdm[f"inertia/pointmass-location-X-inches[{idx}]"] = x_b
         fdm[f"inertia/pointmass-location-Z-inches[{idx}]"] = fdm["inertia/cg-z-in"]
     fdm.run_ic()
     return (fdm["inertia/cg-x-in"] - cg0_in) * 0.0254

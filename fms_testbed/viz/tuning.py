@@ -21,7 +21,8 @@ LOOP_TITLES = {"throttle": "inner n_x loop at the throttle", "elevator": "inner 
 def _nichols_xy(h: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Open-loop phase (deg, unwrapped into (-360, 0]) and gain (dB) of a response."""
     ph = np.degrees(np.unwrap(np.angle(h)))
-    ph = ph - 360.0 * np.ceil(ph[np.argmax(np.abs(h) < 10)] / 360.0) if len(ph) else ph
+    ic = int(np.argmin(np.abs(np.abs(h) - 1.0)))      # phase in (-360, 0] at the crossover
+    ph = ph - 360.0 * np.ceil(ph[ic] / 360.0)
     return ph, 20 * np.log10(np.maximum(np.abs(h), 1e-12))
 
 
@@ -74,7 +75,8 @@ def plot_bode_margins(omega_rps: np.ndarray, resp: dict[str, np.ndarray], margin
         lab = f"{loop}: GM {r.gm_db:.1f} dB, PM {r.pm_deg:.1f}°, ωc {r.wc_rps:.2f} rad/s"
         line, = am.semilogx(omega_rps, 20 * np.log10(np.abs(h)), label=lab)
         ph = np.degrees(np.unwrap(np.angle(h)))
-        ap.semilogx(omega_rps, ph - 360.0 * np.round((ph[-1] + 180) / 360.0 - 0.5), color=line.get_color())
+        ic = int(np.argmin(np.abs(np.abs(h) - 1.0)))
+        ap.semilogx(omega_rps, ph - 360.0 * np.ceil(ph[ic] / 360.0), color=line.get_color())
         am.axvline(r.wc_rps, color=line.get_color(), ls=":", lw=0.8)
     am.axhline(0, color="k", lw=0.8)
     ap.axhline(-180, color="k", lw=0.8)

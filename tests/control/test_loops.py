@@ -11,7 +11,7 @@ import pytest
 from fms_testbed.control import linear
 from fms_testbed.control.coupled_law import CoupledLaw, CoupledLawParams
 from fms_testbed.control.loops import connect, margins
-from fms_testbed.control.schedule import GainSchedule, fit_schedule, qbar_from_state
+from fms_testbed.control.schedule import qbar_from_state, schedule_from_points
 
 P = CoupledLawParams(T_V_s=6.0, xi_V=0.9, T_H_s=9.0, xi_H=0.8)
 
@@ -54,16 +54,17 @@ def test_margins_of_a_known_loop():
     assert 0 < m.disk_margin < 2
 
 
-def test_schedule_fit_recovers_its_coefficients_and_clips():
-    s0 = GainSchedule(5000.0, 50000.0, {"T_V_s": (6.0, 1.5, -2.0)}, {"T_V_s": (4.0, 15.0)})
-    rng = np.random.default_rng(1)
-    q = rng.uniform(2000, 12000, 20)
-    m = rng.uniform(40000, 60000, 20)
-    y = np.array([s0.values(a, b)["T_V_s"] for a, b in zip(q, m)])
-    fit = fit_schedule(q, m, {"T_V_s": y}, {"T_V_s": (4.0, 15.0)})
-    for a, b in zip(q, m):
-        assert fit.values(a, b)["T_V_s"] == pytest.approx(s0.values(a, b)["T_V_s"], abs=1e-9)
-    assert fit.values(1e9, 50000.0)["T_V_s"] == 15.0        # 6 + 1.5 ln(2e5) = 24 → clipped
+def test_schedule_passes_through_its_points_and_is_linear_between():
+    rows = [{"qbar_pa": q, "mass_kg": m, "T_V_s": tv}
+            for q, m, tv in ((3000.0, 40000.0, 5.0), (9000.0, 40000.0, 8.0),
+                             (3000.0, 60000.0, 6.0), (9000.0, 60000.0, 10.0))]
+    s = schedule_from_points(rows)
+    for r in rows:
+        assert s.values(r["qbar_pa"], r["mass_kg"])["T_V_s"] == pytest.approx(r["T_V_s"])
+    mid_q = math.exp(0.5 * (math.log(3000.0) + math.log(9000.0)))
+    assert s.values(mid_q, 40000.0)["T_V_s"] == pytest.approx(6.5)
+    assert s.values(mid_q, 50000.0)["T_V_s"] == pytest.approx(0.5 * (6.5 + 8.0))
+    assert s.values(1e6, 1e6)["T_V_s"] == pytest.approx(10.0)     # held beyond the table
 
 
 def test_law_follows_the_schedule_in_flight():
@@ -71,7 +72,8 @@ def test_law_follows_the_schedule_in_flight():
     from fms_testbed.core.state import AircraftState
     from fms_testbed.core.atmosphere import isa
 
-    sch = GainSchedule(5000.0, 50000.0, {"T_V_s": (6.0, 2.0, 0.0)}, {"T_V_s": (4.0, 15.0)})
+    sch = schedule_from_points([{"qbar_pa": 4000.0, "mass_kg": 50000.0, "T_V_s": 5.0},
+                                {"qbar_pa": 16000.0, "mass_kg": 50000.0, "T_V_s": 9.0}])
     law = CoupledLaw(params=P, schedule=sch)
     T, p, _ = isa(3000.0)
     st = AircraftState(0.0, 0.8, 0.0, 3000.0, 150.0, 120.0, 150.0, 0.0, np.zeros(3), 0.0, 0.05,
@@ -79,4 +81,6 @@ def test_law_follows_the_schedule_in_flight():
                        3000.0, 0.5, 50000.0, float(p), float(T))
     law.update(0.1, st, 3000.0, 150.0)
     q = qbar_from_state(150.0, float(p), float(T))
-    assert law.params.T_V_s == pytest.approx(6.0 + 2.0 * math.log(q / 5000.0), rel=1e-6)
+    want = 5.0 + 4.0 * math.log(q / 4000.0) / math.log(4.0)
+    assert 5.0 < want < 9.0
+    assert law.params.T_V_s == pytest.approx(want, rel=1e-6)
