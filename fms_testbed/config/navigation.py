@@ -108,6 +108,13 @@ class GnssBlock(BaseModel):
     outages: list[IntervalBlock] = Field(default_factory=list, description="no fix inside these")
     outliers: list[OutlierBlock] = Field(default_factory=list, description="outlier bursts")
     ramps: list[RampBlock] = Field(default_factory=list, description="slow ramp faults")
+    antenna_lever_arm_m: Annotated[list[Annotated[float, Field(ge=-100, le=100)]],
+                                   Field(min_length=3, max_length=3)] = Field(
+        [0.0, 0.0, 0.0], description="antenna position from the CG, body x fwd/y right/z down, m")
+    time_tag_error_s: Annotated[float, Field(ge=-1, le=1)] = Field(
+        0.0, description="truth side: fixes are valid this long before their time stamp, s")
+    time_tag_sigma_s: Annotated[float, Field(ge=0, le=1)] = Field(
+        0.0, description="declared 1σ of the time-tag error (the filter's R allows for it), s")
 
     @model_validator(mode="after")
     def _latency(self):
@@ -144,6 +151,9 @@ class FilterBlock(BaseModel):
         1.0, description="longest interval the covariance is propagated over at once (F "
                          "averaged over it), s; a measurement or a GNSS epoch ends one too; "
                          "0: every navigation step")
+    reset_after: Annotated[int, Field(ge=0, le=1000)] = Field(
+        10, description="consecutive gate rejections of a measurement after which the "
+                        "covariance of the states it observes is reset (0: never)")
     predict_rotation_deg: Annotated[float, Field(gt=0, le=90)] = Field(
         1.0, description="an interval also ends once the body has turned this much in it, deg")
 
@@ -164,6 +174,15 @@ class InsGnssBlock(BaseModel):
     baro: BaroBlock | None = Field(default_factory=BaroBlock,
                                    description="baro altimeter (null: none)")
     filter: FilterBlock = Field(default_factory=FilterBlock, description="filter settings")
+    truth_model: Literal["strapdown", "linear"] = Field(
+        "strapdown", description="truth side of the INS units: strapdown mechanisation of a "
+                                 "simulated IMU, or truth ⊕ the linear 33-state error model")
+    alignment: Literal["stationary", "gnss_heading"] = Field(
+        "stationary", description="strapdown units' initial alignment (levelling + "
+                                  "gyrocompassing at rest, or in-air levelling + GNSS heading)")
+    record_sensors: bool = Field(
+        False, description="write the flight's IMU/GNSS/init files (the nav-replay format) "
+                           "into the run folder's sensors/")
     matrices_dt_s: Annotated[float, Field(ge=0, le=10)] = Field(
         1.0, description="the INS units' error model (truth side) reuses its Φ_k, S_k this long, "
                          "s (0: every step) ...")
