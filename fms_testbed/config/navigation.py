@@ -45,7 +45,10 @@ class SinsBlock(BaseModel):
         60.0, description="baro loop time constant, s")
     tol: Annotated[float, Field(gt=0, lt=1e-3)] = Field(
         1e-12, description="adaptive Picard tolerance (relative)")
-    alignment: Literal["stationary", "none"] = Field(
+    truth_model: Literal["linear", "strapdown"] = Field(
+        "linear", description="truth ⊕ the 33-state model, or a strapdown mechanisation of a "
+                              "simulated IMU (vertical baro-aided or free)")
+    alignment: Literal["stationary", "none", "gnss_heading"] = Field(
         "stationary", description="initial attitude errors from a stationary self-alignment, "
                                   "or independent")
     matrices_dt_s: Annotated[float, Field(ge=0, le=60)] = Field(

@@ -429,16 +429,22 @@ class InsGnssFilter:
             self._r_baro = np.array([[baro.white_sigma_m ** 2]])
 
     # -- initialisation and prediction ----------------------------------------------------
-    def initialise(self, ins: NavSolution) -> None:
+    def initialise(self, ins: NavSolution, alignment_s: float | None = None) -> None:
         """P0 at the first INS output: the INS block from the alignment (A diag(p0) Aᵀ of the
         33-state model, :func:`~fms_testbed.sensors.sins.analysis.initial_map`, at the indicated
         attitude, widened by the spread of A over the heading error σ_ψ) plus the
         equivalent-bias variance of the unmodelled accelerometer errors at 1 g; the GNSS and baro
-        states at their stationary variance."""
+        states at their stationary variance. ``alignment_s`` (s): the duration T of a
+        stationary alignment on a noisy IMU, whose white-noise means (VRW²/T, ARW²/T) level and
+        gyrocompass like a bias that the sensor's own bias state does not share: they add
+        A_b diag(q/T) A_bᵀ to the navigation block only (None: no such term)."""
         imu = self.imu
         rpy = (ins.roll_rad, ins.pitch_rad, ins.heading_rad)
         A = initial_map(ins.lat_rad, rpy, imu, SinsOptions())
         P33 = (A * imu.p0_var) @ A.T
+        if alignment_s:
+            Ab = A[:9, 9:15]
+            P33[:9, :9] += (Ab * (imu.q_psd[3:9] / float(alignment_s))) @ Ab.T
         # the map is built at the indicated heading, off by the alignment's own heading error:
         # add the first-order spread of A over that error, σ_ψ² (∂A/∂ψ) diag(p0) (∂A/∂ψ)ᵀ —
         # without it the nearly singular (ε_U, b_g) block of P0 is confidently wrong

@@ -311,7 +311,7 @@ class InsGnssNavigation(NavigationSourceBase):
         reading = self.baro.update(truth) if self.baro is not None else None
         if prev is None:
             for i, f in enumerate(self.filters):
-                f.initialise(ins[i])
+                f.initialise(ins[i], self._alignment_s())
         elif t > prev.t_s:
             # an interval ends where a measurement is valid: at a GNSS epoch (the fix, delivered
             # later, is then used at the filters' time, its time of validity) and at a baro
@@ -355,6 +355,14 @@ class InsGnssNavigation(NavigationSourceBase):
                 self.events += self.ft.check(i, t, [g])
         self._prev_truth, self._prev_ins = truth, ins
         return self.solution(truth, ins)
+
+    def _alignment_s(self) -> float | None:
+        """The stationary alignment's duration of a strapdown bank (its white-noise means are
+        in the initial errors), else None."""
+        b = self.bank
+        if isinstance(b, StrapdownBank) and b.alignment == "stationary":
+            return b.alignment_s
+        return None
 
     def _sensor_pairs(self, truth: AircraftState) -> tuple:
         """Sensor-level stage 1 on the units' raw IMU outputs over the last step."""
