@@ -124,8 +124,8 @@ class GnssPosition(Measurement):
         H[:, ATT] = skew(a)
         H[:, MP] = -np.eye(3)
         R = np.diag(np.asarray(self.sigma_m, float) ** 2)
-        if self.time_tag_sigma_s > 0 and self.v_enu_mps is not None:
-            v = np.asarray(self.v_enu_mps, float)
+        v = None if self.v_enu_mps is None else np.asarray(self.v_enu_mps, float)
+        if self.time_tag_sigma_s > 0 and v is not None and np.all(np.isfinite(v)):
             R = R + self.time_tag_sigma_s ** 2 * np.outer(v, v)
         return z, H, R
 
