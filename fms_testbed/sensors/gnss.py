@@ -11,7 +11,8 @@ e^{-2Δt/τ})) N. A fix is taken every ``1/rate_hz`` s (time of validity ``t_s``
 y right, z down, m) from the CG: p_ant = p_cg + C_b^n l, v_ant = v_cg + C_b^n (ω_eb × l). A
 time-tag error δt (``time_tag_error_s``: the receiver stamps a fix t that is valid at t - δt)
 adds -v δt to the position (first order in δt). Each fix carries the σ the receiver reports
-for it (``pos_sigma_m``, ``vel_sigma_mps``: its white part; a filter's R). Faults (truth side, the filter is not told): outages (no fix), outlier bursts
+for it (``pos_sigma_m``, ``vel_sigma_mps``: its white part times ``reported_sigma_scale``; a
+filter's R). Faults (truth side, the filter is not told): outages (no fix), outlier bursts
 (extra white position noise of ``sigma_m``, the "outliers even with RAIM" of seed 000), and slow
 ramps (a position error growing at ``rate_mps`` per ENU axis from ``start_s`` — the classic
 integrity test). Every random draw comes from the receiver's own seeded generator, in epoch order,
@@ -77,6 +78,7 @@ class GnssSpec:
     antenna_lever_arm_m : antenna position from the CG, body axes (x fwd, y right, z down), m
     time_tag_error_s : truth side: the fixes are valid ``time_tag_error_s`` before their stamp, s
     time_tag_sigma_s : declared 1σ of the time-tag error (what a filter allows for), s
+    reported_sigma_scale : the receiver reports its white σ times this (1: honestly)
     """
 
     pos_markov_sigma_m: tuple[float, float, float] = (1.0, 1.0, 2.0)
@@ -93,6 +95,7 @@ class GnssSpec:
     antenna_lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
     time_tag_error_s: float = 0.0
     time_tag_sigma_s: float = 0.0
+    reported_sigma_scale: float = 1.0
 
     def __post_init__(self):
         for name in ("pos_markov_sigma_m", "pos_white_sigma_m", "vel_markov_sigma_mps",
@@ -176,6 +179,7 @@ class GnssReceiver:
         self._sigma = spec.markov_sigma
         self._tau = spec.markov_tau_s
         self._white = spec.white_sigma
+        self._reported = spec.white_sigma * spec.reported_sigma_scale
         self.markov = self._sigma * self.rng.standard_normal(6)    # stationary start
         self._t_markov: float | None = None
         self._next_epoch_s: float | None = None
@@ -215,7 +219,7 @@ class GnssReceiver:
         return GnssFix(t, t + self.spec.latency_s, truth.lat_rad + err_p[1] / (rm + h),
                        truth.lon_rad + err_p[0] / ((rn + h) * math.cos(truth.lat_rad)),
                        h + err_p[2], v_true + err_v, err_p - p_ant, err_v,
-                       self.markov.copy(), self._white[:3].copy(), self._white[3:].copy())
+                       self.markov.copy(), self._reported[:3].copy(), self._reported[3:].copy())
 
     def update(self, truth: AircraftState) -> list[GnssFix]:
         """Take a fix when an epoch is due at ``truth.t_s`` and return the fixes delivered by

@@ -24,9 +24,7 @@ import pytest
 from scipy.stats import chi2
 
 from fms_testbed.navigation import make_source
-from fms_testbed.navigation.ins_gnss import InsGnssNavigation, gnss_spec
-from fms_testbed.navigation.ins_filter import InsGnssFilter
-from fms_testbed.config.navigation import GnssBlock
+from fms_testbed.navigation.ins_gnss import InsGnssNavigation
 from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
 
 IMU = {"name": "matched-tactical",
@@ -94,15 +92,14 @@ def test_mean_nis_within_ten_percent_of_the_measurement_dimension(mc, group, dim
 
 
 def test_a_filter_told_too_small_a_gnss_noise_fails_the_nis_check():
+    # R is the σ the receiver reports with each fix: a receiver reporting a third of its
+    # white noise
     states = _states(60.0)
-    truth_block = GnssBlock()
-    told = GnssBlock(pos_white_sigma_m=[x / 3 for x in truth_block.pos_white_sigma_m],
-                     vel_white_sigma_mps=[x / 3 for x in truth_block.vel_white_sigma_mps])
 
     def build(sd):
         nav = make_source({"source": "ins_gnss", "imu": IMU}, seed=sd)
-        f = nav.filters[0]
-        nav.filters = [InsGnssFilter(f.imu, gnss_spec(told), f.baro, f.tuning)]
+        rx = nav.receiver
+        rx._reported = rx._reported / 3
         return nav
 
     _, nis = monte_carlo(build, states, 10)
