@@ -31,27 +31,29 @@ def arl0_samples(rate_per_h: float, n_streams: int, dt_s: float) -> float:
 
 def cusum_mean_shift_s(delta: float, sigma1: float, dt_s: float, arl0: float) -> float:
     """T* (s) of a mean shift ``delta`` in white noise of ``sigma1`` per sample (same units),
-    samples every ``dt_s`` (s): ln(ARL0) / (Δ²/2σ₁²) samples, at least one."""
+    samples every ``dt_s`` (s), mean time to false alarm ``arl0`` samples: ln(ARL0) / (Δ²/2σ₁²)
+    samples, at least one."""
     k = 0.5 * (delta / sigma1) ** 2
     return max(1.0, math.log(arl0) / k) * dt_s
 
 
 def cusum_variance_s(rho: float, n_comp: int, dt_s: float, arl0: float) -> float:
     """T* (s) of a variance change by the factor ``rho`` on ``n_comp`` independent components
-    sampled every ``dt_s`` (s): ln(ARL0) / (n_comp (ρ − 1 − ln ρ)/2) samples, at least one."""
+    sampled every ``dt_s`` (s), ``arl0`` samples to a false alarm: ln(ARL0) /
+    (n_comp (ρ − 1 − ln ρ)/2) samples, at least one."""
     k = n_comp * 0.5 * (rho - 1.0 - math.log(rho))
     return max(1.0, math.log(arl0) / k) * dt_s
 
 
 def ramp_s(rate: float, sigma1: float, dt_s: float, arl0: float) -> float:
     """T* (s) of a ramp of ``rate`` (units/s) in white noise ``sigma1`` per sample every
-    ``dt_s`` (s): n = (6 ln(ARL0) σ₁² / (r Δt)²)^(1/3) samples, at least one."""
+    ``dt_s`` (s), ``arl0`` samples to a false alarm: n = (6 ln(ARL0) σ₁² / (r Δt)²)^(1/3) samples, at least one."""
     n = (6.0 * math.log(arl0) * sigma1 ** 2 / (rate * dt_s) ** 2) ** (1.0 / 3.0)
     return max(1.0, n) * dt_s
 
 
 def unit_against_others_sigma(sigma_unit: float, n_others: int) -> float:
-    """σ of one unit's sample against the mean of ``n_others`` like units (same units):
+    """σ of one unit's sample (``sigma_unit``) against the mean of ``n_others`` like units (same units):
     σ √(1 + 1/n) — the information a redundant set holds on which unit changed."""
     return sigma_unit * math.sqrt(1.0 + 1.0 / n_others)
 

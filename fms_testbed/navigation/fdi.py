@@ -86,8 +86,8 @@ def declared_sensor_noise(imus: list, dt_s: float) -> tuple[np.ndarray, np.ndarr
 
 
 def unmodelled_variances(imu) -> tuple[float, float]:
-    """(accelerometer, gyro) scale-factor + 2 × misalignment variance per axis of a declared
-    :class:`~fms_testbed.sensors.sins.presets.ImuModel`, dimensionless: the 33-state errors
+    """(accelerometer, gyro) scale-factor + 2 × misalignment variance per axis of ``imu``, a
+    declared :class:`~fms_testbed.sensors.sins.presets.ImuModel`, dimensionless: the 33-state errors
     the filters do not carry."""
     p = imu.p0_var
     return (float(p[15:18].mean() + 2.0 * p[21:27].mean()),
@@ -95,13 +95,13 @@ def unmodelled_variances(imu) -> tuple[float, float]:
 
 
 def channel_mask(vertical_frozen: bool) -> np.ndarray:
-    """(9,) bool: the comparison channels in use — all, or all but the vertical ones when the
-    vertical channel is frozen (seed 001: no altitude → the vertical channel is excluded)."""
+    """(9,) bool: the comparison channels in use — all, or all but the vertical ones when
+    ``vertical_frozen`` (seed 001: no altitude → the vertical channel is excluded)."""
     return _MASK_VERTICAL.copy() if vertical_frozen else np.ones(9, bool)
 
 
 def majority(nu) -> int | None:
-    """Table 1: the failed unit's index for (ν12, ν13, ν23), None when it names none."""
+    """Table 1: the failed unit's index for ``nu`` = (ν12, ν13, ν23), None when it names none."""
     return MAJORITY.get(tuple(int(v) for v in nu))
 
 
@@ -117,7 +117,7 @@ def residual_ok(nu: np.ndarray, S: np.ndarray, k: float) -> np.ndarray:
 
 
 def frozen_states(n_states: int, vertical: bool) -> np.ndarray:
-    """(n,) bool gain-row mask of ż = Φ(ẑ) + K (y − H ẑ): rows of a frozen channel are zeroed
+    """(``n_states``,) bool gain-row mask of ż = Φ(ẑ) + K (y − H ẑ): rows of a frozen channel are zeroed
     (those states keep their prediction); ``vertical`` freezes :data:`VERTICAL_STATES`."""
     m = np.zeros(n_states, bool)
     if vertical:

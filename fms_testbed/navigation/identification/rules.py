@@ -68,7 +68,8 @@ def exceeds(a: np.ndarray, b: np.ndarray, sa: np.ndarray, sb: np.ndarray, k: flo
 def ratio(a: np.ndarray, b: np.ndarray, sa: np.ndarray, sb: np.ndarray,
           mask: np.ndarray | None = None) -> np.ndarray:
     """The largest |a − b| / √(σ_a² + σ_b²) over the channels in ``mask`` (..., C) → (...,):
-    the statistic :func:`exceeds` compares with k (dimensionless)."""
+    the statistic :func:`exceeds` compares with k (dimensionless); ``sa``, ``sb`` the σ of
+    ``a``, ``b`` in their units."""
     with np.errstate(invalid="ignore", divide="ignore"):
         r = np.abs(wrapped_difference(a, b)) / np.sqrt(np.square(sa) + np.square(sb))
     if mask is not None:
@@ -105,7 +106,7 @@ def pair_flags(y: np.ndarray, sig: np.ndarray, k: float, live: np.ndarray | None
 
 
 def named_unit(nu: np.ndarray, n_live: np.ndarray | None = None) -> np.ndarray:
-    """Table 1: (R,) index of the source (ν12, ν13, ν23) names as failed, −1 for none; only
+    """Table 1: (R,) index of the source ``nu`` (R, 3) = (ν12, ν13, ν23) names as failed, −1 for none; only
     where ``n_live`` (R,) is 3 when given (two sources cannot name one)."""
     nu = np.asarray(nu, np.int64)
     out = _NAMED[nu[:, 0] + 2 * nu[:, 1] + 4 * nu[:, 2]]
@@ -113,7 +114,8 @@ def named_unit(nu: np.ndarray, n_live: np.ndarray | None = None) -> np.ndarray:
 
 
 def fuse(y: np.ndarray, sig: np.ndarray, w: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """The estimate Ẑ of the output block from the units with ``w`` (R, U) true: the
+    """The estimate Ẑ of the output block from the units' ``y`` (R, U, C) with σ ``sig``
+    (R, U, C) where ``w`` (R, U) is true: the
     inverse-variance weighted mean per channel, σ_Ẑ = (Σ σ_i⁻²)^-½ (units independent);
     the heading is averaged as wrapped offsets from the first unit. Realisations without a
     unit give NaN.
@@ -158,8 +160,8 @@ def three_way(z: np.ndarray, sz: np.ndarray, zhat: np.ndarray, shat: np.ndarray,
 
 
 def vote(flags: np.ndarray, n_units: int) -> np.ndarray:
-    """Majority voting: (R, U) bool, every unit but the one the instant's table 1 names
-    (all units for U < 3 or no name). No persistence, no estimator, no memory."""
+    """Majority voting: (R, U) bool, every unit but the one the instant's table 1 on ``flags``
+    (R, 3) names (all units for ``n_units`` U < 3 or no name). No persistence, no estimator, no memory."""
     R = flags.shape[0]
     out = np.ones((R, n_units), bool)
     if n_units == 3:
