@@ -69,7 +69,8 @@ class TwoStage:
     stat_max : (R, 4) the largest statistic so far, in units of its threshold's σ: stage-1
         output pairs, (unused here: the sensor level, filled by the consumer), stage 2
         |Z_i − Ẑ| of the units in use, innovation window Σ NIS / χ²_{1−α}
-    t_detect_s, t_isolate_s, t_exclude_s : (R,), (R, U), (R, U) first stage-1 detection,
+    t_detect_s, t_isolate_s, t_exclude_s : (R,), (R, U), (R, U) first detection (stage 1, or
+        a stage-2 exclusion),
         isolation and exclusion times, s (NaN: never);  t_estimate_failed_s : (R,) last time
         the estimate failed against its prediction, s
     verdict : (R, U) int, stage 2's table of the last update (:func:`.rules.three_way`)
@@ -128,7 +129,7 @@ class TwoStage:
 
     def innovation_fails(self, t_s: float) -> np.ndarray:
         """(R, U) bool: the windowed χ² test of each unit's innovations over ``window_s``
-        fails at false-alarm probability ``alpha`` (Σ NIS > χ²_{1−α}(Σ dof))."""
+        fails at false-alarm probability ``alpha`` (Σ NIS > innovation_scale × χ²_{1−α}(Σ dof))."""
         buf = self._nis
         while buf and buf[0][0] < t_s - self.tuning.window_s:
             _, n, d = buf.pop(0)
@@ -146,7 +147,7 @@ class TwoStage:
         live = self.used & ~self.gnss_failed[:, None]
         np.maximum(self.stat_max[:, 3], np.where(live, r, 0.0).max(axis=1),
                    out=self.stat_max[:, 3])
-        return r > 1.0
+        return r > self.tuning.innovation_scale
 
     def add_baro_test(self, t_s: float, failed: np.ndarray) -> None:
         """Record the units' baro channel tests at ``t_s`` (s): ``failed`` (R, U) bool where
@@ -272,6 +273,8 @@ class TwoStage:
         self.new_exclude |= which
         self.excluded_by[which] = reason
         self.t_exclude_s[which] = np.fmin(self.t_exclude_s[which], t_s)
+        hit = which.any(axis=1)
+        self.t_detect_s[hit] = np.fmin(self.t_detect_s[hit], t_s)     # detected by stage 2
 
     def _remember(self, t_s, zhat, shat, y) -> None:
         self._last_t = t_s
