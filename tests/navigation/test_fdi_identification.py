@@ -72,8 +72,9 @@ def test_stage_2_excludes_a_survivor_stage_1_does_not_name():
         return out
 
     _steps(core, y, sig, 20.0)
-    assert not core.isolated.any() and np.isnan(core.t_detect_s).all()
+    assert not core.isolated.any() and not core.nu.any()       # stage 1 never named it
     assert core.used.tolist() == [[False, True, True]]
+    assert core.t_detect_s[0] == core.t_exclude_s[0, 0]       # stage 2 detected it
     assert core.excluded_by[0, 0] == BY_TABLE
     assert 12.0 - 1e-9 <= core.t_exclude_s[0, 0] <= 12.5
 
