@@ -37,6 +37,7 @@ from fms_testbed.evaluation.detection_limit import (arl0_samples, cusum_mean_shi
                                                     cusum_variance_s, ramp_s,
                                                     unit_against_others_sigma)
 from fms_testbed.evaluation.montecarlo import synthetic_states
+from fms_testbed.navigation.identification.tuning import FdiTuning
 from fms_testbed.navigation.montecarlo import McConfig, McFault, MonteCarlo, run_chunks
 from fms_testbed.sensors.gnss import GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.presets import load_imu
@@ -114,13 +115,35 @@ def _fmt(t, after_s):
     return f"{med:.1f} / {worst}{miss}" if math.isfinite(med) else f"— / —{miss}"
 
 
+def _tuning(args) -> FdiTuning:
+    """The default tuning, with ``--sensor-test`` (and ``--cusum-h``) if given."""
+    kw = {}
+    if args.sensor_test:
+        kw["sensor_test"] = args.sensor_test
+    if args.cusum_h:
+        kw["cusum_h"] = args.cusum_h
+    return FdiTuning(**kw)
+
+
+def _cli(args) -> str:
+    """The non-default options, as typed."""
+    out = f" --sensor-test {args.sensor_test}" if args.sensor_test else ""
+    return out + (f" --cusum-h {args.cusum_h:g}" if args.cusum_h else "")
+
+
+def _suffix(args) -> str:
+    """File-name suffix of a non-default sensor test."""
+    return "" if args.sensor_test in (None, "window") else f"_{args.sensor_test}"
+
+
 def table(args) -> None:
     imu = load_imu("STIM300")
     lines = ["| fault | T* (s) | detect median / worst (s) | isolate median / worst (s) | "
              "isolate median / T* | wrong source | wall (s) |", "|---|---|---|---|---|---|---|"]
     for label, fault, gspec, tstar, source, after in _rows(imu):
         states = synthetic_states("manoeuvres", FAULT_AT_S + after)
-        cfg = McConfig() if gspec is None else McConfig(gnss=gspec)
+        cfg = McConfig(fdi=_tuning(args)) if gspec is None else McConfig(gnss=gspec,
+                                                                         fdi=_tuning(args))
         t0 = time.perf_counter()
         r = run_chunks(MonteCarlo(states, cfg, seed=0), args.seeds, args.seeds, fault,
                        workers=1)
@@ -131,10 +154,10 @@ def table(args) -> None:
                      f"{ratio:.2f} | {int(wrong.sum())}/{wrong.size} | "
                      f"{time.perf_counter() - t0:.0f} |")
         print(lines[-1], flush=True)
-    out = RESULTS / "detection_limits.md"
+    out = RESULTS / f"detection_limits{_suffix(args)}.md"
     head = (f"Seeds 0-{args.seeds - 1} of run seed 0, fault at t = {FAULT_AT_S:g} s of the "
             f"`manoeuvres` profile (`python bench/bench_detection.py table --seeds "
-            f"{args.seeds}`); T* at {RATE_PER_H:g} false alarms per hour.\n\n")
+            f"{args.seeds}{_cli(args)}`); T* at {RATE_PER_H:g} false alarms per hour.\n\n")
     out.write_text(head + "\n".join(lines) + "\n")
     print(f"wrote {out}")
 
@@ -146,8 +169,8 @@ LAYERS = ("stage-1 output pair |Δ|/σ", "sensor-level |z|", "stage-2 |Z_i − �
 def calibrate(args) -> None:
     states = synthetic_states("manoeuvres", 3600.0)
     t0 = time.perf_counter()
-    r = run_chunks(MonteCarlo(states, McConfig(), seed=args.seed), args.runs, args.chunk,
-                   workers=args.workers)
+    r = run_chunks(MonteCarlo(states, McConfig(fdi=_tuning(args)), seed=args.seed), args.runs,
+                   args.chunk, workers=args.workers)
     per_layer = 3e-4
     lines = ["| layer | max over the set | Gumbel (loc, scale) | threshold at "
              f"{per_layer:g}/h |", "|---|---|---|---|"]
@@ -159,15 +182,16 @@ def calibrate(args) -> None:
         print(lines[-1], flush=True)
     head = (f"Calibration set: realisations 0-{args.runs - 1} of seed {args.seed}, one hour of "
             f"the `manoeuvres` profile each (`python bench/bench_detection.py calibrate --runs "
-            f"{args.runs} --seed {args.seed}`, {time.perf_counter() - t0:.0f} s wall).\n\n")
-    (RESULTS / "fdi_calibration.md").write_text(head + "\n".join(lines) + "\n")
+            f"{args.runs} --seed {args.seed}{_cli(args)}`, {time.perf_counter() - t0:.0f} s "
+            "wall).\n\n")
+    (RESULTS / f"fdi_calibration{_suffix(args)}.md").write_text(head + "\n".join(lines) + "\n")
 
 
 def false_alarms(args) -> None:
     states = synthetic_states("manoeuvres", 3600.0)
     t0 = time.perf_counter()
-    r = run_chunks(MonteCarlo(states, McConfig(), seed=args.seed), args.runs, args.chunk,
-                   workers=args.workers)
+    r = run_chunks(MonteCarlo(states, McConfig(fdi=_tuning(args)), seed=args.seed), args.runs,
+                   args.chunk, workers=args.workers)
     iso = np.isfinite(r.t_isolate_s).any(axis=1)
     exc = np.isfinite(r.t_exclude_s).any(axis=1)
     sens = np.isfinite(r.t_gnss_s) | np.isfinite(r.t_baro_s)
@@ -177,7 +201,8 @@ def false_alarms(args) -> None:
     bound = chi2.ppf(0.95, 2 * k + 2) / 2 / args.runs
     text = (f"Disjoint set: realisations 0-{args.runs - 1} of seed {args.seed}, one hour of the "
             f"`manoeuvres` profile each, default tuning (`python bench/bench_detection.py "
-            f"false-alarms --runs {args.runs} --seed {args.seed} --workers {args.workers}`, "
+            f"false-alarms --runs {args.runs} --seed {args.seed} --workers {args.workers}"
+            f"{_cli(args)}`, "
             f"{time.perf_counter() - t0:.0f} s wall).\n\n"
             "| runs | stage-1 detections | isolations | exclusions | GNSS/baro named | "
             "any false removal | 95 % bound (1/h) |\n|---|---|---|---|---|---|---|\n"
@@ -185,7 +210,7 @@ def false_alarms(args) -> None:
             f"{int(sens.sum())} | {k} | {bound:.2e} |\n")
     if k:
         text += f"\nRealisations with a false removal: {list(np.flatnonzero(anyf))}\n"
-    (RESULTS / "fdi_false_alarms.md").write_text(text)
+    (RESULTS / f"fdi_false_alarms{_suffix(args)}.md").write_text(text)
     print(text)
 
 
@@ -194,12 +219,17 @@ def main() -> None:
     sub = ap.add_subparsers(dest="cmd", required=True)
     t = sub.add_parser("table")
     t.add_argument("--seeds", type=int, default=20)
+    subs = [t]
     for name, runs, seed in (("calibrate", 200, 1000), ("false-alarms", 1000, 2000)):
         c = sub.add_parser(name)
+        subs.append(c)
         c.add_argument("--runs", type=int, default=runs)
         c.add_argument("--seed", type=int, default=seed)
         c.add_argument("--chunk", type=int, default=100)
         c.add_argument("--workers", type=int, default=1)
+    for c in subs:
+        c.add_argument("--sensor-test", choices=("window", "cusum"), default=None)
+        c.add_argument("--cusum-h", type=float, default=None)
     args = ap.parse_args()
     {"table": table, "calibrate": calibrate, "false-alarms": false_alarms}[args.cmd](args)
 

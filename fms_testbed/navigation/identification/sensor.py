@@ -10,6 +10,12 @@ windows (a manoeuvre changes the difference of two healthy units by that much). 
 some |Δ| > k_sensor σ_Δ, tested once both windows are full; windows are counted in samples of
 the interval ``dt_s``. The window statistic is the generalised likelihood-ratio test of a mean
 shift of unknown size in a window (Basseville & Nikiforov 1993, § 2.4).
+
+With ``sensor_test = "cusum"`` the statistic is instead Page's two-sided CUSUM of each sample
+against the reference mean (Basseville & Nikiforov § 2.2, the test Lorden's bound T* is the
+delay of): e = x − μ_ref, σ² = σ_sample² + σ_k² |u − ū_ref|²,
+g± ← max(0, g± + Δ (±e − Δ/2) / σ²), ν_ij = 1 while some g > ``cusum_h``, for a design change
+Δ (``cusum_accel_mps2``, ``cusum_gyro_rps``).
 """
 
 from __future__ import annotations
@@ -48,11 +54,13 @@ class SensorPairTest:
     q_white : (U, 6) white-noise densities: accelerometer VRW² ((m/s²)²·s), gyro ARW² (rad²/s)
     dt_s : sample interval, s
     sf_var : (U, 2) declared scale-factor + 2 × misalignment variance (accelerometer, gyro)
-    tuning : ``k_sensor``, ``accel_window_s``, ``gyro_window_s``, ``reference_s``
+    tuning : ``sensor_test``, ``k_sensor``, ``accel_window_s``, ``gyro_window_s``,
+        ``reference_s``, ``cusum_h``, ``cusum_accel_mps2``, ``cusum_gyro_rps``
 
     Attributes
     ----------
-    last_z : (R, pairs, 6) the last test statistics Δ / σ_Δ (0 before the windows are full)
+    last_z : (R, pairs, 6) the last test statistics Δ / σ_Δ, or the CUSUM max(g+, g-) (0
+        before the windows are full)
     """
 
     def __init__(self, n_real: int, n_units: int, q_white: np.ndarray, dt_s: float,
@@ -72,6 +80,8 @@ class SensorPairTest:
             self.groups.append((_Ring(ns, (n_real, P, 3)), _Ring(nl, (n_real, P, 3)),
                                 _Ring(ns, (3,)), _Ring(nl, (3,))))
         self.last_z = np.zeros((n_real, P, 6))
+        self.g = np.zeros((2, n_real, P, 6))                           # CUSUM g+, g-
+        self.design = np.repeat([tuning.cusum_accel_mps2, tuning.cusum_gyro_rps], 3)
 
     def update(self, errs: np.ndarray, f_mps2, w_rps) -> np.ndarray:
         """Add the raw output errors ``errs`` (R, U, 6: accelerometer m/s², gyro rad/s) with the
@@ -89,6 +99,9 @@ class SensorPairTest:
                 ring.push(v)
             if long_.count < long_.n:
                 continue
+            if self.tuning.sensor_test == "cusum":
+                bad |= self._cusum(g, d[:, :, cols], u, short, long_, us, ul)
+                continue
             ns, nr = short.n, long_.n - short.n
             delta = short.sum / ns - (long_.sum - short.sum) / nr
             du = us.sum / ns - (ul.sum - us.sum) / nr
@@ -96,7 +109,29 @@ class SensorPairTest:
             z = delta / np.sqrt(var)
             self.last_z[:, :, cols] = z
             bad |= (np.abs(z) > self.tuning.k_sensor).any(axis=2)
-        out = np.zeros((d.shape[0], 3), bool)
+        return self._by_pair(bad)
+
+    def _cusum(self, g: int, x, u, short, long_, us, ul) -> np.ndarray:
+        """One CUSUM step of group ``g`` (0 accelerometers, 1 gyros) on the samples ``x``
+        (R, pairs, 3) against the reference window's mean; (R, pairs) bool alarms."""
+        cols = slice(3 * g, 3 * g + 3)
+        nr = long_.n - short.n
+        mu = (long_.sum - short.sum) / nr
+        du = u - (ul.sum - us.sum) / nr
+        var = self.var[:, cols] + self.sf[:, cols] * float(du @ du)
+        dd = self.design[cols]
+        e = x - mu
+        gp, gm = self.g[0][..., cols], self.g[1][..., cols]
+        np.maximum(gp + dd * (e - 0.5 * dd) / var, 0.0, out=gp)
+        np.maximum(gm + dd * (-e - 0.5 * dd) / var, 0.0, out=gm)
+        stat = np.maximum(gp, gm)
+        self.g[0][..., cols], self.g[1][..., cols] = gp, gm
+        self.last_z[:, :, cols] = stat
+        return (stat > self.tuning.cusum_h).any(axis=2)
+
+    def _by_pair(self, bad: np.ndarray) -> np.ndarray:
+        """(R, pairs) → (R, 3) in the order of :data:`.rules.PAIRS`."""
+        out = np.zeros((bad.shape[0], 3), bool)
         for p, pair in enumerate(self.pairs):
             out[:, PAIRS.index(pair)] = bad[:, p]
         return out

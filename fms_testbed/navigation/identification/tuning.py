@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from fms_testbed.core.errors import ConfigError
+
 
 @dataclass(frozen=True)
 class FdiTuning:
@@ -17,7 +19,11 @@ class FdiTuning:
     window_s : stage-2 innovation window, s;  alpha : its false-alarm probability per test
     innovation_scale : the window test fails when Σ NIS > innovation_scale × χ²_{1−α}(Σ dof)
         (the innovations are not white: GNSS Markov errors, unmodelled sensor errors)
+    sensor_test : the sensor-level statistic: ``"window"`` (window-mean difference against
+        ``k_sensor`` σ) or ``"cusum"`` (Page's CUSUM against ``cusum_h``)
     k_sensor : sensor-level step threshold in σ of the window-mean difference
+    cusum_h : CUSUM threshold (log-likelihood ratio, dimensionless)
+    cusum_accel_mps2, cusum_gyro_rps : the CUSUM's design change Δ, m/s² and rad/s
     accel_window_s, gyro_window_s : short windows of the sensor-level step test, s
     reference_s : the reference window before the short one, s
     k_residual : the fault-tolerant estimator's ε_i = k_residual √S_ii for |y_i − ŷ_i| ≤ ε_i
@@ -45,7 +51,11 @@ class FdiTuning:
     window_s: float = 10.0
     alpha: float = 1e-6
     innovation_scale: float = 1.1
+    sensor_test: str = "window"
     k_sensor: float = 6.3
+    cusum_h: float = 20.0
+    cusum_accel_mps2: float = 0.75e-3 * 9.80665
+    cusum_gyro_rps: float = 22.0 * 3.141592653589793 / 180.0 / 3600.0
     accel_window_s: float = 1.0
     gyro_window_s: float = 10.0
     reference_s: float = 60.0
@@ -55,6 +65,11 @@ class FdiTuning:
     switch_noise: float = 1e4
     diverge_gamma: float = 25.0
     diverge_count: int = 5
+
+
+    def __post_init__(self):
+        if self.sensor_test not in ("window", "cusum"):
+            raise ConfigError(f"fdi.sensor_test: {self.sensor_test!r}; choose window or cusum")
 
 
 __all__ = ["FdiTuning"]
