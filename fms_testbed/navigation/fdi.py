@@ -361,7 +361,7 @@ class FaultTolerantEstimator:
         self.vertical_frozen[i] = frozen
         f = self.filters[i]
         if hasattr(f, "frozen"):
-            f.frozen = frozen_states(f.P.shape[0], frozen)
+            f.frozen[:] = frozen_states(f.frozen.size, frozen)
         return [_event(t_s, self._unit(i, "ins"), "reconfigured", "estimator",
                        "vertical channel frozen and excluded: no altitude measurement"
                        if frozen else "vertical channel released: altitude measured")]
