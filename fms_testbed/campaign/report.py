@@ -137,7 +137,8 @@ def residual(df: pd.DataFrame) -> dict:
     n = len(tried)
     lo, hi = wilson_interval(k, n)
     return {"flown": n, "residual_errors": k, "rate": k / n if n else float("nan"),
-            "ci_low": lo, "ci_high": hi, "class3": int((df["status"] == "degraded").sum())}
+            "ci_low": lo, "ci_high": hi, "class3": int(((df["status"] == "degraded")
+                                   | (df["monitor_status"] == "coding_suspect")).sum())}
 
 
 def phase_row(folder: Path, df: pd.DataFrame, info: dict) -> dict:

@@ -32,7 +32,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from fms_testbed.campaign.rows import add_sequence, failed_row, flown_row
+from fms_testbed.campaign.rows import add_path_errors, add_sequence, failed_row, flown_row
 from fms_testbed.core.errors import UserError
 from fms_testbed.procedures.index import DatabaseIndex, load_index
 
@@ -257,6 +257,7 @@ def fly_on(case, db, db_path: str, timeout_s: float | None = None,
     stage[0] = "evaluating the flight"
     res = results_of(flight)
     row = flown_row(case, res.summary)
+    add_path_errors(row, res.df, prepared.path.path.profile)
     return row, res
 
 

@@ -43,6 +43,7 @@ COMMAND_MODULES = (
     "fms_testbed.cli.imu_test",     # imu-test
     "fms_testbed.cli.regress",      # regress run / diff / report
     "fms_testbed.cli.montecarlo",   # montecarlo
+    "fms_testbed.cli.nav_replay",   # nav-replay
 )
 
 

@@ -57,7 +57,8 @@ def cmd_fly(args) -> int:
     from fms_testbed.evaluation.outcome import EXIT_CODES
     from fms_testbed.run.api import run_scenario
 
-    overrides = overrides_from_args(args)
+    from fms_testbed.cli.run import with_truth_model
+    overrides = with_truth_model(overrides_from_args(args), args)
     if args.takeoff:
         overrides.setdefault("procedure", {})["start"] = "takeoff"
     res = run_scenario(scenario, seed=args.seed, overrides=overrides, progress=None)
@@ -96,6 +97,8 @@ def register(sub) -> None:
     p.add_argument("--transition", help="en-route (SID/STAR) or approach transition")
     p.add_argument("--runway", help="runway, e.g. 34R (SID/STAR runway transition)")
     add_override_options(p)
+    from fms_testbed.cli.run import add_truth_model_option
+    add_truth_model_option(p)
     p.add_argument("--takeoff", action="store_true",
                    help="SIDs: start at rest on the runway threshold with a takeoff roll "
                         "(procedure.start: takeoff; default: airborne over the runway end)")

@@ -85,7 +85,11 @@ def config_from_args(args):
                             "set)")
         sets = read_conditions(args.conditions)
     else:
-        sets = command_line_sets(_winds(args.wind), _navs(args.nav, args.imu),
+        navs = _navs(args.nav, args.imu)
+        if getattr(args, "truth_model", None):
+            navs = [n if n["source"] == "truth" else {**n, "truth_model": args.truth_model}
+                    for n in navs]
+        sets = command_line_sets(_winds(args.wind), navs,
                                  [parse_isa_dev(v) for v in args.isa_dev_c or []] or None,
                                  missed=args.missed)
     if args.sample_airports is None and (args.sample_seed is not None
@@ -228,6 +232,8 @@ def _add_run(rs) -> None:
                    help="navigation sources: truth or SOURCE[:PRESET], e.g. sins:HG1700, "
                         "ins_gnss:STIM300 (default truth)")
     r.add_argument("--imu", help="IMU preset for --nav sins")
+    from fms_testbed.cli.run import add_truth_model_option
+    add_truth_model_option(r)
     r.add_argument("--conditions", metavar="FILE.yaml",
                    help="condition sets from a YAML file (instead of --wind/--isa-dev-c/--nav)")
     r.add_argument("--missed", action="store_true",
