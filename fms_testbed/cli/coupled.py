@@ -187,7 +187,12 @@ def _compare_envelope(args, laws) -> int:
 # --- analyse -----------------------------------------------------------------------------------
 
 def cmd_analyse(args) -> int:
-    """Linear analysis of the closed loop: decoupling, poles, Bode and step plots with lags."""
+    """Linear analysis of the closed loop: decoupling, poles, Bode and step plots with lags
+    (``--plant jsbsim``: :func:`fms_testbed.cli.tune_envelope.cmd_analyse_jsbsim`)."""
+    if getattr(args, "plant", "pointmass") == "jsbsim":
+        from fms_testbed.cli.tune_envelope import cmd_analyse_jsbsim
+
+        return cmd_analyse_jsbsim(args)
     from fms_testbed.control import linear
     from fms_testbed.control.coupled_law import params_from_config
     from fms_testbed.viz.control import plot_bode_coupling, plot_linear_steps
@@ -259,7 +264,12 @@ def cmd_analyse(args) -> int:
 # --- tune ----------------------------------------------------------------------------------
 
 def cmd_tune(args) -> int:
-    """Optimise the law's (T, ξ) on JSBSim; write gains, report and plots."""
+    """Optimise the law's (T, ξ) on JSBSim; write gains, report and plots
+    (``--envelope``: :func:`fms_testbed.cli.tune_envelope.cmd_tune_envelope`)."""
+    if getattr(args, "envelope", False):
+        from fms_testbed.cli.tune_envelope import cmd_tune_envelope
+
+        return cmd_tune_envelope(args)
     from fms_testbed.viz.control import plot_tuning_overlay
     from fms_testbed.viz.figure import save
     from fms_testbed.evaluation.law_tuning import (OperatingPoint, gains_yaml, linear_prediction, tune,
@@ -326,6 +336,12 @@ def cmd_tune(args) -> int:
 
 def register(subparsers) -> None:
     """Add ``compare``, ``analyse`` and ``tune`` to the ``fms-testbed`` parser."""
+    _register_compare(subparsers)
+    _register_analyse(subparsers)
+    _register_tune(subparsers)
+
+
+def _register_compare(subparsers) -> None:
     p = subparsers.add_parser(
         "compare", help="coupled law vs baselines on JSBSim: table, goals, plots",
         description="Fly scenarios with the coupled law and the baselines (PI autothrottle, TECS) "
@@ -354,6 +370,8 @@ def register(subparsers) -> None:
     add_overwrite_option(p)
     p.set_defaults(func=cmd_compare)
 
+
+def _register_analyse(subparsers) -> None:
     p = subparsers.add_parser(
         "analyse", help="linear analysis of the coupled law (python-control)",
         description="Closed-loop transfer matrix W(p) of the linearised point mass + law: "
@@ -369,8 +387,14 @@ def register(subparsers) -> None:
     p.add_argument("--dv", type=float, default=50.0, help="speed step for the plots, km/h")
     p.add_argument("--out", help="output folder (default results/analyse-<aircraft>-<time>)")
     add_overwrite_option(p)
+    p.add_argument("--plant", choices=("pointmass", "jsbsim"), default="pointmass",
+                   help="jsbsim: linearise the trimmed JSBSim aircraft (FGLinearization), print "
+                        "its modes checked against the nonlinear model, the loops' margins and "
+                        "the point-mass comparison")
     p.set_defaults(func=cmd_analyse)
 
+
+def _register_tune(subparsers) -> None:
     p = subparsers.add_parser(
         "tune", help="tune the coupled law's (T_V, xi_V, T_H, xi_H) on JSBSim",
         description="Bounded Nelder-Mead over (T_V, xi_V, T_H, xi_H) on the JSBSim closed loop "
@@ -386,6 +410,16 @@ def register(subparsers) -> None:
     p.add_argument("--plant", choices=("jsbsim", "pointmass"), default="jsbsim")
     p.add_argument("--write", action="store_true",
                    help="write the tuned coupled_law block into the aircraft's YAML file")
+    p.add_argument("--envelope", action="store_true",
+                   help="tune over a grid of design points into a gain schedule in (dynamic "
+                        "pressure, mass): margins on every loop, robustness, nonlinear checks; "
+                        "writes points.csv, schedule.yaml, aircraft.yaml, report.md, figures")
+    p.add_argument("--grid", metavar="FILE.yaml",
+                   help="with --envelope: design points (points: [{alt_m, tas_mps, mass_kg, "
+                        "config: clean|approach}]) instead of the default grid")
+    p.add_argument("--workers", type=int, default=2, help="with --envelope: local processes")
+    p.add_argument("--no-robust", action="store_true",
+                   help="with --envelope: skip the robustness set (mass, CG, actuator delay)")
     p.add_argument("--out", help="output folder (default results/tune-<aircraft>-<time>)")
     add_overwrite_option(p)
     p.set_defaults(func=cmd_tune)

@@ -49,6 +49,9 @@ from fms_testbed.core.earth import A_M, OMEGA_IE_RPS, normal_gravity_mps2
 from fms_testbed.core.state import AircraftState
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.atmosphere import isa
+from fms_testbed.control.schedule import (REFRESH_REL, GainSchedule, qbar_from_state,
+                                          schedule_from_points)
 
 _SAT_EPS = 0.005
 """Throttle within this of a limit counts as saturated (normalised throttle)."""
@@ -112,6 +115,14 @@ class CoupledLawParams:
     def vy_limit_mps(self) -> float:
         """Steady climb/descent rate of the level-change mode, ``dH_limit / (2 ξ_H T_H)``, m/s."""
         return self.dH_limit_m / (2.0 * self.xi_H * self.T_H_s)
+
+
+def schedule_from_config(cfg: AircraftConfig) -> GainSchedule | None:
+    """The aircraft's ``coupled_law_schedule`` as a :class:`GainSchedule` (None when absent)."""
+    sc = cfg.coupled_law_schedule
+    if sc is None:
+        return None
+    return schedule_from_points([p.model_dump() for p in sc.points])
 
 
 def params_from_config(cfg: AircraftConfig, **overrides) -> CoupledLawParams:
@@ -288,13 +299,27 @@ class CoupledLaw:
     name = "coupled"
 
     def __init__(self, aircraft_cfg: AircraftConfig | None = None,
-                 params: CoupledLawParams | None = None):
+                 params: CoupledLawParams | None = None, schedule: GainSchedule | None = None):
         if params is None:
             if aircraft_cfg is None:
                 raise ValueError("CoupledLaw needs an aircraft config or params")
             params = params_from_config(aircraft_cfg)
+            schedule = schedule or schedule_from_config(aircraft_cfg)
         self.params = params
+        self.schedule = schedule
         self.state = CoupledLawState()
+
+    def _follow_schedule(self, state: AircraftState) -> None:
+        """Take the scheduled (T_V, ξ_V, T_H, ξ_H, τ_ny-trim) at the measured q̄ and mass when one of
+        them moved by more than ``REFRESH_REL`` (:mod:`fms_testbed.control.schedule`)."""
+        ps, ts = float(state.p_static_pa), float(state.t_static_k)
+        if not (math.isfinite(ps) and math.isfinite(ts)):
+            ts, ps, _ = isa(float(state.alt_m))
+        want = self.schedule.values(qbar_from_state(float(state.tas_mps), ps, ts),
+                                    float(state.mass_kg))
+        p = self.params
+        if any(abs(v - getattr(p, k)) > REFRESH_REL * abs(getattr(p, k)) for k, v in want.items()):
+            self.params = replace(p, **want)
 
     def reset(self) -> None:
         """Forget the run-time state (the next update re-engages)."""
@@ -325,6 +350,8 @@ class CoupledLaw:
             for the n_y trim: the law uses the vertical-plane component n_y cos φ)
         alt_cmd_m : altitude target, m;  tas_cmd_mps : true-airspeed target, m/s
         """
+        if self.schedule is not None:
+            self._follow_schedule(state)
         p, st = self.params, self.state
         if not st.engaged:
             self.engage(state, alt_cmd_m, tas_cmd_mps)

@@ -132,7 +132,7 @@ class Performance:
     def from_aircraft(cls, ac) -> "Performance":
         """Take the limits of an :class:`~fms_testbed.config.aircraft.AircraftConfig`."""
         lim = ac.limits
-        return cls(tas_plan_mps=lim.climb_tas_mps, tas_min_mps=lim.cas_min_mps,
+        return cls(tas_plan_mps=lim.climb_cas_mps, tas_min_mps=lim.cas_min_mps,
                    climb_gradient_max=lim.climb_gradient_max,
                    climb_rate_max_mps=lim.climb_rate_max_mps,
                    descent_rate_max_mps=lim.descent_rate_max_mps, bank_max_deg=lim.bank_max_deg,

@@ -120,12 +120,19 @@ def has_piston_engines(model: str) -> bool:
     return False
 
 
+BALLAST_XML = ('<pointmass name="fms-ballast"><weight unit="LBS">0</weight>'
+               '<location unit="IN"><x>0</x><y>0</y><z>0</z></location></pointmass>')
+"""The point mass every sanitised model carries (weight 0: no effect until a design point
+sets its weight and position, :func:`fms_testbed.sim.linearise.set_mass_and_cg`)."""
+
+
 def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None,
                             frames_per_update: int = 1) -> Path:
     """Copy ``model`` from the jsbsim wheel into the sandbox without I/O elements.
 
     Returns the sandbox's ``aircraft`` folder (to pass to ``set_aircraft_path``). Removes every
-    top-level ``<input>`` and ``<output>`` element and appends the inner-loop ``<system>``
+    top-level ``<input>`` and ``<output>`` element, adds the zero-weight ballast point mass
+    (:data:`BALLAST_XML`) and appends the inner-loop ``<system>``
     (not when ``elevator_rate_max_ps`` is None: the bare model, for benchmarks), updated every
     ``frames_per_update`` frames.
     """
@@ -147,6 +154,9 @@ def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None,
             root.remove(el)
             removed += 1
     n_eng = len(root.findall("./propulsion/engine"))
+    mb = root.find("mass_balance")
+    if mb is not None:     # zero-weight ballast, moved by design points for CG shifts
+        mb.append(ET.fromstring(BALLAST_XML))
     if elevator_rate_max_ps:
         root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S, frames_per_update,
                                              piston=has_piston_engines(model))))
