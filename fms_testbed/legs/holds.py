@@ -82,6 +82,29 @@ def _hold_frame(f, inbound: float, lat: float, lon: float) -> tuple[float, float
     return x * math.cos(a) - y * math.sin(a), x * math.sin(a) + y * math.cos(a)
 
 
+def _entry_theta_deg(r_m: float, x0_m: float, leg_m: float) -> float:
+    """The outbound heading offset θ (deg, bisection in −60°..90°) for which the final turn
+    of radius R ends on the inbound line: R (1 + cos θ) − x₀ = L sin θ (``x0_m`` the lateral
+    offset toward the σ side where the outbound leg starts, L = ``leg_m``); the nearer bound
+    when there is no root there."""
+    def miss(t: float) -> float:
+        rt = math.radians(t)
+        return r_m * (1.0 + math.cos(rt)) - x0_m - leg_m * math.sin(rt)
+
+    lo, hi = -60.0, 90.0
+    if miss(lo) * miss(hi) > 0:
+        return lo if abs(miss(lo)) < abs(miss(hi)) else hi
+    m_lo = miss(lo)
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        m_mid = miss(mid)
+        if m_lo * m_mid > 0:
+            lo, m_lo = mid, m_mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
 def _entry(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: float
            ) -> tuple[FlightState, bool]:
     """Hold entry from over the fix, ending over the fix on the inbound course.
@@ -118,19 +141,7 @@ def _entry(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: floa
     theta = 0.0
     for _ in range(3):
         st, x0 = first_turn(theta)
-
-        def miss(t: float) -> float:
-            rt = math.radians(t)
-            return r * (1.0 + math.cos(rt)) - sigma * x0 - leg_m * math.sin(rt)
-
-        lo, hi = -60.0, 90.0
-        if miss(lo) * miss(hi) > 0:
-            theta = lo if abs(miss(lo)) < abs(miss(hi)) else hi
-        else:
-            for _ in range(40):
-                mid = 0.5 * (lo + hi)
-                lo, hi = (mid, hi) if miss(lo) * miss(mid) > 0 else (lo, mid)
-            theta = 0.5 * (lo + hi)
+        theta = _entry_theta_deg(r, sigma * x0, leg_m)
     st, x0 = first_turn(theta)
     # the straight that puts the final turn's end on the inbound line (planar, exact heading)
     psi = math.radians(wrap360(st.track_deg - inbound))
@@ -288,6 +299,28 @@ class PI(Leg):
         return wrap360(c + (45.0 if d == "R" else -45.0)), None
 
     @classmethod
+    def _size(cls, b: LegBuilder, x_next: float | None, limit: float, timed: float,
+              gmax: float) -> tuple:
+        """The manoeuvre's sizes at the planned bank, else at ``gmax`` (class docstring):
+        (bank deg or None for the planned one, R m, the 45° leg m, d₁ least m, d₁ most m, and
+        the far point's offsets a, b m)."""
+        for bank in (None, gmax):
+            if bank is not None:
+                b.radius_m = turn_radius_m(b.speed_mps + b.wind_mps, bank, b.g)
+            r = b.radius_m
+            leg45 = max(timed, 2.2 * r)
+            d_min = max(0.0, (x_next or 0.0) + cls.INBOUND_MIN_M + r * math.tan(
+                math.radians(22.5)) - 3.243 * r)
+            # farthest point: the far side of the 180° turn, |C₂| + R from the fix, with
+            # C₂ = (d₁ + 1.414 R + 0.707 L₁, 0.707 L₁ − 0.414 R) in (outbound, 45° side)
+            a_m, b_m = 1.414 * r + 0.707 * leg45, 0.707 * leg45 - 0.414 * r
+            reach = max(limit - r, 0.0) ** 2 - b_m * b_m
+            d_max = math.sqrt(reach) - a_m if reach > 0 else -math.inf
+            if d_min <= d_max:
+                break
+        return bank, r, leg45, d_min, d_max, a_m, b_m
+
+    @classmethod
     def build(cls, b, s):
         f, c = fix_of(b), course_of(b)
         d = b.turn_dir() or "L"
@@ -303,20 +336,7 @@ class PI(Leg):
         limit = b.leg.rec.distance_m or 10 * NM_M
         timed = 60.0 * timed_speed_mps(b)
         gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
-        for bank in (None, gmax):
-            if bank is not None:
-                b.radius_m = turn_radius_m(b.speed_mps + b.wind_mps, bank, b.g)
-            r = b.radius_m
-            leg45 = max(timed, 2.2 * r)
-            d_min = max(0.0, (x_next or 0.0) + cls.INBOUND_MIN_M + r * math.tan(
-                math.radians(22.5)) - 3.243 * r)
-            # farthest point: the far side of the 180° turn, |C₂| + R from the fix, with
-            # C₂ = (d₁ + 1.414 R + 0.707 L₁, 0.707 L₁ − 0.414 R) in (outbound, 45° side)
-            a_m, b_m = 1.414 * r + 0.707 * leg45, 0.707 * leg45 - 0.414 * r
-            reach = max(limit - r, 0.0) ** 2 - b_m * b_m
-            d_max = math.sqrt(reach) - a_m if reach > 0 else -math.inf
-            if d_min <= d_max:
-                break
+        bank, r, leg45, d_min, d_max, a_m, b_m = cls._size(b, x_next, limit, timed, gmax)
         fits = d_min <= d_max
         if bank is not None and fits:
             b.finding("correction", f"procedure turn at {f.ident} kept within "

@@ -222,28 +222,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
                             path_climb_top_m(seq.proc_type, params.climb_top_m),
                             perf.alt_plan_max_m)
     for i, leg in enumerate(legs):
-        b.i = i
-        b.alt_cap_m = float(alt_caps[i + 1])
-        if leg.rec.missed_approach_start:
-            b.climbing = True
-        speed_in = b.speed_mps if i else None
-        # the conditions at the leg's planned altitude (a wind profile: its wind there)
-        alt_plan = state.alt_m   # the builder's planned altitude at the leg's start
-        b.params = params.for_altitude(alt_plan)
-        if b.climbing and leg_cls_hold(leg) and params.climb_top_m is not None:
-            # a hold in a climb is flown from here up to the climb top (guidance climbs on to
-            # it; an HA is left only at the end of a circuit): its turns are planned for the
-            # TAS at the top (constant CAS: the largest) and the strongest wind on the way
-            top = max(alt_plan, min(params.climb_top_m, b.alt_cap_m))
-            b.params = params.for_band(alt_plan, top)
-            alt_plan = top
-        b.leg_params[i] = b.params
-        b.leg_alt_m[i] = alt_plan
-        b.speed_mps = planned_speed_mps(perf, leg, alt_plan, caps[i], params.isa_dev_c)
-        b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
-        # a turn at the start of the leg is entered at the previous leg's speed: plan its radius
-        # for the faster of the two
-        b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank, g)
+        _plan_leg(b, i, state.alt_m, float(alt_caps[i + 1]), caps[i], bank)
         start_st = state
         leg_cls = LEG_TYPES[leg.pt]
         try:
@@ -263,15 +242,49 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     out = replace(path, legs=tuple(built), segments=tuple(segs),
                   findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
     if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
-        # an arrival starts on the descent path planned back from its last constraint, not
-        # above it at its first coded altitude (an 'at or below' far above the next fixes)
-        alt = arrival_join_alt_m(out, params.descent_angle_deg, perf.tas_plan_mps,
-                                 PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
-                                 params.isa_dev_c)
-        if alt is not None and alt < state0.alt_m - 30.0:
+        alt = _arrival_start_m(out, perf, params, state0.alt_m)
+        if alt is not None:
             again = build_sequence(db, seq, perf, params, start=replace(state0, alt_m=alt))
             return replace(again, start_kind=kind)
     return out
+
+
+def _arrival_start_m(path: ProcedurePath, perf: Performance, params: BuildParams,
+                     alt0_m: float) -> float | None:
+    """The altitude an arrival built from ``alt0_m`` (m) is built again from, m, or None: it
+    starts on the descent path planned back from its last constraint
+    (:func:`~fms_testbed.path.profile.arrival_join_alt_m`), not above it at its first coded
+    altitude (an 'at or below' far above the next fixes)."""
+    alt = arrival_join_alt_m(path, params.descent_angle_deg, perf.tas_plan_mps,
+                             PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps, params.isa_dev_c)
+    return alt if alt is not None and alt < alt0_m - 30.0 else None
+
+
+def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
+              cas_cap_mps: float | None, bank_deg: float) -> None:
+    """Set the builder up for leg ``i`` planned from ``alt_m`` (m): its climb cap (m), its
+    settings (the wind at its planned altitude; a hold in a climb: the strongest up to the
+    climb top, planned at the top), its planned speed (m/s, under ``cas_cap_mps``), climb
+    gradient and turn radius R = V²/(g tan γ) at ``bank_deg`` — for the faster of this leg
+    and the one before (a turn at its start is entered at the previous leg's speed)."""
+    leg, params, perf = b.legs[i], b.params0, b.perf
+    b.i, b.alt_cap_m = i, alt_cap_m
+    if leg.rec.missed_approach_start:
+        b.climbing = True
+    speed_in = b.speed_mps if i else None
+    alt_plan = alt_m
+    b.params = params.for_altitude(alt_plan)
+    if b.climbing and leg_cls_hold(leg) and params.climb_top_m is not None:
+        # guidance climbs on to the top in the hold (an HA is left only at the end of a
+        # circuit): its turns are planned for the TAS at the top (constant CAS: the largest)
+        top = max(alt_plan, min(params.climb_top_m, b.alt_cap_m))
+        b.params = params.for_band(alt_plan, top)
+        alt_plan = top
+    b.leg_params[i] = b.params
+    b.leg_alt_m[i] = alt_plan
+    b.speed_mps = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
+    b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
+    b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank_deg, b.g)
 
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
