@@ -33,6 +33,7 @@ from fms_testbed.legs.types import LEG_TYPES, LegError
 from fms_testbed.legs.model import (BuildParams, BuiltLeg, Finding, FlightState, Performance, PathSegment,
                     approach_cas_caps, max_tailwind_mps,
                     ProcedurePath, isa_tas_mps, turn_radius_m)
+from fms_testbed.legs.moves import join_course
 
 
 
@@ -372,7 +373,6 @@ def _line_line_corner(b: LegBuilder, out: list[PathSegment], seg: PathSegment, k
     fix = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
     if r * t > l_avail:
         r_geom = l_avail / t
-        b.i = a.leg_index
         why = conditions_text(v, w, cp.isa_dev_c, b.leg_alt_m.get(seg.leg_index, 0.0), r,
                               l_avail / t, bank_deg, b.g)
         if r_geom <= 1.0:
@@ -381,14 +381,16 @@ def _line_line_corner(b: LegBuilder, out: list[PathSegment], seg: PathSegment, k
         g_reg = math.degrees(math.atan((v + w) ** 2 / (r_geom * b.g)))
         if g_reg <= gmax:
             b.finding("correction", f"fly-by at {fix}: radius {r:.0f} -> {r_geom:.0f} m, "
-                      f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°){why}", "R")
+                      f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°){why}", "R",
+                      leg_index=a.leg_index)
             r, bank = r_geom, g_reg
         else:
             v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax))) - w
             if v_reg >= perf.tas_min_mps:
                 b.finding("correction", f"fly-by at {fix}: speed {v / KT_MPS:.0f} -> "
                           f"{v_reg / KT_MPS:.0f} kt, bank {gmax:.0f}°, radius "
-                          f"{r_geom:.0f} m (turn {omega:+.0f}°){why}", "V,γ")
+                          f"{r_geom:.0f} m (turn {omega:+.0f}°){why}", "V,γ",
+                          leg_index=a.leg_index)
                 r, bank, v = r_geom, gmax, v_reg
             else:
                 # flown over at the bank limit and the speed flown there: slowing down
@@ -503,9 +505,9 @@ def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
             res.append(replace(seg, geom=f.gap, role="connector"))
         res.append(replace(seg, geom=f.arc))
         if bank > bank_deg:
-            b.i = seg.leg_index
             b.finding("correction", f"fly-by onto the {seg.path_term} arc: bank "
-                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ")
+                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ",
+                      leg_index=seg.leg_index)
         return res
     return [seg]
 
@@ -537,9 +539,9 @@ def _arc_line_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
         if f.line is not None:
             res.append(replace(seg, geom=f.line))
         if bank > bank_deg:
-            b.i = a.leg_index
             b.finding("correction", f"fly-by off the {a.path_term} arc at {a.fix_ident}: bank "
-                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ")
+                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ",
+                      leg_index=a.leg_index)
         return res
     omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
     return _flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g))
@@ -553,7 +555,7 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
     b.finding("correction", f"fly-by at {at} (turn {omega:+.0f}°) "
               f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
-              "V,γ,φ,λ")
+              "V,γ,φ,λ", leg_index=a.leg_index)
     lat, lon = a.geom.end
     end = seg.geom.end
     # rejoin the next line's own course before its end, so that the legs built after it (which
@@ -567,7 +569,7 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     tmp.climbing = False
     target = Fix(ident=seg.fix_ident, region="", section="", lat_deg=end[0], lon_deg=end[1])
     state = FlightState(lat, lon, a.geom.end_course_deg, 0.0, flyby=False)
-    tmp.join_course(state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
+    join_course(tmp, state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
     if depth == 0:
         segs = round_corners(tmp, b.perf, b.params, math.degrees(math.atan(
             (v_turn + b.wind_mps) ** 2 / (r * b.g))), depth=1)
