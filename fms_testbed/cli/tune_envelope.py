@@ -32,7 +32,7 @@ FIGURES = ("nichols.png", "bode-worst.png", "steps.png", "schedule.png")
 
 
 def goal_lines(df: pd.DataFrame) -> list[tuple[bool, str]]:
-    """(met, text) of the envelope goals over every trimmed point of ``points.csv``."""
+    """(met, text) of the envelope goals over every trimmed point of ``df`` (``points.csv``)."""
     from fms_testbed.evaluation.envelope_points import GM_MIN_DB, PM_MIN_DEG
 
     ok = df[df["gm_min_db"].notna()]
@@ -70,7 +70,8 @@ def _schedule_curves(res) -> dict[str, pd.DataFrame]:
 
 
 def write_figures(res, name: str, tmp: Path) -> None:
-    """Nichols (all points), Bode at the smallest-PM point, steps at the worst points, schedule."""
+    """Write into ``tmp`` the figures of ``res`` for aircraft ``name``: Nichols (all points),
+    Bode at the smallest-PM point, steps at the worst points, the schedule."""
     from fms_testbed.evaluation.envelope_tuning import FIG_OMEGA_RPS
     from fms_testbed.control.loops import BREAKS
     from fms_testbed.viz.figure import save

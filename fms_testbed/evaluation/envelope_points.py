@@ -62,7 +62,8 @@ _OMEGA = np.logspace(-3, 2, 400)
 
 
 def qbar_ratio(cfg: AircraftConfig, qbar_pa: float) -> float:
-    """q̄_ref / q̄ of the inner loops' schedule (reference: the aircraft's default condition)."""
+    """q̄_ref / q̄ of the inner loops' schedule at ``qbar_pa`` (Pa); the reference is the aircraft
+    ``cfg``'s default condition."""
     _, _, rho = isa(cfg.default_condition.alt_m)
     return 0.5 * float(rho) * cfg.default_condition.tas_mps ** 2 / qbar_pa
 
@@ -81,8 +82,9 @@ def point_loops(cfg: AircraftConfig, model: AirframeModel, law: CoupledLawParams
 
 
 def freq_response(sys, omega_rps: np.ndarray) -> np.ndarray:
-    """SISO frequency response C (jωI - A)⁻¹ B + D on ``omega_rps`` (rad/s), via the
-    eigen-decomposition of A (vectorised over ω)."""
+    """SISO frequency response C (jωI - A)⁻¹ B + D of ``sys`` on ``omega_rps`` (rad/s), via the
+    eigen-decomposition of A (vectorised over ω; for diagonalisable A, as the longitudinal
+    loops are)."""
     A, B, C, D = (np.asarray(m) for m in (sys.A, sys.B, sys.C, sys.D))
     lam, V = np.linalg.eig(A)
     cb = (C @ V).ravel() * np.linalg.solve(V, B).ravel()
@@ -90,8 +92,9 @@ def freq_response(sys, omega_rps: np.ndarray) -> np.ndarray:
 
 
 def grid_margins(L, omega_rps: np.ndarray = _OMEGA) -> tuple[float, float, float]:
-    """(GM dB, PM deg, disk margin α) of a loop transfer from its response on a grid: GM at the
-    phase crossovers (Im L changes sign with Re L < 0), PM at |L| = 1, α = min 2|1+L|/|1-L|."""
+    """(GM dB, PM deg, disk margin α) of a loop transfer ``L`` from its response on the grid
+    ``omega_rps`` (rad/s): GM at the phase crossovers (Im L changes sign with Re L < 0), PM at
+    |L| = 1, α = min 2|1+L|/|1-L|."""
     h = freq_response(L, omega_rps)
     cross = np.flatnonzero((np.sign(h.imag[:-1]) != np.sign(h.imag[1:])) & (h.real[:-1] < 0))
     gms = [abs(20 * math.log10(abs(h.real[i]))) for i in cross if h.real[i] != 0]
@@ -113,7 +116,8 @@ def step_matrices(sys, dt_s: float = _DT_S) -> tuple[np.ndarray, np.ndarray]:
 
 
 def step_outputs(sys, u: np.ndarray, t_end_s: float = T_STEP_S, dt_s: float = _DT_S) -> np.ndarray:
-    """Outputs (time × outputs) of ``sys`` for a constant input vector ``u`` from rest."""
+    """Outputs (time × outputs) of ``sys`` for a constant input vector ``u`` from rest, every
+    ``dt_s`` seconds up to ``t_end_s`` seconds."""
     Phi, Gam = step_matrices(sys, dt_s)
     C, D = np.asarray(sys.C), np.asarray(sys.D)
     n = int(t_end_s / dt_s)

@@ -55,7 +55,7 @@ FIG_OMEGA_RPS = np.logspace(-2.5, 1.7, 300)
 
 
 def loaded_mass_kg(cfg: AircraftConfig) -> float:
-    """The JSBSim model's loaded mass, kg (its file's fuel and payload)."""
+    """The loaded mass of the aircraft ``cfg``'s JSBSim model, kg (its file's fuel and payload)."""
     from fms_testbed.sim.jsbsim_core import JSBSimAircraft
 
     ac = JSBSimAircraft(cfg)
@@ -64,8 +64,9 @@ def loaded_mass_kg(cfg: AircraftConfig) -> float:
 
 
 def default_grid(cfg: AircraftConfig) -> list[DesignPoint]:
-    """Envelope points × :data:`MASS_FACTORS` clean, plus approach points (landing flap, gear
-    down) at :data:`APPROACH_ALT_M` and Vapp(m) + :data:`APPROACH_ADD_CAS_MPS` per mass."""
+    """The default grid of aircraft ``cfg``: its envelope points × :data:`MASS_FACTORS` clean,
+    plus approach points (landing flap, gear down) at :data:`APPROACH_ALT_M` and Vapp(m) +
+    :data:`APPROACH_ADD_CAS_MPS` per mass."""
     m0 = loaded_mass_kg(cfg)
     pts = [DesignPoint(e.alt_m, e.tas_mps, round(f * m0), "clean")
            for e in cfg.envelope for f in MASS_FACTORS]
@@ -93,7 +94,7 @@ class _Grid(BaseModel):
 
 
 def read_grid(path: str | Path) -> list[DesignPoint]:
-    """Design points from a YAML file ``points: [{alt_m, tas_mps, mass_kg, config}, ...]``.
+    """Design points from the YAML file ``path``: ``points: [{alt_m, tas_mps, mass_kg, config}]``.
 
     Raises
     ------
@@ -157,7 +158,8 @@ def _mins(row: dict, prefix: str = "") -> tuple[float, float, float]:
 
 
 def robustness_set(point: DesignPoint, mass_kg: float) -> list[tuple[DesignPoint, float]]:
-    """(design point, actuator delay s) of the robustness check around ``point``."""
+    """(design point, actuator delay s) of the robustness check around ``point`` at mass
+    ``mass_kg`` (kg): :data:`ROBUST_NAMES` in order."""
     f = ROBUST_MASS_FRAC
     return ([(replace(point, mass_kg=mass_kg * (1 + s * f)), 0.0) for s in (-1, 1)]
             + [(replace(point, mass_kg=mass_kg, cg_shift_m=s * ROBUST_CG_M), 0.0) for s in (-1, 1)]
@@ -304,7 +306,8 @@ def schedule_block(s: GainSchedule) -> dict:
 
 
 def aircraft_with_schedule(cfg: AircraftConfig, s: GainSchedule) -> str:
-    """The aircraft file's text with its ``coupled_law_schedule`` block replaced (appended)."""
+    """The text of aircraft ``cfg``'s file with its ``coupled_law_schedule`` block replaced by
+    the schedule ``s`` (appended when it has none)."""
     src = Path(cfg.source_file).read_text()
     lines, out, skip = src.splitlines(), [], False
     for ln in lines:

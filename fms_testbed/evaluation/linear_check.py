@@ -50,7 +50,8 @@ def _free_run(cfg, point: DesignPoint, pulse: float) -> np.ndarray:
 
 
 def nonlinear_pulse(cfg, point: DesignPoint) -> np.ndarray:
-    """Response to the elevator pulse on the nonlinear JSBSim model (inner loops off): the run
+    """Response of aircraft ``cfg`` at design point ``point`` to the elevator pulse on the
+    nonlinear JSBSim model (inner loops off): the run
     with the pulse minus the run without it (which removes the trim's own slow drift).
 
     Returns
@@ -64,7 +65,8 @@ def nonlinear_pulse(cfg, point: DesignPoint) -> np.ndarray:
 
 
 def linear_pulse(model, t_s: np.ndarray) -> np.ndarray:
-    """The linear model's response to the same pulse: columns q_rps, V_mps, alpha_rad."""
+    """The linear ``model``'s response to the same pulse at times ``t_s`` (s): columns q_rps,
+    V_mps, alpha_rad."""
     import control as ct
 
     u = np.zeros((2, len(t_s)))
@@ -80,8 +82,8 @@ def _damped(t, a, s, w, ph, b, c):
 
 
 def fit_mode(t_s: np.ndarray, y: np.ndarray, w_guess_rps: float) -> Mode:
-    """ω_n and ζ of a damped sinusoid fitted to ``y(t)`` (module docstring), from a start at
-    ``w_guess_rps`` (rad/s)."""
+    """ω_n and ζ of a damped sinusoid fitted to ``y`` at times ``t_s`` (s; module docstring),
+    from a start at ``w_guess_rps`` (rad/s)."""
     t = t_s - t_s[0]
     p0 = [float(np.ptp(y)) / 2 or 1e-3, 0.1 * w_guess_rps, w_guess_rps, 0.0, 0.0, 0.0]
     p, _ = curve_fit(_damped, t, y, p0=p0, maxfev=20000)
@@ -133,7 +135,6 @@ def _pointmass_lines(cfg, model, law: CoupledLawParams) -> list[str]:
     """The closed loop on the JSBSim linearisation against the point-mass model with lags."""
     g = linear_goals(point_loops(cfg, model, law))
     V0 = model.trim.tas_mps
-    t = np.arange(1, int(120 / 0.1) + 1) * 0.1
     out = []
     for tau_nx, tau_ny, what in ((0.0, 0.0, "point mass, no lags (paper)"),
                                  (model.engine_lag_s, 0.5, f"point mass, lags n_x "
@@ -143,7 +144,6 @@ def _pointmass_lines(cfg, model, law: CoupledLawParams) -> list[str]:
         yv = step_outputs(sys, np.array([DV_STEP_FRAC * V0, 0.0]))
         out.append(f"| {what} | {np.abs(yh[:, 0]).max() / KMH_MPS:.3f} | "
                    f"{np.abs(yv[:, 1]).max():.3f} | — | — |")
-    del t
     return ["", f"Closed loop (coupled law T_V {law.T_V_s} s, ξ_V {law.xi_V}, T_H {law.T_H_s} s, "
             f"ξ_H {law.xi_H}): +{DH_STEP_M:g} m and +{DV_STEP_FRAC:.0%} TAS steps",
             "| plant | max|ΔV| km/h | max|ΔH| m | min GM dB | min PM deg |", "|---|---|---|---|---|",

@@ -318,8 +318,9 @@ class Mode:
 
 
 def longitudinal_modes(model: AirframeModel) -> tuple[Mode, Mode]:
-    """(short period, phugoid) of the bare airframe (without the engine lag state), from the
-    eigenvalues of the longitudinal A: the faster and the slower complex pair."""
+    """(short period, phugoid) of the bare airframe of ``model`` (:class:`AirframeModel`, without
+    the engine lag state), from the eigenvalues of the longitudinal A: the faster and the slower
+    complex pair."""
     A = np.asarray(model.lon.A)[:5, :5]
     ev = [e for e in np.linalg.eigvals(A) if e.imag > 1e-6]
     if len(ev) < 2:

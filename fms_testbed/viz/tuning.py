@@ -173,3 +173,28 @@ def plot_linear_check(t_s: np.ndarray, nonlinear: np.ndarray, linear: np.ndarray
         ax.legend(fontsize=8)
     fig.suptitle(title)
     return fig
+
+
+def plot_campaign_shift(runs: dict[str, pd.DataFrame], metrics, title: str) -> Figure:
+    """Empirical distributions of per-flight error metrics for each run of a campaign check.
+
+    Parameters
+    ----------
+    runs : run label → flights table (regress rows);  metrics : columns to draw (unit in the
+        name: ``_m`` metres, ``_kt`` knots);  title : headline
+    """
+    fig, axes = subplots(1, len(metrics), figsize=(5 * len(metrics), 4.5))
+    for ax, m in zip(np.atleast_1d(axes), metrics):
+        for label, df in runs.items():
+            v = np.sort(df[m].dropna().to_numpy())
+            if len(v):
+                ax.step(v, np.arange(1, len(v) + 1) / len(v), where="post",
+                        label=f"{label} (median {np.median(v):.3g})")
+        unit = "m" if m.endswith("_m") else "kt"
+        ax.set_xlabel(f"{m.rsplit('_', 1)[0]}, {unit}")
+        ax.set_ylabel("fraction of flights")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    return fig
