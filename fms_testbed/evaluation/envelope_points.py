@@ -11,7 +11,8 @@ coupled law's (T_V, ξ_V, T_H, ξ_H) and its n_y-trim time constant are tuned th
 * soft goals (cost), on the linear closed loop's responses to an altitude step ``dH`` and a
   speed step ``dV``: tracking (integral of |error| over the step, in step sizes × 10 s),
   decoupling ((max|ΔV| / 0.5 km/h)² + (max|ΔH| / 0.75 m)², half the nonlinear goals), and
-  activity (peak throttle in 0.3 of its range and peak elevator in 0.1, per step).
+  activity (peak throttle in 0.3 of its range and peak elevator in 0.1, per step), plus a pull
+  towards the starting tuning (:data:`REG_WEIGHT`).
 
 The margins inside the optimiser are read from the loop's frequency response on a grid
 (:func:`grid_margins`); the reported ones are python-control's (:func:`~.loops.margins`).
@@ -52,6 +53,10 @@ BOUNDS = {"T_V_s": (4.0, 15.0), "xi_V": (0.6, 1.5), "T_H_s": (5.0, 20.0), "xi_H"
 n_y tracking-error integrator, the element that sets the elevator channel's phase margin at
 low dynamic pressure)."""
 NAMES = tuple(BOUNDS)
+REG_WEIGHT = 2.0
+"""Weight of the pull towards the starting tuning, ``REG_WEIGHT Σ ((x - x0)/(hi - lo))²``: the
+soft cost is flat near its optimum, and without the pull neighbouring points land on unrelated
+optima (a jagged schedule)."""
 DH_STEP_M = 100.0
 """Altitude step of the soft goals and of the nonlinear check, m (inside the ±dH limit)."""
 DV_STEP_FRAC = 0.10
@@ -220,13 +225,16 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
         r = minimize(lambda v: -min(np.min(_constraints(goals(v))), 0.2), u0,
                      method="Nelder-Mead", options={"maxfev": 80, "xatol": 0.01, "fatol": 1e-3})
         u = np.clip(r.x, 0.0, 1.0)
-    minimize(lambda v: goals(v).cost, u, method="SLSQP", bounds=[(0.0, 1.0)] * len(NAMES),
+    def cost(v):
+        return goals(v).cost + REG_WEIGHT * float(np.sum((np.clip(v, 0, 1) - u0) ** 2))
+
+    minimize(cost, u, method="SLSQP", bounds=[(0.0, 1.0)] * len(NAMES),
              constraints=[{"type": "ineq", "fun": lambda v: _constraints(goals(v))}],
              options={"maxiter": max_iter, "ftol": 1e-4, "eps": 1e-3})
     done = list(cache.values())
     feas = [(uu, g) for uu, g in done if np.min(_constraints(g)) >= 0]
     if feas:
-        best_u, gb = min(feas, key=lambda e: e[1].cost)
+        best_u, gb = min(feas, key=lambda e: cost(e[0]))
     else:
         best_u, gb = max(done, key=lambda e: np.min(_constraints(e[1])))
     return PointTuning(params(best_u), gb, g0, len(cache), bool(feas))

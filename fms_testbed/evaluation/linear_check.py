@@ -92,8 +92,15 @@ def fit_mode(t_s: np.ndarray, y: np.ndarray, w_guess_rps: float) -> Mode:
     return Mode(wn, s / wn)
 
 
-def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_dir) -> list[str]:
-    """Lines of the ``analyse --plant jsbsim`` report; writes ``linear-vs-jsbsim.png``.
+MODE_TOL_REL = 0.05
+"""The linearisation agrees with JSBSim when the short-period frequency and the phugoid period
+are within this fraction of the fitted ones."""
+
+
+def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_dir
+                  ) -> tuple[list[str], bool]:
+    """Lines of the ``analyse --plant jsbsim`` report and whether the linear modes agree with the
+    nonlinear fit (:data:`MODE_TOL_REL`); writes ``linear-vs-jsbsim.png``.
 
     Parameters
     ----------
@@ -128,7 +135,10 @@ def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_
              f"| phugoid | {ph.wn_rps:.4f}, {ph.zeta:.3f} (T {ph.period_s:.1f} s) | "
              f"{ph_nl.wn_rps:.4f}, {ph_nl.zeta:.3f} (T {ph_nl.period_s:.1f} s) |",
              f"pitch-rate response, first 10 s: RMS(linear - JSBSim) / peak = {err_q:.3f}"]
-    return lines + _pointmass_lines(cfg, model, law)
+    ok = (abs(sp_nl.wn_rps / sp.wn_rps - 1) <= MODE_TOL_REL
+          and abs(ph_nl.period_s / ph.period_s - 1) <= MODE_TOL_REL)
+    lines.append(f"modes agree within {MODE_TOL_REL:.0%}: {'yes' if ok else 'NO'}")
+    return lines + _pointmass_lines(cfg, model, law), ok
 
 
 def _pointmass_lines(cfg, model, law: CoupledLawParams) -> list[str]:
