@@ -65,6 +65,7 @@ def main() -> int:
     ap.add_argument("--wind", default="270/30", help="FROM_DEG/SPEED_KT")
     ap.add_argument("--turbulence", default="moderate", choices=("light", "moderate", "severe"))
     ap.add_argument("--out", required=True)
+    ap.add_argument("--md", help="also write docs/results/MD and docs/figures/tuning/")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -83,15 +84,25 @@ def main() -> int:
     from fms_testbed.viz.figure import save
     from fms_testbed.viz.tuning import plot_campaign_shift
 
-    md = (f"# Campaign check: {args.old} vs {args.new}\n\nCommand: `python "
-          f"{' '.join(sys.argv)}`\n\nConditions: wind {args.wind} kt, {args.turbulence} turbulence; "
+    md = ("<!-- written by python bench/bench_tune_campaign.py; rerun it to refresh, do not edit "
+          f"by hand -->\n\nCommand: `python bench/bench_tune_campaign.py {' '.join(sys.argv[1:])}`"
+          f"\n\nAircraft: `{args.old}` (file gains) and `{args.new}` (tuned schedule). "
+          f"Conditions: wind {args.wind} kt, {args.turbulence} turbulence; "
           f"{len(both)} paired flights.\n\n{markdown_table(table.reset_index())}\n\n"
           "Median of the paired differences (tuned − file gains): "
           + ", ".join(f"{m} {v:+.3g}" for m, v in diffs.items()) + "\n")
     (out / "campaign-shift.md").write_text(md)
+    if args.md:
+        (Path(__file__).resolve().parents[1] / "docs" / "results" / args.md).write_text(md)
+        fig = Path(__file__).resolve().parents[1] / "docs" / "figures" / "tuning"
+        fig.mkdir(parents=True, exist_ok=True)
     save(plot_campaign_shift(runs, METRICS, f"{args.old}: file gains vs tuned schedule, wind "
                              f"{args.wind} kt, {args.turbulence} turbulence ({len(both)} paired "
                              "flights)"), out / "campaign-shift.png")
+    if args.md:
+        import shutil
+
+        shutil.copy(out / "campaign-shift.png", fig / "campaign-shift.png")
     print(md)
     return 0
 
