@@ -11,6 +11,7 @@ nonlinear deviations), ``schedule.yaml``, ``aircraft.yaml`` (the aircraft file w
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -102,6 +103,14 @@ def _report(cfg, res, goals, args, points_md: str) -> str:
     load = os.getloadavg()
     terms = markdown_table(pd.DataFrame(res.schedule.table()))
     gl = "\n".join(f"- {'PASS' if ok else 'FAIL'}: {t}" for ok, t in goals)
+    b0 = cfg.inner_loops.bank
+    bank = (f"Bank loop (one gain set for the grid): file kp {b0.kp:g}, kd {b0.kd:g} → kp "
+            f"{res.bank.kp:g}, kd {res.bank.kd:g}; smallest scaled slack of its GM/PM goals "
+            f"{res.bank_slack[0]:.3f} → {res.bank_slack[1]:.3f} (≥ 0: met). Nonlinear bank "
+            "steps at the default condition: " + ", ".join(
+                f"{math.degrees(r.spec.amplitude):.0f}° settles {r.settle_s:.1f} s "
+                f"(spec {r.spec.settle_max_s:g}), overshoot {r.overshoot_pct:.1f} % "
+                f"(spec {r.spec.overshoot_max_pct:g})" for r in res.bank_steps))
     figs = "\n".join(f"![{f}]({f})" for f in FIGURES)
     return (f"# Envelope tuning of the coupled law — {cfg.name}\n\n"
             f"Command: `fms-testbed tune --aircraft {args.aircraft} --envelope"
@@ -112,7 +121,8 @@ def _report(cfg, res, goals, args, points_md: str) -> str:
             "(+100 m and +10 % TAS steps).\n\n"
             f"Wall time: tuning {res.tune_wall_s:.0f} s, checks {res.check_wall_s:.0f} s on "
             f"{res.workers} workers (load average at the end {load[0]:.1f} / {load[1]:.1f} / "
-            f"{load[2]:.1f}, {os.cpu_count()} cores).\n\n## Goals\n\n{gl}\n\n## Schedule\n\n"
+            f"{load[2]:.1f}, {os.cpu_count()} cores).\n\n## Goals\n\n{gl}\n\n{bank}\n\n"
+            "## Schedule\n\n"
             "Piecewise linear in ln q̄ per mass level, linear in mass between levels:\n\n"
             f"{terms}\n\n"
             f"## Points\n\n{points_md}\n\n## Figures\n\n{figs}\n")
@@ -140,7 +150,7 @@ def cmd_tune_envelope(args) -> int:
     block = schedule_block(res.schedule)
     (tmp / "schedule.yaml").write_text(yaml.safe_dump({"coupled_law_schedule": block},
                                                       sort_keys=False))
-    (tmp / "aircraft.yaml").write_text(aircraft_with_schedule(cfg, res.schedule))
+    (tmp / "aircraft.yaml").write_text(aircraft_with_schedule(cfg, res.schedule, res.bank))
     goals = goal_lines(table)
     show = [c for c in ("alt_m", "tas_mps", "mass_kg", "config", "status", "gm_min_db",
                         "pm_min_deg", "disk_margin", "max_dv_kmh", "max_dh_m", "old_max_dv_kmh",
@@ -150,7 +160,10 @@ def cmd_tune_envelope(args) -> int:
     (tmp / "report.md").write_text(_report(cfg, res, goals, args, md))
     print(md)
     print("\nGoals:\n" + "\n".join(f"- {'PASS' if ok else 'FAIL'}: {t}" for ok, t in goals))
-    print(f"\nwall time: tuning {res.tune_wall_s:.0f} s, checks {res.check_wall_s:.0f} s")
+    print(f"\nbank loop: kp {res.bank.kp:g}, kd {res.bank.kd:g} (file {cfg.inner_loops.bank.kp:g}, "
+          f"{cfg.inner_loops.bank.kd:g}); goal slack {res.bank_slack[0]:.3f} → "
+          f"{res.bank_slack[1]:.3f}")
+    print(f"wall time: tuning {res.tune_wall_s:.0f} s, checks {res.check_wall_s:.0f} s")
     print(f"written to {out}/ (points.csv, schedule.yaml, aircraft.yaml, report.md, "
           f"{', '.join(FIGURES)})")
     folder.commit()

@@ -24,6 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import control as ct
 import numpy as np
 from scipy.linalg import expm
 from scipy.optimize import minimize
@@ -88,10 +89,12 @@ def point_loops(cfg: AircraftConfig, model: AirframeModel, law: CoupledLawParams
 
 def freq_response(sys, omega_rps: np.ndarray) -> np.ndarray:
     """SISO frequency response C (jωI - A)⁻¹ B + D of ``sys`` on ``omega_rps`` (rad/s), via the
-    eigen-decomposition of A (vectorised over ω; for diagonalisable A, as the longitudinal
-    loops are)."""
+    eigen-decomposition of A (vectorised over ω), or python-control's response when A is
+    (nearly) defective."""
     A, B, C, D = (np.asarray(m) for m in (sys.A, sys.B, sys.C, sys.D))
     lam, V = np.linalg.eig(A)
+    if np.linalg.cond(V) > 1e8:         # defective A (repeated integrators): python-control
+        return np.asarray(ct.frequency_response(sys, omega_rps).complex).ravel()
     cb = (C @ V).ravel() * np.linalg.solve(V, B).ravel()
     return (cb[None, :] / (1j * omega_rps[:, None] - lam[None, :])).sum(axis=1) + D[0, 0]
 
@@ -300,3 +303,57 @@ def verify(cfg: AircraftConfig, point: DesignPoint, make_law, duration_s: float 
     dv = float(np.abs(a[:, 2] - a[0, 2]).max() / KMH_MPS)
     dh = float(np.abs(s[:, 1] - s[0, 1]).max())
     return StepCheck(dv, dh, {"alt": a, "speed": s})
+
+
+def _bank_slack(cfg: AircraftConfig, models: list, gains) -> np.ndarray:
+    """Scaled slack of the bank loop's GM and PM goals (plus buffers) at every model."""
+    from fms_testbed.sim.inner_steps import replace_gains
+
+    c = replace_gains(cfg, "bank", gains)
+    out = []
+    for m in models:
+        gm, pm, _ = grid_margins(point_loops(c, m, start_law(cfg)).loop("aileron"))
+        out += [(gm - GM_MIN_DB - TUNE_BUFFER["gm_db"]) / 6.0,
+                (pm - PM_MIN_DEG - TUNE_BUFFER["pm_deg"]) / 45.0]
+    return np.array(out)
+
+
+def start_law(cfg: AircraftConfig) -> CoupledLawParams:
+    """The coupled-law tuning of the aircraft file (the tuner's start)."""
+    from fms_testbed.control.coupled_law import params_from_config
+
+    return params_from_config(cfg)
+
+
+def tune_bank_loop(cfg: AircraftConfig, models: list, max_evals: int = 60):
+    """One bank-loop gain set (k_p, k_d of the aircraft file's ``inner_loops.bank``; the JSBSim
+    system scales them with q̄_ref/q̄) meeting the GM/PM goals plus buffers at every design point:
+    Nelder-Mead on log-gains minimising the squared goal violations plus a pull
+    ``0.05 Σ ln²(k/k0)`` towards the file's gains.
+
+    Parameters
+    ----------
+    cfg : aircraft;  models : linear airframes of the design points
+    max_evals : Nelder-Mead evaluations
+
+    Returns
+    -------
+    (gains, smallest slack before, smallest slack after) — slack ≥ 0: every goal met
+    """
+    g0 = cfg.inner_loops.bank
+    x0 = np.log([g0.kp, max(g0.kd, 1e-3)])
+
+    def gains(x):
+        return g0.model_copy(update={"kp": float(np.exp(x[0])), "kd": float(np.exp(x[1]))})
+
+    def f(x):
+        sl = _bank_slack(cfg, models, gains(x))
+        return float(np.sum(np.minimum(sl, 0.0) ** 2) * 100 + 0.05 * np.sum((x - x0) ** 2))
+
+    before = float(np.min(_bank_slack(cfg, models, g0)))
+    if before >= 0:
+        return g0, before, before
+    r = minimize(f, x0, method="Nelder-Mead", options={"maxfev": max_evals, "xatol": 0.01})
+    best = gains(r.x)
+    best = best.model_copy(update={"kp": round(best.kp, 3), "kd": round(best.kd, 3)})
+    return best, before, float(np.min(_bank_slack(cfg, models, best)))
