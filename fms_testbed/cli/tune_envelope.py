@@ -185,11 +185,16 @@ def cmd_analyse_jsbsim(args) -> int:
     out = _out_dir(args.out, f"analyse-jsbsim-{cfg.name}")
     folder = OutputFolder(out, getattr(args, "overwrite", False))
     tmp = folder.open()
-    rep, ok = compare_point(cfg, alt, tas, params_from_config(cfg), tmp)
-    for line in rep:
+    from fms_testbed.viz.figure import save
+    from fms_testbed.viz.tuning import plot_linear_check
+
+    chk = compare_point(cfg, alt, tas, params_from_config(cfg))
+    for line in chk.lines:
         print(line)
+    save(plot_linear_check(chk.t_s, chk.nonlinear, chk.linear, chk.title),
+         tmp / "linear-vs-jsbsim.png")
     (tmp / "analysis.md").write_text(f"# {cfg.name}: linearised JSBSim at {alt:.0f} m / "
-                                     f"{tas:.1f} m/s\n\n" + "\n".join(rep) + "\n")
+                                     f"{tas:.1f} m/s\n\n" + "\n".join(chk.lines) + "\n")
     print(f"\nwritten to {out}/ (analysis.md, linear-vs-jsbsim.png)")
     folder.commit()
-    return 0 if ok else 1
+    return 0 if chk.ok else 1

@@ -13,6 +13,7 @@ model's response to the same pulse is overlaid.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import curve_fit
@@ -97,19 +98,27 @@ MODE_TOL_REL = 0.05
 are within this fraction of the fitted ones."""
 
 
-def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_dir
-                  ) -> tuple[list[str], bool]:
-    """Lines of the ``analyse --plant jsbsim`` report and whether the linear modes agree with the
-    nonlinear fit (:data:`MODE_TOL_REL`); writes ``linear-vs-jsbsim.png``.
+@dataclass(frozen=True)
+class LinearCheck:
+    """Outcome of :func:`compare_point`: report lines, whether the modes agree, and the figure
+    data (time s, nonlinear and linear responses, headline)."""
+
+    lines: list[str]
+    ok: bool
+    t_s: np.ndarray
+    nonlinear: np.ndarray
+    linear: np.ndarray
+    title: str
+
+
+def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams) -> LinearCheck:
+    """The ``analyse --plant jsbsim`` check: report lines and whether the linear modes agree
+    with the nonlinear fit (:data:`MODE_TOL_REL`), with the pulse responses for the figure.
 
     Parameters
     ----------
     cfg : aircraft;  alt_m, tas_mps : operating point (m, m/s);  law : coupled-law tuning
-    out_dir : folder for the figure
     """
-    from fms_testbed.viz.figure import save
-    from fms_testbed.viz.tuning import plot_linear_check
-
     pt = DesignPoint(alt_m, tas_mps)
     model = linearise(cfg, pt)
     sp, ph = longitudinal_modes(model)
@@ -121,11 +130,9 @@ def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_
     sp_nl = fit_mode(t[i_sp], nl[i_sp, 1], sp.wn_rps)
     ph_nl = fit_mode(t[i_ph], nl[i_ph, 2], ph.wn_rps)
     err_q = float(np.sqrt(np.mean((lin[:, 0] - nl[:, 1])[t < 10] ** 2)) / np.abs(nl[t < 10, 1]).max())
-    save(plot_linear_check(t, nl, lin, f"{cfg.name} at {alt_m:.0f} m / {tas_mps:.1f} m/s: "
-                           f"elevator pulse {PULSE:g} for 1 s, inner loops off\nshort period "
-                           f"ω_n {sp.wn_rps:.3f} (linear) vs {sp_nl.wn_rps:.3f} rad/s (JSBSim fit); "
-                           f"phugoid period {ph.period_s:.1f} vs {ph_nl.period_s:.1f} s"),
-         out_dir / "linear-vs-jsbsim.png")
+    title = (f"{cfg.name} at {alt_m:.0f} m / {tas_mps:.1f} m/s: elevator pulse {PULSE:g} for 1 s, "
+             f"inner loops off\nshort period ω_n {sp.wn_rps:.3f} (linear) vs {sp_nl.wn_rps:.3f} "
+             f"rad/s (JSBSim fit); phugoid period {ph.period_s:.1f} vs {ph_nl.period_s:.1f} s")
     lines = [f"trim: alpha {model.trim.alpha_deg:.2f} deg, throttle {model.trim.throttle:.3f}, "
              f"mass {model.mass_kg:.0f} kg, q̄ {model.qbar_pa:.0f} Pa, engine lag "
              f"{model.engine_lag_s:.2f} s (63 % of a 0.05 throttle step)",
@@ -138,7 +145,7 @@ def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_
     ok = (abs(sp_nl.wn_rps / sp.wn_rps - 1) <= MODE_TOL_REL
           and abs(ph_nl.period_s / ph.period_s - 1) <= MODE_TOL_REL)
     lines.append(f"modes agree within {MODE_TOL_REL:.0%}: {'yes' if ok else 'NO'}")
-    return lines + _pointmass_lines(cfg, model, law), ok
+    return LinearCheck(lines + _pointmass_lines(cfg, model, law), ok, t, nl, lin, title)
 
 
 def _pointmass_lines(cfg, model, law: CoupledLawParams) -> list[str]:
