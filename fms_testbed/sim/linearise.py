@@ -92,6 +92,25 @@ class AirframeModel:
     qbar_pa: float
     engine_lag_s: float
 
+    def __reduce__(self):
+        """Pickle through plain arrays (python-control systems hold lambdas): process pools."""
+        return (_rebuild_model, (_ss_parts(self.lon), _ss_parts(self.lat), self.trim, self.point,
+                                 self.mass_kg, self.qbar_pa, self.engine_lag_s))
+
+
+def _ss_parts(sys: ct.StateSpace) -> tuple:
+    return (np.asarray(sys.A), np.asarray(sys.B), np.asarray(sys.C), np.asarray(sys.D),
+            list(sys.input_labels), list(sys.output_labels), list(sys.state_labels), sys.name)
+
+
+def _ss_from(parts: tuple) -> ct.StateSpace:
+    A, B, C, D, ins, outs, states, name = parts
+    return ct.ss(A, B, C, D, inputs=ins, outputs=outs, states=states, name=name)
+
+
+def _rebuild_model(lon, lat, *rest) -> "AirframeModel":
+    return AirframeModel(_ss_from(lon), _ss_from(lat), *rest)
+
 
 def _tanks(fdm) -> list[float]:
     """Contents of every tank, lbs."""
