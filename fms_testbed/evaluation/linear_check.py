@@ -136,7 +136,8 @@ def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams) -> L
     lines = [f"trim: alpha {model.trim.alpha_deg:.2f} deg, throttle {model.trim.throttle:.3f}, "
              f"mass {model.mass_kg:.0f} kg, q̄ {model.qbar_pa:.0f} Pa, engine lag "
              f"{model.engine_lag_s:.2f} s (63 % of a 0.05 throttle step)",
-             "| mode | linear (FGLinearization) ω_n rad/s, ζ | nonlinear JSBSim fit ω_n, ζ |",
+             "| mode | linear (FGLinearization, speed column by central differences) ω_n rad/s, ζ "
+             "| nonlinear JSBSim fit ω_n, ζ |",
              "|---|---|---|",
              f"| short period | {sp.wn_rps:.3f}, {sp.zeta:.3f} | {sp_nl.wn_rps:.3f}, {sp_nl.zeta:.3f} |",
              f"| phugoid | {ph.wn_rps:.4f}, {ph.zeta:.3f} (T {ph.period_s:.1f} s) | "
