@@ -289,6 +289,8 @@ class Margins:
     wc_rps: float
 
 
+GM_NONE_DB = 100.0
+"""A gain margin above this (numerical crossings where |L| is negligible) counts as none: inf."""
 OMEGA_RPS = np.logspace(-3, 2.5, 600)
 """Frequency grid of the margin computations, rad/s."""
 
@@ -305,6 +307,7 @@ def margins(L: ct.StateSpace, omega_rps: np.ndarray = OMEGA_RPS) -> Margins:
     """
     gm, pm, _, wpc, wgc, _ = ct.stability_margins(L, returnall=True)
     gms = [abs(20 * math.log10(g)) for g in np.atleast_1d(gm) if g > 0 and math.isfinite(g)]
+    gms = [g for g in gms if g < GM_NONE_DB]
     pms = list(np.atleast_1d(pm))
     wgs = list(np.atleast_1d(wgc))
     gm_db = min(gms) if gms else math.inf

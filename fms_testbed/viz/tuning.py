@@ -161,11 +161,11 @@ def plot_linear_check(t_s: np.ndarray, nonlinear: np.ndarray, linear: np.ndarray
     fig, (aq, av) = subplots(2, 1, figsize=(10, 7))
     short = t_s <= 15.0
     aq.plot(t_s[short], np.degrees(nonlinear[short, 1]), label="JSBSim (nonlinear)")
-    aq.plot(t_s[short], np.degrees(linear[short, 0]), "--", label="FGLinearization model")
+    aq.plot(t_s[short], np.degrees(linear[short, 0]), "--", label="linear model (FGLinearization, speed column by central differences)")
     aq.set_xlabel("time, s")
     aq.set_ylabel("pitch rate deviation, deg/s")
     av.plot(t_s, nonlinear[:, 2], label="JSBSim (nonlinear)")
-    av.plot(t_s, linear[:, 1], "--", label="FGLinearization model")
+    av.plot(t_s, linear[:, 1], "--", label="linear model (FGLinearization, speed column by central differences)")
     av.set_xlabel("time, s")
     av.set_ylabel("airspeed deviation, m/s")
     for ax in (aq, av):
