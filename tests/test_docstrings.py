@@ -37,6 +37,10 @@ MODULES = [
     "guidance.replan", "guidance.vnav", "guidance.step_log", "guidance.profile_kernel",
     "guidance.speed_plan", "guidance.active_path", "run.summary", "run.schemas", "run.api",
     "evaluation.records", "evaluation.flight_errors", "evaluation.threshold",
+    # fault identification
+    "navigation.identification.rules", "navigation.identification.sensor",
+    "navigation.identification.two_stage", "navigation.identification.tuning",
+    "navigation.fdi", "evaluation.detection_limit",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")

@@ -14,7 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.units import KT_MPS
@@ -52,9 +52,11 @@ class Limits(_Frozen):
     climb_gradient_max: Annotated[float, Field(gt=0, lt=0.5)] = Field(
         description="max climb gradient (rise over run) at the planned speed, dimensionless")
     descent_rate_max_mps: Pos = Field(description="max planned descent rate, m/s")
-    climb_tas_mps: Pos = Field(
-        description="planned terminal-area speed for path building and guidance, m/s: the TAS "
-                    "at sea level, flown as that CAS at altitude")
+    climb_cas_mps: Pos = Field(
+        validation_alias=AliasChoices("climb_cas_mps", "climb_tas_mps"),
+        description="planned terminal-area speed for path building and guidance, a CAS, m/s "
+                    "(its TAS at each leg's planned altitude); the older key climb_tas_mps is read "
+                    "as the same CAS")
 
     @model_validator(mode="after")
     def _order(self):

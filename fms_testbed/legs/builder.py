@@ -101,6 +101,9 @@ class LegBuilder:
         self.radius_m = 1000.0
         self.climbing = True
         self.gradient = 0.05
+        self.alt_cap_m = math.inf
+        """The highest altitude the climb of the current leg may reach, m (the climb planner's
+        :func:`~fms_testbed.path.profile.climb_caps_m` at the leg's end)."""
         self._corner_pending = False
         self._upstream_depth = 0
         self.joined = True
@@ -157,10 +160,11 @@ class LegBuilder:
         self.segments.append(PathSegment(geom, self.i, pt, ident, role, self.speed_mps, bank))
 
     def advance(self, state: FlightState, dist_m: float, **changes) -> FlightState:
-        """Move the planned altitude along ``dist_m`` of path (climb or descent) and update."""
+        """Move the planned altitude along ``dist_m`` of path and update: a climb at the
+        planned gradient up to :attr:`alt_cap_m` (never down to it)."""
         alt = state.alt_m
         if self.climbing:
-            alt += dist_m * self.gradient
+            alt = min(alt + dist_m * self.gradient, max(self.alt_cap_m, alt))
         return replace(state, alt_m=alt, **changes)
 
     def as_transition(self, first: int) -> None:

@@ -201,13 +201,70 @@ def descent_leg_tas_mps(path: ProcedurePath, leg_alt_m: np.ndarray, cas_plan_mps
     return out
 
 
+def climb_phases(records, proc_type: str, start_in_climb: bool = False) -> np.ndarray:
+    """Per node (the start and every leg end), True where the leg ending there is climbed: a
+    SID, or from the first missed-approach leg on (or all of it with ``start_in_climb``)."""
+    climb = np.zeros(len(records) + 1, dtype=bool)
+    climbing = proc_type == "D" or start_in_climb
+    for k, r in enumerate(records):
+        climbing = climbing or r.missed_approach_start
+        climb[k + 1] = climbing
+    return climb
+
+
+def path_climb_top_m(proc_type: str, climb_top_m: float | None) -> float | None:
+    """The climb top a path of type ``proc_type`` is planned to, m: the flight's
+    ``climb_top_m`` for a SID; None for an approach (its missed approach climbs to its own
+    coded altitudes, the highest of them, not to the SID climb top)."""
+    return None if proc_type == "F" else climb_top_m
+
+
+def climb_caps_m(records, climb: np.ndarray, climb_top_m: float | None = None,
+                 alt_max_m: float = math.inf) -> np.ndarray:
+    """The altitude a climb may reach at each node (the start and every leg end), m.
+
+    A climb is capped by every 'at or below' ahead of the node and levels at the highest
+    climb constraint still ahead, raised to ``climb_top_m`` when given (else, with none
+    coded, the coded transition altitude, else 18,000 ft); never above ``alt_max_m`` (the
+    aircraft's ceiling less its margin). The one climb planner: the leg builder (planned
+    altitudes, speeds and turn radii) and :func:`plan_profile` both use it.
+
+    Parameters
+    ----------
+    records : the legs' :class:`~fms_testbed.procedures.legrecord.LegRecord` in order
+    climb : per node, whether it is climbed (:func:`climb_phases`)
+    climb_top_m : the flight's climb top, m (None: from the records, above)
+    alt_max_m : the highest altitude the plan may reach, m
+    """
+    n = len(records)
+    cap = np.full(n + 1, np.inf)
+    run = np.inf
+    top = -np.inf
+    trans = next((r.trans_alt_m for r in records if r.trans_alt_m), None)
+    wins = [(None, None)] + [window(r.alt_desc, r.alt1_m, r.alt2_m) for r in records]
+    for k in range(n, -1, -1):
+        lo, hi = wins[k]
+        if climb[k]:
+            if hi is not None:
+                run = min(run, hi)
+                top = max(top, hi)
+            elif lo is not None:
+                top = max(top, lo)
+        if climb_top_m is not None:
+            level = max(top, climb_top_m)
+        else:
+            level = top if np.isfinite(top) else (trans if trans else 18000 * FT_M)
+        cap[k] = min(run, level, alt_max_m)
+    return cap
+
+
 def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
                  descent_angle_deg: float = 3.0, climb_top_m: float | None = None,
                  descent_gradient_max: float | None = None,
                  descent_rate_mps: float | None = None,
                  wind: tuple[float, float] | None = None,
                  start_in_climb: bool = False, cas_plan_mps: float | None = None,
-                 isa_dev_c: float = 0.0) -> VerticalProfile:
+                 isa_dev_c: float = 0.0, alt_max_m: float = math.inf) -> VerticalProfile:
     """Plan the vertical profile of a built path.
 
     Parameters
@@ -231,6 +288,9 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     cas_plan_mps, isa_dev_c : with ``descent_rate_mps``, the aircraft's planned CAS (m/s) and
         the day's ISA deviation (K): descents are planned within the energy the aircraft can
         shed (below)
+    alt_max_m : the highest altitude the plan may reach (the aircraft's ceiling less its
+        margin, :attr:`~fms_testbed.legs.model.Performance.alt_plan_max_m`), m: climbs level
+        at :func:`climb_caps_m`, descents start no higher
 
     Notes
     -----
@@ -257,13 +317,9 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     n = len(path.legs)
     ends = leg_end_distances(path)
     windows = []
-    climb = np.zeros(n + 1, dtype=bool)
-    climbing = path.proc_type == "D" or start_in_climb
+    climb = climb_phases([lg.record for lg in path.legs], path.proc_type, start_in_climb)
     for k, lg in enumerate(path.legs):
         r = lg.record
-        if r.missed_approach_start:
-            climbing = True
-        climb[k + 1] = climbing
         lo, hi = window(r.alt_desc, r.alt1_m, r.alt2_m)
         if lo is not None or hi is not None:
             windows.append(AltitudeWindow(k, r.fix.ident if r.fix else "", ends[k], r.alt_desc,
@@ -277,7 +333,8 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     # descent: backward pass from the last descent node, then clamp into windows
     desc_idx = [k for k in range(1, n + 1) if not climb[k]]
     coded = [v for w in windows for v in (w.lo_m, w.hi_m) if v is not None]
-    ceiling = max([start_alt_m] + coded)   # never plan above the start or any coded altitude
+    # never plan above the start or any coded altitude, nor above the aircraft's ceiling
+    ceiling = max(min(max(coded, default=-math.inf), alt_max_m), start_alt_m)
     def ground_speed(k: int, v: float) -> float:
         """Planned ground speed on leg k at TAS v (a tailwind: the same descent rate is a
         shallower path; class 1: wind), m/s."""
@@ -360,24 +417,7 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
         for k in range(1, n + 1):
             if not climb[k] and not climb[k - 1] and alt[k] > alt[k - 1]:
                 alt[k] = max(alt[k - 1], lo_at[k] if lo_at[k] is not None else -np.inf)
-    # climb: forward pass, capped by every 'at or below' ahead and levelling off at the
-    # highest climb constraint still ahead (else the coded transition altitude, else 18,000 ft)
-    cap = np.full(n + 1, np.inf)
-    run = np.inf
-    top = -np.inf
-    trans = next((lg.record.trans_alt_m for lg in path.legs if lg.record.trans_alt_m), None)
-    for k in range(n, -1, -1):
-        if climb[k]:
-            if hi_at[k] is not None:
-                run = min(run, hi_at[k])
-                top = max(top, hi_at[k])
-            elif lo_at[k] is not None:
-                top = max(top, lo_at[k])
-        if climb_top_m is not None:
-            level = max(top, climb_top_m)
-        else:
-            level = top if np.isfinite(top) else (trans if trans else 18000 * FT_M)
-        cap[k] = min(run, level)
+    cap = climb_caps_m([lg.record for lg in path.legs], climb, climb_top_m, alt_max_m)
     for k in range(1, n + 1):
         if climb[k]:
             base = alt[k - 1]

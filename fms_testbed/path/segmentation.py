@@ -25,7 +25,8 @@ from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
-from fms_testbed.path.profile import PLAN_CLIMB_FRACTION, arrival_join_alt_m, window
+from fms_testbed.path.profile import (PLAN_CLIMB_FRACTION, arrival_join_alt_m, climb_caps_m,
+                                     climb_phases, path_climb_top_m, window)
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
@@ -134,8 +135,8 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
         alt = next((_descent_target(lg) for lg in legs if lg.rec.alt1_m is not None), None)
         if alt is None:
             alt = elev + (10000 if seq.proc_type == "E" else 3000) * FT_M
-            if perf is not None:            # never above the aircraft's ceiling (less margin)
-                alt = min(alt, perf.alt_plan_max_m)
+        if perf is not None:            # never above the aircraft's ceiling (less margin)
+            alt = min(alt, perf.alt_plan_max_m)
     if first.fix is not None:
         return FlightState(first.fix.lat_deg, first.fix.lon_deg, None, alt,
                            fix_ident=first.fix.ident)
@@ -151,18 +152,21 @@ def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float,
     approach_cas_caps`) capped by an 'at or below' speed limit, raised to
     an 'at or above' one, and equal to an 'at' one — the speed guidance will fly there, so turn
     radii are planned for it (limits are IAS, turned to TAS on a day ``isa_dev_c`` K off the
-    ISA: a warm day flies a higher TAS for the same CAS, so a larger radius), m/s."""
+    ISA: a warm day flies a higher TAS for the same CAS, so a larger radius) — never above
+    the aircraft's VMO / MMO there (:meth:`~fms_testbed.legs.model.Performance.tas_max_mps`),
+    m/s."""
     v = isa_tas_mps(perf.tas_plan_mps if cas_cap_mps is None else
                     min(perf.tas_plan_mps, cas_cap_mps), alt_m, isa_dev_c)  # flown as a CAS
     lim = leg.rec.speed_limit_mps
-    if lim is None:
-        return v
-    lim_tas = isa_tas_mps(lim, alt_m, isa_dev_c)
-    if leg.rec.speed_desc == "-":
-        return min(v, lim_tas)
-    if leg.rec.speed_desc == "+":
-        return max(v, lim_tas)
-    return lim_tas  # blank or '@': at
+    if lim is not None:
+        lim_tas = isa_tas_mps(lim, alt_m, isa_dev_c)
+        if leg.rec.speed_desc == "-":
+            v = min(v, lim_tas)
+        elif leg.rec.speed_desc == "+":
+            v = max(v, lim_tas)
+        else:
+            v = lim_tas  # blank or '@': at
+    return min(v, perf.tas_max_mps(alt_m, isa_dev_c))   # inside VMO / MMO
 
 
 def leg_cls_hold(leg: ResolvedLeg) -> bool:
@@ -213,8 +217,13 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
     built: list[BuiltLeg] = []
     caps = approach_cas_caps([lg.rec for lg in legs], seq.proc_type, perf.tas_min_mps)
+    recs = [lg.rec for lg in legs]
+    alt_caps = climb_caps_m(recs, climb_phases(recs, seq.proc_type),
+                            path_climb_top_m(seq.proc_type, params.climb_top_m),
+                            perf.alt_plan_max_m)
     for i, leg in enumerate(legs):
         b.i = i
+        b.alt_cap_m = float(alt_caps[i + 1])
         if leg.rec.missed_approach_start:
             b.climbing = True
         speed_in = b.speed_mps if i else None
@@ -225,7 +234,7 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
             # a hold in a climb is flown from here up to the climb top (guidance climbs on to
             # it; an HA is left only at the end of a circuit): its turns are planned for the
             # TAS at the top (constant CAS: the largest) and the strongest wind on the way
-            top = max(alt_plan, params.climb_top_m)
+            top = max(alt_plan, min(params.climb_top_m, b.alt_cap_m))
             b.params = params.for_band(alt_plan, top)
             alt_plan = top
         b.leg_params[i] = b.params
@@ -246,7 +255,8 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
             state = replace(state, alt_m=_descent_target(leg))
         built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps,
-                              coded=leg_cls.coded_path(b, term)))
+                              coded=leg_cls.coded_path(b, term), resolved=leg,
+                              from_fix=prev_fixes[i]))
     segs = round_corners(b, perf, params, bank)
     built = _attach_segments(built, segs)
     status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"

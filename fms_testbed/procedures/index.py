@@ -59,7 +59,7 @@ from fms_testbed.procedures.records import Fix
 
 log = logging.getLogger(__name__)
 
-INDEX_FORMAT = 1
+INDEX_FORMAT = 2
 """Version of the index layout; part of the cache key."""
 
 #: Modules of this package that do not read records (not part of the parser hash).
@@ -127,13 +127,34 @@ class DatabaseIndex:
         return hashlib.sha256(self.line_digests[idx].tobytes()).hexdigest()
 
 
+RECORD_NUMBER_COLS = slice(123, 128)
+"""ARINC-424 columns 124-128, the file record number: where a record sits in the file, not
+what it says (left out of a line's digest)."""
+
+
+def record_content(line: str) -> str:
+    """A record's text without its file record number (columns 124-128 blanked; a line shorter
+    than 128 characters is kept whole).
+
+    Parameters
+    ----------
+    line : one line of the file
+    """
+    if len(line) < RECORD_NUMBER_COLS.stop:
+        return line
+    return line[:RECORD_NUMBER_COLS.start] + " " * 5 + line[RECORD_NUMBER_COLS.stop:]
+
+
 def line_digests(text: str) -> np.ndarray:
-    """64-bit BLAKE2b digest of each line of ``text`` (split as the loader splits it)."""
+    """64-bit BLAKE2b digest of each line of ``text`` (split as the loader splits it), over the
+    record's content: the file record number (columns 124-128) left out
+    (:func:`record_content`), so a record inserted earlier in the file changes no digest of
+    the records after it."""
     out = np.empty(0, dtype=np.uint64)
     lines = split_lines(text)
     if lines:
-        raw = b"".join(hashlib.blake2b(ln.encode("latin-1", "replace"), digest_size=8).digest()
-                       for ln in lines)
+        raw = b"".join(hashlib.blake2b(record_content(ln).encode("latin-1", "replace"),
+                                       digest_size=8).digest() for ln in lines)
         out = np.frombuffer(raw, dtype=np.uint64).copy()
     return out
 
@@ -378,5 +399,5 @@ def _bytes(path: Path) -> bytes:
 
 
 __all__ = ["INDEX_FORMAT", "PACKED_FIELDS", "DatabaseIndex", "PackedMapping", "packed",
-           "cache_dir", "line_digests", "load_index",
+           "cache_dir", "line_digests", "load_index", "record_content",
            "parser_hash", "resolve_db_path"]

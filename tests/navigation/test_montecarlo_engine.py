@@ -11,7 +11,7 @@ from fms_testbed.navigation import make_source
 from fms_testbed.navigation.kalman import correct_delayed
 from fms_testbed.navigation.montecarlo import (McConfig, McFault, MonteCarlo, _group_update,
                                                run_chunks)
-from fms_testbed.sensors.gnss import GnssSpec, Interval
+from fms_testbed.sensors.gnss import GnssSpec, Interval, Ramp
 
 
 def test_group_update_is_correct_delayed_member_by_member():
@@ -115,3 +115,27 @@ def test_no_false_exclusion_where_unmodelled_misalignment_once_caused_them():
     r = MonteCarlo(states, cfg, seed=0).run([51, 465, 544])
     assert not np.isfinite(r.t_exclude_s).any(), r.t_exclude_s
     assert not np.isfinite(r.t_detect_s).any(), r.t_detect_s
+
+
+def test_raw_output_voting_keeps_a_drift_the_filters_calibrate_and_drops_a_large_step():
+    """Voting on the free inertial outputs at k_pair √2 σ_free: a drift ×2 on INS 2 stays in
+    the vote (its raw error is inside the declared envelope for minutes), a 10 mg accelerometer
+    step leaves it within the run; the NSE of the voted output is logged beside the output's."""
+    states = synthetic_states("manoeuvres", 500.0)
+    mc = MonteCarlo(states, McConfig(), seed=7)
+    drift = mc.run(range(3), McFault("gyro_drift_scale", 2.0, 200.0, 1))
+    step = mc.run(range(3), McFault("accel_bias_step", 10000.0, 200.0, 1, "x"))
+    assert (drift.vote_in[:, 1] > 0.99).all(), drift.vote_in
+    assert (step.vote_in[:, 1] < 0.5).all() and (step.vote_in[:, [0, 2]] > 0.99).all()
+    assert step.hist_vote.sum() == step.hist_gnss.sum() + step.hist_coast.sum()
+
+
+def test_a_gnss_ramp_names_the_gnss_and_no_unit():
+    """Every unit's innovation window failing together, no INS pair disagreeing: table 1 with
+    the GNSS as the odd source out."""
+    ramp = Ramp(Interval(200.0, 1e9), (2.0, 0.0, 0.0))
+    states = synthetic_states("manoeuvres", 260.0)
+    r = MonteCarlo(states, McConfig(gnss=GnssSpec(ramps=(ramp,))), seed=3).run(range(3))
+    assert np.isfinite(r.t_gnss_s).all() and (r.t_gnss_s > 200.0).all()
+    assert (r.t_gnss_s < 215.0).all()
+    assert not np.isfinite(r.t_exclude_s).any() and not np.isfinite(r.t_isolate_s).any()
