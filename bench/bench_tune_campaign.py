@@ -2,7 +2,7 @@
 with the tuned aircraft file, in wind and turbulence, and the shift of the error distributions.
 
     python bench/bench_tune_campaign.py --new RUN/aircraft.yaml [--old 737]
-        [--airports KBFI KDLS ...] [--limit N] [--workers 2] [--wind 270/30]
+        [--airports KBFI KDLS ...] [--types STAR,APPROACH] [--limit N] [--workers 2] [--wind 270/30]
         [--turbulence moderate] --out DIR
 
 Two ``fms-testbed regress run`` campaigns over the same cases (embedded excerpt, ``--airports``,
@@ -36,6 +36,8 @@ def _run(aircraft: str, cond: Path, args, out: Path) -> pd.DataFrame:
         argv += ["--airports", *args.airports]
     if args.limit:
         argv += ["--limit", str(args.limit)]
+    if args.types:
+        argv += ["--types", args.types]
     rc = main(argv)
     if rc not in (0, 1):
         raise SystemExit(f"regress run for {aircraft} exited {rc}")
@@ -61,6 +63,8 @@ def main() -> int:
     ap.add_argument("--old", default="737", help="aircraft with the file gains (name or file)")
     ap.add_argument("--airports", nargs="*", default=None)
     ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--types", default="STAR,APPROACH",
+                    help="procedure types (descending profiles carry the vertical path error)")
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--wind", default="270/30", help="FROM_DEG/SPEED_KT")
     ap.add_argument("--turbulence", default="moderate", choices=("light", "moderate", "severe"))

@@ -106,7 +106,8 @@ def _report(cfg, res, goals, args, points_md: str) -> str:
     b0 = cfg.inner_loops.bank
     bank = (f"Bank loop (one gain set for the grid): file kp {b0.kp:g}, kd {b0.kd:g} → kp "
             f"{res.bank.kp:g}, kd {res.bank.kd:g}; smallest scaled slack of its GM/PM goals "
-            f"{res.bank_slack[0]:.3f} → {res.bank_slack[1]:.3f} (≥ 0: met). Nonlinear bank "
+            f"{res.bank_slack[0]:.3f} → {res.bank_slack[1]:.3f} (against the goals plus the "
+            "tuner's buffers 1 dB / 5°; ≥ 0: buffers kept). Nonlinear bank "
             "steps at the default condition: " + ", ".join(
                 f"{math.degrees(r.spec.amplitude):.0f}° settles {r.settle_s:.1f} s "
                 f"(spec {r.spec.settle_max_s:g}), overshoot {r.overshoot_pct:.1f} % "

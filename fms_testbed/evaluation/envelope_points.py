@@ -319,7 +319,7 @@ def _bank_slack(cfg: AircraftConfig, models: list, gains) -> np.ndarray:
 
 
 def start_law(cfg: AircraftConfig) -> CoupledLawParams:
-    """The coupled-law tuning of the aircraft file (the tuner's start)."""
+    """The coupled-law tuning of the aircraft file of ``cfg`` (the tuner's start)."""
     from fms_testbed.control.coupled_law import params_from_config
 
     return params_from_config(cfg)
