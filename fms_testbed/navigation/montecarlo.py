@@ -143,7 +143,7 @@ class _Batch:
                                   s0.heading_rad, {}))
         self.P, self.gidx = f0.P[None].copy(), np.zeros(self.M, np.int64)
         self.xhat, self.comp = np.zeros((self.M, n)), np.zeros((self.M, 6))
-        self.fdi = TwoStage(Rn, U, cfg.fdi)
+        self.fdi = TwoStage(Rn, U, cfg.fdi, track_stats=True)
         self.sensor: SensorPairTest | None = None
         self.sd_sensor = None
         self.next_fix = self.next_baro = s0.t_s
