@@ -38,7 +38,7 @@ from fms_testbed.evaluation.detection_limit import (arl0_samples, cusum_mean_shi
                                                     unit_against_others_sigma)
 from fms_testbed.evaluation.montecarlo import synthetic_states
 from fms_testbed.navigation.identification.tuning import FdiTuning
-from fms_testbed.navigation.montecarlo import McConfig, McFault, MonteCarlo, run_chunks
+from fms_testbed.navigation.montecarlo import McConfig, McFault, McResult, MonteCarlo, run_chunks
 from fms_testbed.sensors.gnss import GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.presets import load_imu
 
@@ -197,31 +197,51 @@ def calibrate(args) -> None:
     (RESULTS / f"fdi_calibration{_suffix(args)}.md").write_text(head + "\n".join(lines) + "\n")
 
 
-def false_alarms(args) -> None:
+def _fa_chunk(job):
+    """One chunk of the false-alarm set (worker process)."""
+    seed, first, n, tuning = job
     states = synthetic_states("manoeuvres", 3600.0)
+    return run_chunks(MonteCarlo(states, McConfig(fdi=tuning), seed=seed), n, n, first=first)
+
+
+def false_alarms(args) -> None:
+    """Chunks of ``--chunk`` realisations on ``--workers`` processes; the page is rewritten
+    after every chunk, so an interrupted run leaves the counts of the chunks it finished."""
+    from concurrent.futures import ProcessPoolExecutor
+
     t0 = time.perf_counter()
-    r = run_chunks(MonteCarlo(states, McConfig(fdi=_tuning(args)), seed=args.seed), args.runs,
-                   args.chunk, workers=args.workers)
+    jobs = [(args.seed, a, min(args.chunk, args.runs - a), _tuning(args))
+            for a in range(0, args.runs, args.chunk)]
+    done = []
+    with ProcessPoolExecutor(max_workers=args.workers) as ex:
+        for r in ex.map(_fa_chunk, jobs):
+            done.append(r)
+            _write_false_alarms(args, done, time.perf_counter() - t0)
+
+
+def _write_false_alarms(args, parts, wall_s) -> None:
+    r = McResult.concat(parts)
+    n = r.index.size
     iso = np.isfinite(r.t_isolate_s).any(axis=1)
     exc = np.isfinite(r.t_exclude_s).any(axis=1)
     sens = np.isfinite(r.t_gnss_s) | np.isfinite(r.t_baro_s)
     det = np.isfinite(r.t_detect_s)
     anyf = iso | exc | sens
     k = int(anyf.sum())
-    bound = chi2.ppf(0.95, 2 * k + 2) / 2 / args.runs
-    text = (f"Disjoint set: realisations 0-{args.runs - 1} of seed {args.seed}, one hour of the "
+    bound = chi2.ppf(0.95, 2 * k + 2) / 2 / n
+    state = "" if n == args.runs else f" — interrupted: {n} of the {args.runs} realisations run"
+    text = (f"Disjoint set: realisations 0-{n - 1} of seed {args.seed}, one hour of the "
             f"`manoeuvres` profile each, default tuning (`python bench/bench_detection.py "
-            f"false-alarms --runs {args.runs} --seed {args.seed} --workers {args.workers}"
-            f"{_cli(args)}`, "
-            f"{time.perf_counter() - t0:.0f} s wall).\n\n"
-            "| runs | stage-1 detections | isolations | exclusions | GNSS/baro named | "
+            f"false-alarms --runs {args.runs} --seed {args.seed} --chunk {args.chunk} "
+            f"--workers {args.workers}{_cli(args)}`, {wall_s:.0f} s wall{state}).\n\n"
+            "| runs | detections | isolations | exclusions | GNSS/baro named | "
             "any false removal | 95 % bound (1/h) |\n|---|---|---|---|---|---|---|\n"
-            f"| {args.runs} | {int(det.sum())} | {int(iso.sum())} | {int(exc.sum())} | "
+            f"| {n} | {int(det.sum())} | {int(iso.sum())} | {int(exc.sum())} | "
             f"{int(sens.sum())} | {k} | {bound:.2e} |\n")
     if k:
-        text += f"\nRealisations with a false removal: {list(np.flatnonzero(anyf))}\n"
+        text += f"\nRealisations with a false removal: {list(r.index[anyf])}\n"
     (RESULTS / f"fdi_false_alarms{_suffix(args)}.md").write_text(text)
-    print(text)
+    print(text, flush=True)
 
 
 def main() -> None:
