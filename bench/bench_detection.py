@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 from pathlib import Path
 
@@ -42,7 +43,14 @@ from fms_testbed.navigation.montecarlo import McConfig, McFault, McResult, Monte
 from fms_testbed.sensors.gnss import GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.presets import load_imu
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
+PAGES = ("fdi_calibration.md", "fdi_false_alarms.md", "detection_limits_without_drift.md",
+         "detection_limits_drift.md")
+"""The docs/results pages this bench writes with the default options (``--only 'gyro drift'``
+with and without ``--exclude`` for the two detection-limit pages)."""
 RATE_PER_H = 3e-3
 """The goal's false-alarm rate (zero in 1,000 one-hour flights: ≤ 3e-3/h at 95 %)."""
 FAULT_AT_S = 200.0
@@ -168,8 +176,7 @@ def table(args) -> None:
     head = (f"Seeds 0-{args.seeds - 1} of run seed 0, fault at t = {FAULT_AT_S:g} s of the "
             f"`manoeuvres` profile (`python bench/bench_detection.py table --seeds "
             f"{args.seeds}{_cli(args)}{_rows_cli(args)}`); T* at {RATE_PER_H:g} false alarms per hour.\n\n")
-    out.write_text(head + "\n".join(lines) + "\n")
-    print(f"wrote {out}")
+    report.write(out, head + "\n".join(lines))
 
 
 LAYERS = ("stage-1 output pair |Δ|/σ", "sensor-level |z|", "stage-2 |Z_i − Ẑ|/σ",
@@ -194,7 +201,7 @@ def calibrate(args) -> None:
             f"the `manoeuvres` profile each (`python bench/bench_detection.py calibrate --runs "
             f"{args.runs} --seed {args.seed}{_cli(args)}`, {time.perf_counter() - t0:.0f} s "
             "wall).\n\n")
-    (RESULTS / f"fdi_calibration{_suffix(args)}.md").write_text(head + "\n".join(lines) + "\n")
+    report.write(RESULTS / f"fdi_calibration{_suffix(args)}.md", head + "\n".join(lines))
 
 
 def _fa_chunk(job):
@@ -240,7 +247,7 @@ def _write_false_alarms(args, parts, wall_s) -> None:
             f"{int(sens.sum())} | {k} | {bound:.2e} |\n")
     if k:
         text += f"\nRealisations with a false removal: {list(r.index[anyf])}\n"
-    (RESULTS / f"fdi_false_alarms{_suffix(args)}.md").write_text(text)
+    report.write(RESULTS / f"fdi_false_alarms{_suffix(args)}.md", text)
     print(text, flush=True)
 
 
