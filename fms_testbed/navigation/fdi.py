@@ -133,7 +133,8 @@ def switch_components(nu: np.ndarray, S: np.ndarray, scale: np.ndarray, R: np.nd
     the nominal R (S⁰ = S − (scale − 1) R on the diagonal); A = diag(a): the component's row of
     H̃ = A H is switched off and its measurement replaced by artificial white noise ζ of
     variance ``switch_noise`` × R_ii (R̃ = A R + (I − A) ζ), which leaves K's column for it
-    ≈ 0. Divergence test: νᵀν > γ tr(S⁰) on the components in use.
+    ≈ 0. Divergence test: every component failing and νᵀν > γ tr(S⁰) — the filter no longer
+    explains any of its measurements (an outlier burst lets some through).
 
     Parameters
     ----------
@@ -150,9 +151,7 @@ def switch_components(nu: np.ndarray, S: np.ndarray, scale: np.ndarray, R: np.nd
     s0 = np.diag(S) - (np.asarray(scale, float) - 1.0) * np.diag(R)
     ok = np.abs(nu) <= tuning.k_residual * np.sqrt(np.maximum(s0, 0.0))
     new = np.where(ok, 1.0, tuning.switch_noise)
-    on = np.asarray(scale) <= 1.0 + 1e-9
-    diverging = bool(on.any() and float(nu[on] @ nu[on]) > tuning.diverge_gamma
-                     * float(s0[on].sum()))
+    diverging = bool(not ok.any() and float(nu @ nu) > tuning.diverge_gamma * float(s0.sum()))
     return new, diverging
 
 

@@ -59,7 +59,7 @@ def test_component_switching_turns_off_the_failed_component_and_flags_divergence
     nu = np.array([0.3, 10.0, -1.0])                          # component 2: 10 > 5√1
     scale, div = switch_components(nu, S, np.ones(3), R, tune)
     np.testing.assert_array_equal(scale, [1.0, tune.switch_noise, 1.0])
-    assert div == (100.09 + 1.0 > tune.diverge_gamma * 6.0)
+    assert not div                                             # two components pass
     S_off = S + np.diag((scale - 1.0) * 0.5)                  # the filter's S with ζ
     scale2, _ = switch_components(nu, S_off, scale, R, tune)  # tested at the nominal S
     np.testing.assert_array_equal(scale2, scale)              # still off while it fails

@@ -119,12 +119,14 @@ def test_no_false_exclusion_where_unmodelled_misalignment_once_caused_them():
 
 def test_raw_output_voting_keeps_a_drift_the_filters_calibrate_and_drops_a_large_step():
     """Voting on the free inertial outputs at k_pair √2 σ_free: a drift ×2 on INS 2 stays in
-    the vote (its raw error is inside the declared envelope for minutes), a 10 mg accelerometer
-    step leaves it within the run; the NSE of the voted output is logged beside the output's."""
+    the vote (its raw error is inside the declared envelope for minutes), a 100 mg accelerometer
+    step leaves it within the run (10 mg does not within 300 s: the free envelope carries the
+    alignment's heading σ, 150 m/s × δψ of velocity); the NSE of the voted output is logged
+    beside the output's."""
     states = synthetic_states("manoeuvres", 500.0)
     mc = MonteCarlo(states, McConfig(), seed=7)
     drift = mc.run(range(3), McFault("gyro_drift_scale", 2.0, 200.0, 1))
-    step = mc.run(range(3), McFault("accel_bias_step", 10000.0, 200.0, 1, "x"))
+    step = mc.run(range(3), McFault("accel_bias_step", 100000.0, 200.0, 1, "x"))
     assert (drift.vote_in[:, 1] > 0.99).all(), drift.vote_in
     assert (step.vote_in[:, 1] < 0.5).all() and (step.vote_in[:, [0, 2]] > 0.99).all()
     assert step.hist_vote.sum() == step.hist_gnss.sum() + step.hist_coast.sum()
