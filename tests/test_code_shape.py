@@ -82,3 +82,14 @@ def long_functions() -> list[tuple[str, str, int]]:
 def test_package_long_functions_within_the_goal():
     long = long_functions()
     assert len(long) <= LONG_FUNCTIONS_MAX, sorted(long, key=lambda f: -f[2])
+
+
+def test_package_modules_and_classes_within_the_goal():
+    big = []
+    for p in _modules():
+        lines, classes, _ = shape(p)
+        name = str(p.relative_to(PACKAGE))
+        if lines > MODULE_MAX_LINES:
+            big.append((name, f"{lines} lines"))
+        big += [(name, f"class {c} has {n} methods") for c, n in classes if n > CLASS_MAX_METHODS]
+    assert not big, big
