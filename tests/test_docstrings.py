@@ -13,6 +13,9 @@ MODULES = [
     # the coupled law and its studies
     "control.coupled_law", "control.baselines", "control.pointmass", "control.linear",
     "control.metrics", "evaluation.law_tuning", "evaluation.law_comparison", "viz.control",
+    # envelope tuning
+    "sim.linearise", "control.loops", "control.schedule", "evaluation.envelope_points",
+    "evaluation.envelope_tuning", "evaluation.linear_check", "viz.tuning", "cli.tune_envelope",
     # MEMS gyro drift
     "sensors.mems.preset", "sensors.mems.temperature", "sensors.mems.model",
     "sensors.mems.compensation", "sensors.mems.allan", "sensors.mems.static_test",

@@ -32,7 +32,7 @@ FIGURES = ("nichols.png", "bode-worst.png", "steps.png", "schedule.png")
 
 
 def goal_lines(df: pd.DataFrame) -> list[tuple[bool, str]]:
-    """(met, text) of the envelope goals over every trimmed point of ``points.csv``."""
+    """(met, text) of the envelope goals over every trimmed point of ``df`` (``points.csv``)."""
     from fms_testbed.evaluation.envelope_points import GM_MIN_DB, PM_MIN_DEG
 
     ok = df[df["gm_min_db"].notna()]
@@ -70,7 +70,8 @@ def _schedule_curves(res) -> dict[str, pd.DataFrame]:
 
 
 def write_figures(res, name: str, tmp: Path) -> None:
-    """Nichols (all points), Bode at the smallest-PM point, steps at the worst points, schedule."""
+    """Write into ``tmp`` the figures of ``res`` for aircraft ``name``: Nichols (all points),
+    Bode at the smallest-PM point, steps at the worst points, the schedule."""
     from fms_testbed.evaluation.envelope_tuning import FIG_OMEGA_RPS
     from fms_testbed.control.loops import BREAKS
     from fms_testbed.viz.figure import save
@@ -102,6 +103,15 @@ def _report(cfg, res, goals, args, points_md: str) -> str:
     load = os.getloadavg()
     terms = markdown_table(pd.DataFrame(res.schedule.table()))
     gl = "\n".join(f"- {'PASS' if ok else 'FAIL'}: {t}" for ok, t in goals)
+    b0 = cfg.inner_loops.bank
+    bank = (f"Bank loop (one gain set for the grid): file kp {b0.kp:g}, kd {b0.kd:g} → kp "
+            f"{res.bank.kp:g}, kd {res.bank.kd:g}; smallest scaled slack of its GM/PM goals "
+            f"{res.bank_slack[0]:.3f} → {res.bank_slack[1]:.3f} (against the goals plus the "
+            "tuner's buffers 1 dB / 5°; ≥ 0: buffers kept). Nonlinear bank "
+            "steps at the default condition: " + ", ".join(
+                f"{math.degrees(r.spec.amplitude):.0f}° settles {r.settle_s:.1f} s "
+                f"(spec {r.spec.settle_max_s:g}), overshoot {r.overshoot_pct:.1f} % "
+                f"(spec {r.spec.overshoot_max_pct:g})" for r in res.bank_steps))
     figs = "\n".join(f"![{f}]({f})" for f in FIGURES)
     return (f"# Envelope tuning of the coupled law — {cfg.name}\n\n"
             f"Command: `fms-testbed tune --aircraft {args.aircraft} --envelope"
@@ -112,7 +122,8 @@ def _report(cfg, res, goals, args, points_md: str) -> str:
             "(+100 m and +10 % TAS steps).\n\n"
             f"Wall time: tuning {res.tune_wall_s:.0f} s, checks {res.check_wall_s:.0f} s on "
             f"{res.workers} workers (load average at the end {load[0]:.1f} / {load[1]:.1f} / "
-            f"{load[2]:.1f}, {os.cpu_count()} cores).\n\n## Goals\n\n{gl}\n\n## Schedule\n\n"
+            f"{load[2]:.1f}, {os.cpu_count()} cores).\n\n## Goals\n\n{gl}\n\n{bank}\n\n"
+            "## Schedule\n\n"
             "Piecewise linear in ln q̄ per mass level, linear in mass between levels:\n\n"
             f"{terms}\n\n"
             f"## Points\n\n{points_md}\n\n## Figures\n\n{figs}\n")
@@ -140,7 +151,7 @@ def cmd_tune_envelope(args) -> int:
     block = schedule_block(res.schedule)
     (tmp / "schedule.yaml").write_text(yaml.safe_dump({"coupled_law_schedule": block},
                                                       sort_keys=False))
-    (tmp / "aircraft.yaml").write_text(aircraft_with_schedule(cfg, res.schedule))
+    (tmp / "aircraft.yaml").write_text(aircraft_with_schedule(cfg, res.schedule, res.bank))
     goals = goal_lines(table)
     show = [c for c in ("alt_m", "tas_mps", "mass_kg", "config", "status", "gm_min_db",
                         "pm_min_deg", "disk_margin", "max_dv_kmh", "max_dh_m", "old_max_dv_kmh",
@@ -150,7 +161,10 @@ def cmd_tune_envelope(args) -> int:
     (tmp / "report.md").write_text(_report(cfg, res, goals, args, md))
     print(md)
     print("\nGoals:\n" + "\n".join(f"- {'PASS' if ok else 'FAIL'}: {t}" for ok, t in goals))
-    print(f"\nwall time: tuning {res.tune_wall_s:.0f} s, checks {res.check_wall_s:.0f} s")
+    print(f"\nbank loop: kp {res.bank.kp:g}, kd {res.bank.kd:g} (file {cfg.inner_loops.bank.kp:g}, "
+          f"{cfg.inner_loops.bank.kd:g}); goal slack {res.bank_slack[0]:.3f} → "
+          f"{res.bank_slack[1]:.3f}")
+    print(f"wall time: tuning {res.tune_wall_s:.0f} s, checks {res.check_wall_s:.0f} s")
     print(f"written to {out}/ (points.csv, schedule.yaml, aircraft.yaml, report.md, "
           f"{', '.join(FIGURES)})")
     folder.commit()
@@ -158,8 +172,9 @@ def cmd_tune_envelope(args) -> int:
 
 
 def cmd_analyse_jsbsim(args) -> int:
-    """``analyse --plant jsbsim``: linearise the trimmed aircraft, print its modes and the loops'
-    margins, compare with the point-mass model, and check the linearisation against JSBSim."""
+    """``analyse --plant jsbsim``: linearise the trimmed aircraft, print its modes checked
+    against the nonlinear model and the closed loop against the point-mass model; exit 1 when
+    the modes disagree (:data:`~fms_testbed.evaluation.linear_check.MODE_TOL_REL`)."""
     from fms_testbed.cli.coupled import _out_dir
     from fms_testbed.control.coupled_law import params_from_config
     from fms_testbed.core.units import KMH_MPS
@@ -171,11 +186,16 @@ def cmd_analyse_jsbsim(args) -> int:
     out = _out_dir(args.out, f"analyse-jsbsim-{cfg.name}")
     folder = OutputFolder(out, getattr(args, "overwrite", False))
     tmp = folder.open()
-    rep = compare_point(cfg, alt, tas, params_from_config(cfg), tmp)
-    for line in rep:
+    from fms_testbed.viz.figure import save
+    from fms_testbed.viz.tuning import plot_linear_check
+
+    chk = compare_point(cfg, alt, tas, params_from_config(cfg))
+    for line in chk.lines:
         print(line)
+    save(plot_linear_check(chk.t_s, chk.nonlinear, chk.linear, chk.title),
+         tmp / "linear-vs-jsbsim.png")
     (tmp / "analysis.md").write_text(f"# {cfg.name}: linearised JSBSim at {alt:.0f} m / "
-                                     f"{tas:.1f} m/s\n\n" + "\n".join(rep) + "\n")
+                                     f"{tas:.1f} m/s\n\n" + "\n".join(chk.lines) + "\n")
     print(f"\nwritten to {out}/ (analysis.md, linear-vs-jsbsim.png)")
     folder.commit()
-    return 0 if not any(math.isnan(0.0) for _ in rep) else 1
+    return 0 if chk.ok else 1

@@ -118,7 +118,8 @@ class CoupledLawParams:
 
 
 def schedule_from_config(cfg: AircraftConfig) -> GainSchedule | None:
-    """The aircraft's ``coupled_law_schedule`` as a :class:`GainSchedule` (None when absent)."""
+    """The aircraft configuration ``cfg``'s ``coupled_law_schedule`` as a :class:`GainSchedule`
+    (None when absent)."""
     sc = cfg.coupled_law_schedule
     if sc is None:
         return None
@@ -372,15 +373,7 @@ class CoupledLaw:
         ny = min(max(ny, p.ny_min), p.ny_max)
 
         if p.ny_trim_tau_s > 0:
-            ny_law = ny
-            ny = min(max(ny + st.ny_trim, p.ny_min), p.ny_max)
-            a = min(dt_s / p.ny_model_tau_s, 1.0) if p.ny_model_tau_s > 0 else 1.0
-            st.ny_model += a * (ny_law - st.ny_model)
-            if p.ny_min < ny < p.ny_max:
-                # measured n_y, vertical-plane component (the law works in the vertical plane)
-                ny_meas = float(state.ny) * math.cos(state.roll_rad)
-                st.ny_trim += (st.ny_model - ny_meas) * dt_s / p.ny_trim_tau_s
-                st.ny_trim = min(max(st.ny_trim, -0.1), 0.1)
+            ny = self._ny_trim(ny, dt_s, state)
 
         if st.protect_mode:
             # flight path holds the speed; keep the throttle at its limit
@@ -398,6 +391,20 @@ class CoupledLaw:
             st.nxa_cmd += rate * dt_s
         st.dny = ny - 1.0
         return st.nxa_cmd, ny
+
+    def _ny_trim(self, ny_law: float, dt_s: float, state: AircraftState) -> float:
+        """n_y tracking-error integrator (``ny_trim_tau_s``): the command plus the trim, the
+        model of the inner loop advanced, the trim integrated unless the command is clipped."""
+        p, st = self.params, self.state
+        ny = min(max(ny_law + st.ny_trim, p.ny_min), p.ny_max)
+        a = min(dt_s / p.ny_model_tau_s, 1.0) if p.ny_model_tau_s > 0 else 1.0
+        st.ny_model += a * (ny_law - st.ny_model)
+        if p.ny_min < ny < p.ny_max:
+            # measured n_y, vertical-plane component (the law works in the vertical plane)
+            ny_meas = float(state.ny) * math.cos(state.roll_rad)
+            st.ny_trim += (st.ny_model - ny_meas) * dt_s / p.ny_trim_tau_s
+            st.ny_trim = min(max(st.ny_trim, -0.1), 0.1)
+        return ny
 
     def _protect(self, ny: float, dV: float, V: float, gam: float, nx_meas: float,
                  gr: float) -> float:

@@ -98,7 +98,12 @@ def _pi(name: str, kp: float, ki: float, inputs: list[str], out: str, weights: l
 
 
 def inner_blocks(g: InnerGains, V0_mps: float) -> list[ct.StateSpace]:
-    """The four inner loops as blocks (module docstring); signals in SI, load factors in g."""
+    """The four inner loops as blocks (module docstring); signals in SI, load factors in g.
+
+    Parameters
+    ----------
+    g : gains at the point;  V0_mps : trim TAS, m/s (coordinated-turn yaw rate)
+    """
     ny = _pi("ny_loop", -g.ny_kp, -g.ny_ki, ["dny_cmd", "ny", "q"], "elevator",
              [1.0, -1.0, 0.0], extra=[-g.ny_kff, 0.0, g.ny_kd])
     nx = _pi("nx_loop", g.nx_kp, g.nx_ki, ["nx_cmd", "nx"], "throttle", [1.0, -1.0],
@@ -112,7 +117,12 @@ def inner_blocks(g: InnerGains, V0_mps: float) -> list[ct.StateSpace]:
 
 def path_block(law: LateralLaw, V0_mps: float) -> ct.StateSpace:
     """Cross-track kinematics and the path law (module docstring): inputs (psi, beta, kappa),
-    outputs (bank_cmd, xtk); states (xtk_m, track_err_rad)."""
+    outputs (bank_cmd, xtk); states (xtk_m, chi_d_rad).
+
+    Parameters
+    ----------
+    law : path-law tuning;  V0_mps : ground speed = TAS (calm air), m/s
+    """
     g, w, z, V = G0_MPS2, law.omega_rps, law.zeta, V0_mps
     # states z (m), chi_d (rad): z' = V (psi + beta - chi_d), chi_d' = V kappa
     A = np.array([[0.0, -V], [0.0, 0.0]])
@@ -131,6 +141,10 @@ def law_block(p: CoupledLawParams, V0_mps: float) -> ct.StateSpace:
         ṅ_m = (Δn_y,law - n_m) / τ_m,   ṫ = (n_m - Δn_y) / τ_t,   Δn_y,cmd = Δn_y,law + t
 
     with the thrust channel's cross term on the command including ``t``.
+
+    Parameters
+    ----------
+    p : law tuning;  V0_mps : trim TAS, m/s
     """
     s = law_ss(p, V0_mps)
     ins = ["V_cmd", "H_cmd", "V", "gamma", "h", "nx", "ny"]
@@ -151,7 +165,7 @@ def law_block(p: CoupledLawParams, V0_mps: float) -> ct.StateSpace:
 
 
 def delay_block(signal: str, delay_s: float) -> ct.StateSpace:
-    """Second-order Padé delay from ``<signal>_c`` to ``<signal>`` (s)."""
+    """Second-order Padé delay of ``delay_s`` seconds from ``<signal>_c`` to ``<signal>``."""
     num, den = ct.pade(delay_s, 2)
     d = ct.ss(ct.tf(num, den))
     return ct.ss(d.A, d.B, d.C, d.D, inputs=[f"{signal}_c"], outputs=[signal],
@@ -275,6 +289,8 @@ class Margins:
     wc_rps: float
 
 
+GM_NONE_DB = 100.0
+"""A gain margin above this (numerical crossings where |L| is negligible) counts as none: inf."""
 OMEGA_RPS = np.logspace(-3, 2.5, 600)
 """Frequency grid of the margin computations, rad/s."""
 
@@ -291,6 +307,7 @@ def margins(L: ct.StateSpace, omega_rps: np.ndarray = OMEGA_RPS) -> Margins:
     """
     gm, pm, _, wpc, wgc, _ = ct.stability_margins(L, returnall=True)
     gms = [abs(20 * math.log10(g)) for g in np.atleast_1d(gm) if g > 0 and math.isfinite(g)]
+    gms = [g for g in gms if g < GM_NONE_DB]
     pms = list(np.atleast_1d(pm))
     wgs = list(np.atleast_1d(wgc))
     gm_db = min(gms) if gms else math.inf
@@ -304,7 +321,8 @@ def margins(L: ct.StateSpace, omega_rps: np.ndarray = OMEGA_RPS) -> Margins:
 
 
 def closed_loop_damping(pl: PointLoops, axis: str) -> tuple[float, float]:
-    """(smallest damping ratio of the oscillatory closed-loop poles, largest real part (1/s))."""
+    """(smallest damping ratio of the oscillatory closed-loop poles, largest real part (1/s)) of
+    the loops ``pl`` on ``axis`` (``"lon"`` or ``"lat"``)."""
     sys = pl.closed(axis, ["V_cmd", "H_cmd"] if axis == "lon" else ["kappa"],
                     ["V", "h"] if axis == "lon" else ["xtk"])
     ev = np.linalg.eigvals(np.asarray(sys.A))

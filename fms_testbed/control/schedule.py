@@ -98,6 +98,7 @@ def schedule_from_points(rows: list[dict]) -> GainSchedule:
 
 
 def qbar_from_state(tas_mps: float, p_static_pa: float, t_static_k: float) -> float:
-    """Dynamic pressure ½ ρ V², Pa, with ρ = p_s / (R T_s) (m/s, Pa, K)."""
+    """Dynamic pressure ½ ρ V², Pa, at TAS ``tas_mps`` (m/s) with ρ = p_s / (R T_s) from the
+    static pressure ``p_static_pa`` (Pa) and temperature ``t_static_k`` (K)."""
     rho = p_static_pa / (R_JPKGK * max(t_static_k, 1.0))
     return 0.5 * rho * tas_mps * tas_mps

@@ -11,7 +11,8 @@ coupled law's (T_V, ξ_V, T_H, ξ_H) and its n_y-trim time constant are tuned th
 * soft goals (cost), on the linear closed loop's responses to an altitude step ``dH`` and a
   speed step ``dV``: tracking (integral of |error| over the step, in step sizes × 10 s),
   decoupling ((max|ΔV| / 0.5 km/h)² + (max|ΔH| / 0.75 m)², half the nonlinear goals), and
-  activity (peak throttle in 0.3 of its range and peak elevator in 0.1, per step).
+  activity (peak throttle in 0.3 of its range and peak elevator in 0.1, per step), plus a pull
+  towards the starting tuning (:data:`REG_WEIGHT`).
 
 The margins inside the optimiser are read from the loop's frequency response on a grid
 (:func:`grid_margins`); the reported ones are python-control's (:func:`~.loops.margins`).
@@ -23,6 +24,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, replace
 
+import control as ct
 import numpy as np
 from scipy.linalg import expm
 from scipy.optimize import minimize
@@ -52,6 +54,10 @@ BOUNDS = {"T_V_s": (4.0, 15.0), "xi_V": (0.6, 1.5), "T_H_s": (5.0, 20.0), "xi_H"
 n_y tracking-error integrator, the element that sets the elevator channel's phase margin at
 low dynamic pressure)."""
 NAMES = tuple(BOUNDS)
+REG_WEIGHT = 2.0
+"""Weight of the pull towards the starting tuning, ``REG_WEIGHT Σ ((x - x0)/(hi - lo))²``: the
+soft cost is flat near its optimum, and without the pull neighbouring points land on unrelated
+optima (a jagged schedule)."""
 DH_STEP_M = 100.0
 """Altitude step of the soft goals and of the nonlinear check, m (inside the ±dH limit)."""
 DV_STEP_FRAC = 0.10
@@ -62,7 +68,8 @@ _OMEGA = np.logspace(-3, 2, 400)
 
 
 def qbar_ratio(cfg: AircraftConfig, qbar_pa: float) -> float:
-    """q̄_ref / q̄ of the inner loops' schedule (reference: the aircraft's default condition)."""
+    """q̄_ref / q̄ of the inner loops' schedule at ``qbar_pa`` (Pa); the reference is the aircraft
+    ``cfg``'s default condition."""
     _, _, rho = isa(cfg.default_condition.alt_m)
     return 0.5 * float(rho) * cfg.default_condition.tas_mps ** 2 / qbar_pa
 
@@ -81,17 +88,21 @@ def point_loops(cfg: AircraftConfig, model: AirframeModel, law: CoupledLawParams
 
 
 def freq_response(sys, omega_rps: np.ndarray) -> np.ndarray:
-    """SISO frequency response C (jωI - A)⁻¹ B + D on ``omega_rps`` (rad/s), via the
-    eigen-decomposition of A (vectorised over ω)."""
+    """SISO frequency response C (jωI - A)⁻¹ B + D of ``sys`` on ``omega_rps`` (rad/s), via the
+    eigen-decomposition of A (vectorised over ω), or python-control's response when A is
+    (nearly) defective."""
     A, B, C, D = (np.asarray(m) for m in (sys.A, sys.B, sys.C, sys.D))
     lam, V = np.linalg.eig(A)
+    if np.linalg.cond(V) > 1e8:         # defective A (repeated integrators): python-control
+        return np.asarray(ct.frequency_response(sys, omega_rps).complex).ravel()
     cb = (C @ V).ravel() * np.linalg.solve(V, B).ravel()
     return (cb[None, :] / (1j * omega_rps[:, None] - lam[None, :])).sum(axis=1) + D[0, 0]
 
 
 def grid_margins(L, omega_rps: np.ndarray = _OMEGA) -> tuple[float, float, float]:
-    """(GM dB, PM deg, disk margin α) of a loop transfer from its response on a grid: GM at the
-    phase crossovers (Im L changes sign with Re L < 0), PM at |L| = 1, α = min 2|1+L|/|1-L|."""
+    """(GM dB, PM deg, disk margin α) of a loop transfer ``L`` from its response on the grid
+    ``omega_rps`` (rad/s): GM at the phase crossovers (Im L changes sign with Re L < 0), PM at
+    |L| = 1, α = min 2|1+L|/|1-L|."""
     h = freq_response(L, omega_rps)
     cross = np.flatnonzero((np.sign(h.imag[:-1]) != np.sign(h.imag[1:])) & (h.real[:-1] < 0))
     gms = [abs(20 * math.log10(abs(h.real[i]))) for i in cross if h.real[i] != 0]
@@ -113,7 +124,8 @@ def step_matrices(sys, dt_s: float = _DT_S) -> tuple[np.ndarray, np.ndarray]:
 
 
 def step_outputs(sys, u: np.ndarray, t_end_s: float = T_STEP_S, dt_s: float = _DT_S) -> np.ndarray:
-    """Outputs (time × outputs) of ``sys`` for a constant input vector ``u`` from rest."""
+    """Outputs (time × outputs) of ``sys`` for a constant input vector ``u`` from rest, every
+    ``dt_s`` seconds up to ``t_end_s`` seconds."""
     Phi, Gam = step_matrices(sys, dt_s)
     C, D = np.asarray(sys.C), np.asarray(sys.D)
     n = int(t_end_s / dt_s)
@@ -216,13 +228,16 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
         r = minimize(lambda v: -min(np.min(_constraints(goals(v))), 0.2), u0,
                      method="Nelder-Mead", options={"maxfev": 80, "xatol": 0.01, "fatol": 1e-3})
         u = np.clip(r.x, 0.0, 1.0)
-    minimize(lambda v: goals(v).cost, u, method="SLSQP", bounds=[(0.0, 1.0)] * len(NAMES),
+    def cost(v):
+        return goals(v).cost + REG_WEIGHT * float(np.sum((np.clip(v, 0, 1) - u0) ** 2))
+
+    minimize(cost, u, method="SLSQP", bounds=[(0.0, 1.0)] * len(NAMES),
              constraints=[{"type": "ineq", "fun": lambda v: _constraints(goals(v))}],
              options={"maxiter": max_iter, "ftol": 1e-4, "eps": 1e-3})
     done = list(cache.values())
     feas = [(uu, g) for uu, g in done if np.min(_constraints(g)) >= 0]
     if feas:
-        best_u, gb = min(feas, key=lambda e: e[1].cost)
+        best_u, gb = min(feas, key=lambda e: cost(e[0]))
     else:
         best_u, gb = max(done, key=lambda e: np.min(_constraints(e[1])))
     return PointTuning(params(best_u), gb, g0, len(cache), bool(feas))
@@ -288,3 +303,57 @@ def verify(cfg: AircraftConfig, point: DesignPoint, make_law, duration_s: float 
     dv = float(np.abs(a[:, 2] - a[0, 2]).max() / KMH_MPS)
     dh = float(np.abs(s[:, 1] - s[0, 1]).max())
     return StepCheck(dv, dh, {"alt": a, "speed": s})
+
+
+def _bank_slack(cfg: AircraftConfig, models: list, gains) -> np.ndarray:
+    """Scaled slack of the bank loop's GM and PM goals (plus buffers) at every model."""
+    from fms_testbed.sim.inner_steps import replace_gains
+
+    c = replace_gains(cfg, "bank", gains)
+    out = []
+    for m in models:
+        gm, pm, _ = grid_margins(point_loops(c, m, start_law(cfg)).loop("aileron"))
+        out += [(gm - GM_MIN_DB - TUNE_BUFFER["gm_db"]) / 6.0,
+                (pm - PM_MIN_DEG - TUNE_BUFFER["pm_deg"]) / 45.0]
+    return np.array(out)
+
+
+def start_law(cfg: AircraftConfig) -> CoupledLawParams:
+    """The coupled-law tuning of the aircraft file of ``cfg`` (the tuner's start)."""
+    from fms_testbed.control.coupled_law import params_from_config
+
+    return params_from_config(cfg)
+
+
+def tune_bank_loop(cfg: AircraftConfig, models: list, max_evals: int = 60):
+    """One bank-loop gain set (k_p, k_d of the aircraft file's ``inner_loops.bank``; the JSBSim
+    system scales them with q̄_ref/q̄) meeting the GM/PM goals plus buffers at every design point:
+    Nelder-Mead on log-gains minimising the squared goal violations plus a pull
+    ``0.05 Σ ln²(k/k0)`` towards the file's gains.
+
+    Parameters
+    ----------
+    cfg : aircraft;  models : linear airframes of the design points
+    max_evals : Nelder-Mead evaluations
+
+    Returns
+    -------
+    (gains, smallest slack before, smallest slack after) — slack ≥ 0: every goal met
+    """
+    g0 = cfg.inner_loops.bank
+    x0 = np.log([g0.kp, max(g0.kd, 1e-3)])
+
+    def gains(x):
+        return g0.model_copy(update={"kp": float(np.exp(x[0])), "kd": float(np.exp(x[1]))})
+
+    def f(x):
+        sl = _bank_slack(cfg, models, gains(x))
+        return float(np.sum(np.minimum(sl, 0.0) ** 2) * 100 + 0.05 * np.sum((x - x0) ** 2))
+
+    before = float(np.min(_bank_slack(cfg, models, g0)))
+    if before >= 0:
+        return g0, before, before
+    r = minimize(f, x0, method="Nelder-Mead", options={"maxfev": max_evals, "xatol": 0.01})
+    best = gains(r.x)
+    best = best.model_copy(update={"kp": round(best.kp, 3), "kd": round(best.kd, 3)})
+    return best, before, float(np.min(_bank_slack(cfg, models, best)))

@@ -4,7 +4,9 @@ checks (margins on every loop, robustness, nonlinear JSBSim steps).
 1. every design point is trimmed, linearised and tuned (:func:`.envelope_points.tune_point`);
 2. the tuned (T_V, ξ_V, T_H, ξ_H, τ_ny-trim) become the schedule: a table continuous in dynamic
    pressure and mass through every tuned point (:mod:`fms_testbed.control.schedule`);
-3. every point is checked with the *scheduled* gains — the ones the law flies: margins of the six
+3. one bank-loop gain set is tuned to the margin goals at every point
+   (:func:`.envelope_points.tune_bank_loop`) and its nonlinear bank steps are flown;
+4. every point is checked with the *scheduled* gains — the ones the law flies: margins of the six
    broken loops (python-control ``stability_margins`` and ``disk_margins``), the same margins
    under the robustness set (mass ±:data:`ROBUST_MASS_FRAC`, CG ±:data:`ROBUST_CG_M`, an
    actuator delay of :data:`ROBUST_DELAY_S`), and the nonlinear altitude and speed steps
@@ -35,15 +37,18 @@ from fms_testbed.control.loops import BREAKS, margins
 from fms_testbed.control.schedule import SCHEDULED, GainSchedule, schedule_from_points
 from fms_testbed.core.atmosphere import cas_to_tas
 from fms_testbed.core.errors import ConfigError, TrimError
-from fms_testbed.evaluation.envelope_points import point_loops, tune_point, verify
+from fms_testbed.evaluation.envelope_points import (point_loops, tune_bank_loop, tune_point,
+                                                    verify)
+from fms_testbed.sim.inner_steps import check_aircraft, replace_gains
 from fms_testbed.sim.linearise import DesignPoint, linearise
 
 MASS_FACTORS = (0.9, 1.1)
 """Default grid: masses as fractions of the model's loaded mass."""
 APPROACH_ALT_M = 600.0
 """Default grid: altitude of the approach-configuration points, m."""
-APPROACH_ADD_CAS_MPS = (0.0, 10.0)
-"""Default grid: approach points at Vapp(m) plus these, m/s CAS."""
+APPROACH_ADD_CAS_MPS = (0.0, 5.0)
+"""Default grid: approach points at Vapp(m) plus these, m/s CAS (the Global 5000 model's
+landing flap trims below α −4° from Vapp + 7 m/s)."""
 ROBUST_MASS_FRAC = 0.10
 """Robustness set: mass ± this fraction."""
 ROBUST_CG_M = 0.20
@@ -55,7 +60,7 @@ FIG_OMEGA_RPS = np.logspace(-2.5, 1.7, 300)
 
 
 def loaded_mass_kg(cfg: AircraftConfig) -> float:
-    """The JSBSim model's loaded mass, kg (its file's fuel and payload)."""
+    """The loaded mass of the aircraft ``cfg``'s JSBSim model, kg (its file's fuel and payload)."""
     from fms_testbed.sim.jsbsim_core import JSBSimAircraft
 
     ac = JSBSimAircraft(cfg)
@@ -64,8 +69,9 @@ def loaded_mass_kg(cfg: AircraftConfig) -> float:
 
 
 def default_grid(cfg: AircraftConfig) -> list[DesignPoint]:
-    """Envelope points × :data:`MASS_FACTORS` clean, plus approach points (landing flap, gear
-    down) at :data:`APPROACH_ALT_M` and Vapp(m) + :data:`APPROACH_ADD_CAS_MPS` per mass."""
+    """The default grid of aircraft ``cfg``: its envelope points × :data:`MASS_FACTORS` clean,
+    plus approach points (landing flap, gear down) at :data:`APPROACH_ALT_M` and Vapp(m) +
+    :data:`APPROACH_ADD_CAS_MPS` per mass."""
     m0 = loaded_mass_kg(cfg)
     pts = [DesignPoint(e.alt_m, e.tas_mps, round(f * m0), "clean")
            for e in cfg.envelope for f in MASS_FACTORS]
@@ -93,7 +99,7 @@ class _Grid(BaseModel):
 
 
 def read_grid(path: str | Path) -> list[DesignPoint]:
-    """Design points from a YAML file ``points: [{alt_m, tas_mps, mass_kg, config}, ...]``.
+    """Design points from the YAML file ``path``: ``points: [{alt_m, tas_mps, mass_kg, config}]``.
 
     Raises
     ------
@@ -124,7 +130,7 @@ def _tune_job(ref: str, point: DesignPoint) -> dict:
     out = {"point": point, "status": "ok" if res.feasible else "hard goals not met",
            "qbar_pa": model.qbar_pa, "mass_kg": model.mass_kg, "engine_lag_s": model.engine_lag_s,
            "n_evals": res.n_evals, "cost_start": res.start.cost, "cost": res.goals.cost,
-           "tune_s": time.perf_counter() - t0}
+           "tune_s": time.perf_counter() - t0, "model": model}
     out.update({f"tuned_{n}": getattr(res.params, n) for n in SCHEDULED})
     return out
 
@@ -157,7 +163,8 @@ def _mins(row: dict, prefix: str = "") -> tuple[float, float, float]:
 
 
 def robustness_set(point: DesignPoint, mass_kg: float) -> list[tuple[DesignPoint, float]]:
-    """(design point, actuator delay s) of the robustness check around ``point``."""
+    """(design point, actuator delay s) of the robustness check around ``point`` at mass
+    ``mass_kg`` (kg): :data:`ROBUST_NAMES` in order."""
     f = ROBUST_MASS_FRAC
     return ([(replace(point, mass_kg=mass_kg * (1 + s * f)), 0.0) for s in (-1, 1)]
             + [(replace(point, mass_kg=mass_kg, cg_shift_m=s * ROBUST_CG_M), 0.0) for s in (-1, 1)]
@@ -190,10 +197,13 @@ def _robust_columns(cfg, point: DesignPoint, mass_kg: float, law_at, nominal) ->
 
 
 def _check_job(ref: str, point: DesignPoint, schedule: GainSchedule, robust: bool,
-               duration_s: float) -> tuple[dict, dict]:
-    """Margins, robustness and the nonlinear steps with the scheduled gains at one point;
-    returns (row, figure data: loop responses and the step runs)."""
+               duration_s: float, bank=None) -> tuple[dict, dict]:
+    """Margins, robustness and the nonlinear steps with the scheduled gains (and the bank-loop
+    gains ``bank`` when given) at one point; returns (row, figure data: loop responses and the
+    step runs)."""
     cfg = _aircraft(ref)
+    if bank is not None:
+        cfg = replace_gains(cfg, "bank", bank)
     t0 = time.perf_counter()
     base = params_from_config(cfg)
 
@@ -228,6 +238,9 @@ class EnvelopeResult:
     check_wall_s: float
     workers: int
     figures: dict
+    bank: object = None
+    bank_slack: tuple = ()
+    bank_steps: list = ()
 
 
 def _pool_map(fn, jobs: list[tuple], workers: int) -> list:
@@ -259,13 +272,16 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
     tuned = _pool_map(_tune_job, [(ref, p) for p in points], workers)
     t1 = time.perf_counter()
     ok = [r for r in tuned if "qbar_pa" in r]
+    models = [r.pop("model") for r in ok]
     if len(ok) < 3:
         raise ConfigError(f"{cfg.name}: only {len(ok)} design points trimmed; a schedule "
                           "needs at least 3")
     sched = schedule_from_points([{"qbar_pa": r["qbar_pa"], "mass_kg": r["mass_kg"],
                                    **{n: r[f"tuned_{n}"] for n in SCHEDULED}} for r in ok])
-    checks = _pool_map(_check_job, [(ref, r["point"], sched, robust, duration_s) for r in tuned
-                                    if "qbar_pa" in r], workers)
+    bank, before, after = tune_bank_loop(cfg, models)
+    checks = _pool_map(_check_job, [(ref, r["point"], sched, robust, duration_s, bank)
+                                    for r in tuned if "qbar_pa" in r], workers)
+    steps = [r for r in check_aircraft(replace_gains(cfg, "bank", bank)) if r.spec.loop == "bank"]
     t2 = time.perf_counter()
     rows, figs, it = [], {}, iter(checks)
     for r in tuned:
@@ -281,7 +297,8 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
             if fig:
                 figs[p.label()] = fig
         rows.append(base)
-    return EnvelopeResult(pd.DataFrame(rows), sched, t1 - t0, t2 - t1, workers, figs)
+    return EnvelopeResult(pd.DataFrame(rows), sched, t1 - t0, t2 - t1, workers, figs, bank,
+                          (before, after), steps)
 
 
 POINT_COLUMNS = ("alt_m", "tas_mps", "mass_kg", "config", "gm_min_db", "pm_min_deg",
@@ -303,9 +320,18 @@ def schedule_block(s: GainSchedule) -> dict:
     return {"points": s.table()}
 
 
-def aircraft_with_schedule(cfg: AircraftConfig, s: GainSchedule) -> str:
-    """The aircraft file's text with its ``coupled_law_schedule`` block replaced (appended)."""
+def aircraft_with_schedule(cfg: AircraftConfig, s: GainSchedule, bank=None) -> str:
+    """The text of aircraft ``cfg``'s file with its ``coupled_law_schedule`` block replaced by
+    the schedule ``s`` (appended when it has none) and, when ``bank`` (PID gains) is given, its
+    ``inner_loops.bank`` line replaced."""
+    import re
+
     src = Path(cfg.source_file).read_text()
+    if bank is not None:
+        line = f"  bank: {{kp: {bank.kp:g}, ki: {bank.ki:g}, kd: {bank.kd:g}}}"
+        src, n = re.subn(r"(?m)^  bank: \{[^}]*\}", line, src, count=1)
+        if n != 1:
+            raise ConfigError(f"{cfg.source_file}: no one-line 'bank: {{...}}' under inner_loops")
     lines, out, skip = src.splitlines(), [], False
     for ln in lines:
         if ln.startswith("coupled_law_schedule:"):

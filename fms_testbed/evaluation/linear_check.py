@@ -13,6 +13,7 @@ model's response to the same pulse is overlaid.
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 import numpy as np
 from scipy.optimize import curve_fit
@@ -50,7 +51,8 @@ def _free_run(cfg, point: DesignPoint, pulse: float) -> np.ndarray:
 
 
 def nonlinear_pulse(cfg, point: DesignPoint) -> np.ndarray:
-    """Response to the elevator pulse on the nonlinear JSBSim model (inner loops off): the run
+    """Response of aircraft ``cfg`` at design point ``point`` to the elevator pulse on the
+    nonlinear JSBSim model (inner loops off): the run
     with the pulse minus the run without it (which removes the trim's own slow drift).
 
     Returns
@@ -64,7 +66,8 @@ def nonlinear_pulse(cfg, point: DesignPoint) -> np.ndarray:
 
 
 def linear_pulse(model, t_s: np.ndarray) -> np.ndarray:
-    """The linear model's response to the same pulse: columns q_rps, V_mps, alpha_rad."""
+    """The linear ``model``'s response to the same pulse at times ``t_s`` (s): columns q_rps,
+    V_mps, alpha_rad."""
     import control as ct
 
     u = np.zeros((2, len(t_s)))
@@ -80,8 +83,8 @@ def _damped(t, a, s, w, ph, b, c):
 
 
 def fit_mode(t_s: np.ndarray, y: np.ndarray, w_guess_rps: float) -> Mode:
-    """ω_n and ζ of a damped sinusoid fitted to ``y(t)`` (module docstring), from a start at
-    ``w_guess_rps`` (rad/s)."""
+    """ω_n and ζ of a damped sinusoid fitted to ``y`` at times ``t_s`` (s; module docstring),
+    from a start at ``w_guess_rps`` (rad/s)."""
     t = t_s - t_s[0]
     p0 = [float(np.ptp(y)) / 2 or 1e-3, 0.1 * w_guess_rps, w_guess_rps, 0.0, 0.0, 0.0]
     p, _ = curve_fit(_damped, t, y, p0=p0, maxfev=20000)
@@ -90,17 +93,32 @@ def fit_mode(t_s: np.ndarray, y: np.ndarray, w_guess_rps: float) -> Mode:
     return Mode(wn, s / wn)
 
 
-def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_dir) -> list[str]:
-    """Lines of the ``analyse --plant jsbsim`` report; writes ``linear-vs-jsbsim.png``.
+MODE_TOL_REL = 0.05
+"""The linearisation agrees with JSBSim when the short-period frequency and the phugoid period
+are within this fraction of the fitted ones."""
+
+
+@dataclass(frozen=True)
+class LinearCheck:
+    """Outcome of :func:`compare_point`: report lines, whether the modes agree, and the figure
+    data (time s, nonlinear and linear responses, headline)."""
+
+    lines: list[str]
+    ok: bool
+    t_s: np.ndarray
+    nonlinear: np.ndarray
+    linear: np.ndarray
+    title: str
+
+
+def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams) -> LinearCheck:
+    """The ``analyse --plant jsbsim`` check: report lines and whether the linear modes agree
+    with the nonlinear fit (:data:`MODE_TOL_REL`), with the pulse responses for the figure.
 
     Parameters
     ----------
     cfg : aircraft;  alt_m, tas_mps : operating point (m, m/s);  law : coupled-law tuning
-    out_dir : folder for the figure
     """
-    from fms_testbed.viz.figure import save
-    from fms_testbed.viz.tuning import plot_linear_check
-
     pt = DesignPoint(alt_m, tas_mps)
     model = linearise(cfg, pt)
     sp, ph = longitudinal_modes(model)
@@ -112,28 +130,29 @@ def compare_point(cfg, alt_m: float, tas_mps: float, law: CoupledLawParams, out_
     sp_nl = fit_mode(t[i_sp], nl[i_sp, 1], sp.wn_rps)
     ph_nl = fit_mode(t[i_ph], nl[i_ph, 2], ph.wn_rps)
     err_q = float(np.sqrt(np.mean((lin[:, 0] - nl[:, 1])[t < 10] ** 2)) / np.abs(nl[t < 10, 1]).max())
-    save(plot_linear_check(t, nl, lin, f"{cfg.name} at {alt_m:.0f} m / {tas_mps:.1f} m/s: "
-                           f"elevator pulse {PULSE:g} for 1 s, inner loops off\nshort period "
-                           f"ω_n {sp.wn_rps:.3f} (linear) vs {sp_nl.wn_rps:.3f} rad/s (JSBSim fit); "
-                           f"phugoid period {ph.period_s:.1f} vs {ph_nl.period_s:.1f} s"),
-         out_dir / "linear-vs-jsbsim.png")
+    title = (f"{cfg.name} at {alt_m:.0f} m / {tas_mps:.1f} m/s: elevator pulse {PULSE:g} for 1 s, "
+             f"inner loops off\nshort period ω_n {sp.wn_rps:.3f} (linear) vs {sp_nl.wn_rps:.3f} "
+             f"rad/s (JSBSim fit); phugoid period {ph.period_s:.1f} vs {ph_nl.period_s:.1f} s")
     lines = [f"trim: alpha {model.trim.alpha_deg:.2f} deg, throttle {model.trim.throttle:.3f}, "
              f"mass {model.mass_kg:.0f} kg, q̄ {model.qbar_pa:.0f} Pa, engine lag "
              f"{model.engine_lag_s:.2f} s (63 % of a 0.05 throttle step)",
-             "| mode | linear (FGLinearization) ω_n rad/s, ζ | nonlinear JSBSim fit ω_n, ζ |",
+             "| mode | linear (FGLinearization, speed column by central differences) ω_n rad/s, ζ "
+             "| nonlinear JSBSim fit ω_n, ζ |",
              "|---|---|---|",
              f"| short period | {sp.wn_rps:.3f}, {sp.zeta:.3f} | {sp_nl.wn_rps:.3f}, {sp_nl.zeta:.3f} |",
              f"| phugoid | {ph.wn_rps:.4f}, {ph.zeta:.3f} (T {ph.period_s:.1f} s) | "
              f"{ph_nl.wn_rps:.4f}, {ph_nl.zeta:.3f} (T {ph_nl.period_s:.1f} s) |",
              f"pitch-rate response, first 10 s: RMS(linear - JSBSim) / peak = {err_q:.3f}"]
-    return lines + _pointmass_lines(cfg, model, law)
+    ok = (abs(sp_nl.wn_rps / sp.wn_rps - 1) <= MODE_TOL_REL
+          and abs(ph_nl.period_s / ph.period_s - 1) <= MODE_TOL_REL)
+    lines.append(f"modes agree within {MODE_TOL_REL:.0%}: {'yes' if ok else 'NO'}")
+    return LinearCheck(lines + _pointmass_lines(cfg, model, law), ok, t, nl, lin, title)
 
 
 def _pointmass_lines(cfg, model, law: CoupledLawParams) -> list[str]:
     """The closed loop on the JSBSim linearisation against the point-mass model with lags."""
     g = linear_goals(point_loops(cfg, model, law))
     V0 = model.trim.tas_mps
-    t = np.arange(1, int(120 / 0.1) + 1) * 0.1
     out = []
     for tau_nx, tau_ny, what in ((0.0, 0.0, "point mass, no lags (paper)"),
                                  (model.engine_lag_s, 0.5, f"point mass, lags n_x "
@@ -143,7 +162,6 @@ def _pointmass_lines(cfg, model, law: CoupledLawParams) -> list[str]:
         yv = step_outputs(sys, np.array([DV_STEP_FRAC * V0, 0.0]))
         out.append(f"| {what} | {np.abs(yh[:, 0]).max() / KMH_MPS:.3f} | "
                    f"{np.abs(yv[:, 1]).max():.3f} | — | — |")
-    del t
     return ["", f"Closed loop (coupled law T_V {law.T_V_s} s, ξ_V {law.xi_V}, T_H {law.T_H_s} s, "
             f"ξ_H {law.xi_H}): +{DH_STEP_M:g} m and +{DV_STEP_FRAC:.0%} TAS steps",
             "| plant | max|ΔV| km/h | max|ΔH| m | min GM dB | min PM deg |", "|---|---|---|---|---|",

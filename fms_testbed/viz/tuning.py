@@ -161,15 +161,40 @@ def plot_linear_check(t_s: np.ndarray, nonlinear: np.ndarray, linear: np.ndarray
     fig, (aq, av) = subplots(2, 1, figsize=(10, 7))
     short = t_s <= 15.0
     aq.plot(t_s[short], np.degrees(nonlinear[short, 1]), label="JSBSim (nonlinear)")
-    aq.plot(t_s[short], np.degrees(linear[short, 0]), "--", label="FGLinearization model")
+    aq.plot(t_s[short], np.degrees(linear[short, 0]), "--", label="linear model (FGLinearization, speed column by central differences)")
     aq.set_xlabel("time, s")
     aq.set_ylabel("pitch rate deviation, deg/s")
     av.plot(t_s, nonlinear[:, 2], label="JSBSim (nonlinear)")
-    av.plot(t_s, linear[:, 1], "--", label="FGLinearization model")
+    av.plot(t_s, linear[:, 1], "--", label="linear model (FGLinearization, speed column by central differences)")
     av.set_xlabel("time, s")
     av.set_ylabel("airspeed deviation, m/s")
     for ax in (aq, av):
         ax.grid(True, alpha=0.3)
         ax.legend(fontsize=8)
     fig.suptitle(title)
+    return fig
+
+
+def plot_campaign_shift(runs: dict[str, pd.DataFrame], metrics, title: str) -> Figure:
+    """Empirical distributions of per-flight error metrics for each run of a campaign check.
+
+    Parameters
+    ----------
+    runs : run label → flights table (regress rows);  metrics : columns to draw (unit in the
+        name: ``_m`` metres, ``_kt`` knots);  title : headline
+    """
+    fig, axes = subplots(1, len(metrics), figsize=(5 * len(metrics), 4.5))
+    for ax, m in zip(np.atleast_1d(axes), metrics):
+        for label, df in runs.items():
+            v = np.sort(df[m].dropna().to_numpy())
+            if len(v):
+                ax.step(v, np.arange(1, len(v) + 1) / len(v), where="post",
+                        label=f"{label} (median {np.median(v):.3g})")
+        unit = "m" if m.endswith("_m") else "kt"
+        ax.set_xlabel(f"{m.rsplit('_', 1)[0]}, {unit}")
+        ax.set_ylabel("fraction of flights")
+        ax.grid(True, alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
     return fig
