@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
 import time
 from pathlib import Path
 
@@ -38,11 +39,18 @@ from fms_testbed.evaluation.detection_limit import (arl0_samples, cusum_mean_shi
                                                     unit_against_others_sigma)
 from fms_testbed.evaluation.montecarlo import synthetic_states
 from fms_testbed.navigation.identification.tuning import FdiTuning
-from fms_testbed.navigation.montecarlo import McConfig, McFault, MonteCarlo, run_chunks
+from fms_testbed.navigation.montecarlo import McConfig, McFault, McResult, MonteCarlo, run_chunks
 from fms_testbed.sensors.gnss import GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.presets import load_imu
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
+PAGES = ("fdi_calibration.md", "fdi_false_alarms.md", "detection_limits_without_drift.md",
+         "detection_limits_drift.md")
+"""The docs/results pages this bench writes with the default options (``--only 'gyro drift'``
+with and without ``--exclude`` for the two detection-limit pages)."""
 RATE_PER_H = 3e-3
 """The goal's false-alarm rate (zero in 1,000 one-hour flights: ≤ 3e-3/h at 95 %)."""
 FAULT_AT_S = 200.0
@@ -67,7 +75,7 @@ def _rows(imu):
     sb = math.sqrt(imu.p0_var[12])
     for k in (2, 5, 10):
         rows.append((f"gyro drift ×{k}", McFault("gyro_drift_scale", k, FAULT_AT_S, 1),
-                     None, cusum_mean_shift_s((k - 1) * sb, sg, DT_S, a_ins), "ins2", 3600.0))
+                     None, cusum_mean_shift_s((k - 1) * sb, sg, DT_S, a_ins), "ins2", 1800.0))
     g = GnssSpec()
     a_g = arl0_samples(RATE_PER_H, 1, 1.0 / g.rate_hz)
     for r in (0.5, 2.0):
@@ -131,6 +139,13 @@ def _cli(args) -> str:
     return out + (f" --cusum-h {args.cusum_h:g}" if args.cusum_h else "")
 
 
+def _rows_cli(args) -> str:
+    """The row filter, as typed."""
+    if not args.only:
+        return ""
+    return f" --only '{args.only}'" + (" --exclude" if args.exclude else "")
+
+
 def _suffix(args) -> str:
     """File-name suffix of a non-default sensor test."""
     return "" if args.sensor_test in (None, "window") else f"_{args.sensor_test}"
@@ -141,6 +156,8 @@ def table(args) -> None:
     lines = ["| fault | T* (s) | detect median / worst (s) | isolate median / worst (s) | "
              "isolate median / T* | wrong source | wall (s) |", "|---|---|---|---|---|---|---|"]
     for label, fault, gspec, tstar, source, after in _rows(imu):
+        if args.only and (args.only in label) == args.exclude:
+            continue
         states = synthetic_states("manoeuvres", FAULT_AT_S + after)
         cfg = McConfig(fdi=_tuning(args)) if gspec is None else McConfig(gnss=gspec,
                                                                          fdi=_tuning(args))
@@ -154,12 +171,12 @@ def table(args) -> None:
                      f"{ratio:.2f} | {int(wrong.sum())}/{wrong.size} | "
                      f"{time.perf_counter() - t0:.0f} |")
         print(lines[-1], flush=True)
-    out = RESULTS / f"detection_limits{_suffix(args)}.md"
+    part = "" if not args.only else ("_without_" if args.exclude else "_") + args.only.split()[-1]
+    out = RESULTS / f"detection_limits{_suffix(args)}{part}.md"
     head = (f"Seeds 0-{args.seeds - 1} of run seed 0, fault at t = {FAULT_AT_S:g} s of the "
             f"`manoeuvres` profile (`python bench/bench_detection.py table --seeds "
-            f"{args.seeds}{_cli(args)}`); T* at {RATE_PER_H:g} false alarms per hour.\n\n")
-    out.write_text(head + "\n".join(lines) + "\n")
-    print(f"wrote {out}")
+            f"{args.seeds}{_cli(args)}{_rows_cli(args)}`); T* at {RATE_PER_H:g} false alarms per hour.\n\n")
+    report.write(out, head + "\n".join(lines))
 
 
 LAYERS = ("stage-1 output pair |Δ|/σ", "sensor-level |z|", "stage-2 |Z_i − Ẑ|/σ",
@@ -184,34 +201,54 @@ def calibrate(args) -> None:
             f"the `manoeuvres` profile each (`python bench/bench_detection.py calibrate --runs "
             f"{args.runs} --seed {args.seed}{_cli(args)}`, {time.perf_counter() - t0:.0f} s "
             "wall).\n\n")
-    (RESULTS / f"fdi_calibration{_suffix(args)}.md").write_text(head + "\n".join(lines) + "\n")
+    report.write(RESULTS / f"fdi_calibration{_suffix(args)}.md", head + "\n".join(lines))
+
+
+def _fa_chunk(job):
+    """One chunk of the false-alarm set (worker process)."""
+    seed, first, n, tuning = job
+    states = synthetic_states("manoeuvres", 3600.0)
+    return run_chunks(MonteCarlo(states, McConfig(fdi=tuning), seed=seed), n, n, first=first)
 
 
 def false_alarms(args) -> None:
-    states = synthetic_states("manoeuvres", 3600.0)
+    """Chunks of ``--chunk`` realisations on ``--workers`` processes; the page is rewritten
+    after every chunk, so an interrupted run leaves the counts of the chunks it finished."""
+    from concurrent.futures import ProcessPoolExecutor
+
     t0 = time.perf_counter()
-    r = run_chunks(MonteCarlo(states, McConfig(fdi=_tuning(args)), seed=args.seed), args.runs,
-                   args.chunk, workers=args.workers)
+    jobs = [(args.seed, a, min(args.chunk, args.runs - a), _tuning(args))
+            for a in range(0, args.runs, args.chunk)]
+    done = []
+    with ProcessPoolExecutor(max_workers=args.workers) as ex:
+        for r in ex.map(_fa_chunk, jobs):
+            done.append(r)
+            _write_false_alarms(args, done, time.perf_counter() - t0)
+
+
+def _write_false_alarms(args, parts, wall_s) -> None:
+    r = McResult.concat(parts)
+    n = r.index.size
     iso = np.isfinite(r.t_isolate_s).any(axis=1)
     exc = np.isfinite(r.t_exclude_s).any(axis=1)
     sens = np.isfinite(r.t_gnss_s) | np.isfinite(r.t_baro_s)
     det = np.isfinite(r.t_detect_s)
     anyf = iso | exc | sens
     k = int(anyf.sum())
-    bound = chi2.ppf(0.95, 2 * k + 2) / 2 / args.runs
-    text = (f"Disjoint set: realisations 0-{args.runs - 1} of seed {args.seed}, one hour of the "
+    bound = chi2.ppf(0.95, 2 * k + 2) / 2 / n
+    state = "" if n == args.runs else f" — interrupted: {n} of the {args.runs} realisations run"
+    text = (f"Disjoint set: realisations 0-{n - 1} of seed {args.seed}, one hour of the "
             f"`manoeuvres` profile each, default tuning (`python bench/bench_detection.py "
-            f"false-alarms --runs {args.runs} --seed {args.seed} --workers {args.workers}"
-            f"{_cli(args)}`, "
-            f"{time.perf_counter() - t0:.0f} s wall).\n\n"
-            "| runs | stage-1 detections | isolations | exclusions | GNSS/baro named | "
+            f"false-alarms --runs {args.runs} --seed {args.seed} --chunk {args.chunk} "
+            f"--workers {args.workers}{_cli(args)}`, {wall_s:.0f} s wall{state}).\n\n"
+            "| runs | detections | isolations | exclusions | GNSS/baro named | "
             "any false removal | 95 % bound (1/h) |\n|---|---|---|---|---|---|---|\n"
-            f"| {args.runs} | {int(det.sum())} | {int(iso.sum())} | {int(exc.sum())} | "
+            f"| {n} | {int(det.sum())} | {int(iso.sum())} | {int(exc.sum())} | "
             f"{int(sens.sum())} | {k} | {bound:.2e} |\n")
     if k:
-        text += f"\nRealisations with a false removal: {list(np.flatnonzero(anyf))}\n"
-    (RESULTS / f"fdi_false_alarms{_suffix(args)}.md").write_text(text)
-    print(text)
+        text += f"\nRealisations with a false removal: {list(r.index[anyf])}\n"
+    report.write(RESULTS / f"fdi_false_alarms{_suffix(args)}.md", text)
+    print(text, flush=True)
 
 
 def main() -> None:
@@ -219,6 +256,8 @@ def main() -> None:
     sub = ap.add_subparsers(dest="cmd", required=True)
     t = sub.add_parser("table")
     t.add_argument("--seeds", type=int, default=20)
+    t.add_argument("--only", default=None, help="rows whose label contains this text")
+    t.add_argument("--exclude", action="store_true", help="rows whose label does not")
     subs = [t]
     for name, runs, seed in (("calibrate", 200, 1000), ("false-alarms", 1000, 2000)):
         c = sub.add_parser(name)

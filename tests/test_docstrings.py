@@ -27,7 +27,7 @@ MODULES = [
     "procedures.index", "campaign.cases", "campaign.conditions", "campaign.rows",
     "campaign.worker", "campaign.executors", "campaign.store", "campaign.runner",
     "campaign.diff", "campaign.report", "campaign.figures", "cli.regress",
-    "procedures.testdb", "campaign.manifest",
+    "procedures.testdb", "campaign.manifest", "campaign.audit", "evaluation.navigation_truth",
     # the strapdown IMU and INS
     "sensors.imu.kinematics", "sensors.imu.synthesis", "sensors.imu.errors",
     "navigation.bank", "navigation.inertial.strapdown", "navigation.inertial.alignment",

@@ -88,7 +88,12 @@ def write_plan(out: Path, cases) -> None:
 
 
 def read_plan(out: Path) -> pa.Table | None:
-    """The run's plan (None: the folder has none, or it cannot be read)."""
+    """The run's plan (None: the folder has none, or it cannot be read).
+
+    Parameters
+    ----------
+    out : the campaign folder
+    """
     try:
         t = pq.read_table(out / PLAN)
     except (OSError, pa.ArrowException):

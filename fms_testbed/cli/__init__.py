@@ -112,8 +112,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
-    except UserError as exc:
-        print(f"fms-testbed: error: {exc}", file=sys.stderr)
+    except UserError as exc:    # one line, whatever the message (a parser's may span several)
+        text = " ".join(part.strip() for part in str(exc).splitlines() if part.strip())
+        print(f"fms-testbed: error: {text}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("fms-testbed: interrupted", file=sys.stderr)

@@ -109,7 +109,12 @@ def bounded_float(lo: float, hi: float, unit: str, lo_open: bool = False):
 
 
 SEED = bounded_int(0, SEED_MAX, "a seed (whole number >= 0)")
-"""``--seed`` type of every command: 0..2**63 - 1."""
+"""``--seed`` type of the commands that seed numpy only: 0..2**63 - 1."""
+FLIGHT_SEED_MAX = 2 ** 31 - 1
+"""Largest seed of a flight: JSBSim's ``simulation/randomseed`` is a signed 32-bit integer (a
+larger value becomes -2**31, so every larger seed would fly the same turbulence)."""
+FLIGHT_SEED = bounded_int(0, FLIGHT_SEED_MAX, "a seed (whole number >= 0)")
+"""``--seed`` type of the flight commands: 0..2**31 - 1."""
 
 
 def _cell(v) -> str:
@@ -171,7 +176,7 @@ def add_override_options(p, aircraft_default: str | None = None) -> None:
     p.add_argument("--allow-degraded", action="store_true",
                    help="fly a procedure with a rejected or duplicated record of its own "
                         "(refused by default; the summary lists what is in doubt)")
-    p.add_argument("--seed", type=SEED, default=0,
+    p.add_argument("--seed", type=FLIGHT_SEED, default=0,
                    help="seed for turbulence and sensor errors (default 0; a scenario's "
                         "navigation.seed seeds the navigation errors instead)")
     p.add_argument("--missed", action="store_true",

@@ -27,9 +27,8 @@ DEFAULT_STAGES = "none,temperature,run-to-run,slow-drift"
 MIN_DURATION_S = 60.0
 """Shortest test, s (the run-to-run stage averages the first 60 s after switch-on)."""
 BYTES_PER_SAMPLE = 300
-"""Peak memory of the test per output sample (triad), bytes: the series of every stage are
-held whole (peak RSS 0.37 GB for 1 h and 0.65 GB for 4 h with ``--allan`` at 100 Hz, over a
-0.30 GB interpreter: 240 B per sample, rounded up)."""
+"""Peak memory of the test per output sample of the triad, bytes, with the series of every
+stage held whole (an upper bound of the peak RSS over the interpreter's, ``--allan`` included)."""
 MEMORY_SHARE = 0.5
 """Share of the machine's available memory a test may take."""
 

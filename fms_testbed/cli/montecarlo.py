@@ -70,8 +70,7 @@ def _faults(texts, t_s: float):
 
 
 WALL_S_PER_REALISATION_S = 1.0e-3
-"""Wall time per simulated second of one realisation, s (50 realisations of 10 min took 29 s
-on one worker of a loaded 2-core machine)."""
+"""Wall time per simulated second of one realisation on one worker, s (the estimate's rate)."""
 MAX_ESTIMATE_H = 24.0
 """A run estimated to take longer (wall time, h) is refused before any work."""
 MAX_DURATION_MIN = 1440.0

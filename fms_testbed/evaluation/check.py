@@ -18,7 +18,7 @@ from fms_testbed.core.processes import die_with_parent
 from fms_testbed.core.geodesy import gravity_mps2, inverse
 from fms_testbed.core.segments import Arc
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
-from fms_testbed.procedures.database import Database, load_database
+from fms_testbed.procedures.database import Database
 from fms_testbed.procedures.legrecord import PATH_TERMINATORS, PROC_TYPES
 from fms_testbed.legs.model import BuildParams, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
@@ -197,12 +197,19 @@ def check_airport(db: Database, airport: str, perf: Performance,
     return rows
 
 
+def _load(db_path) -> Database:
+    """The database through its index (:func:`~fms_testbed.procedures.index.load_index`: the
+    file parsed once, then unpickled in a fraction of a second by every worker)."""
+    from fms_testbed.procedures.index import load_index
+    return load_index(db_path).db
+
+
 _WORKER: dict = {}
 
 
 def _init_worker(db_path: str, perf: Performance, params: BuildParams) -> None:
     die_with_parent()                       # no orphan worker after a SIGKILL of the parent
-    _WORKER["db"] = load_database(db_path)
+    _WORKER["db"] = _load(db_path)
     _WORKER["perf"] = perf
     _WORKER["params"] = params
 
@@ -239,7 +246,7 @@ def run_check(db_path: str | None, perf: Performance, airports: list[str] | None
     """Check a database (every airport, or ``airports``, repeats merged case-insensitively)."""
     t0 = time.perf_counter()
     params = params or BuildParams()
-    db = load_database(db_path)
+    db = _load(db_path)
     known = set(db.airport_idents())
     todo = merge_airports(airports) or sorted(known)
     missing = [a for a in todo if a not in known]

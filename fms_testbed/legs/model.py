@@ -110,13 +110,15 @@ class Performance:
 
     def tas_max_mps(self, alt_m: float, isa_dev_c: float = 0.0) -> float:
         """Largest TAS inside the speed envelope at ``alt_m`` (m) on a day ``isa_dev_c`` (K)
-        off the ISA, m/s: min(TAS(VMO), MMO · a), a the speed of sound there."""
-        from fms_testbed.core.atmosphere import GAMMA, R_JPKGK, isa
+        off the ISA, m/s: min(TAS(VMO), MMO · a), a = √(γ R T) the speed of sound there
+        (T of :func:`~fms_testbed.core.atmosphere.isa`, the troposphere's lapse to 11 km)."""
+        from fms_testbed.core.atmosphere import GAMMA, H_TROP_M, LAPSE_KPM, R_JPKGK, T0_K
+        h = max(alt_m, 0.0)
         v = math.inf
         if math.isfinite(self.cas_max_mps):
-            v = cas_to_tas_scalar(self.cas_max_mps, max(alt_m, 0.0), isa_dev_c)
+            v = cas_to_tas_scalar(self.cas_max_mps, h, isa_dev_c)
         if math.isfinite(self.mach_max):
-            t_k = float(isa(max(alt_m, 0.0), isa_dev_c)[0])
+            t_k = T0_K + isa_dev_c - LAPSE_KPM * min(h, H_TROP_M)
             v = min(v, self.mach_max * math.sqrt(GAMMA * R_JPKGK * t_k))
         return v
 

@@ -125,30 +125,33 @@ def frozen_states(n_states: int, vertical: bool) -> np.ndarray:
     return m
 
 
-def switch_components(nu: np.ndarray, S: np.ndarray, scale: np.ndarray,
+def switch_components(nu: np.ndarray, S: np.ndarray, scale: np.ndarray, R: np.ndarray,
                       tuning: FdiTuning = FdiTuning()) -> tuple[np.ndarray, bool]:
     """The adaptive variant's component switching for one measurement group (seed 001, eq. 7).
 
-    a_i = 1 when |ν_i| ≤ ε_i = k_residual √S_ii, else 0; A = diag(a): the component's row of
+    a_i = 1 when |ν_i| ≤ ε_i = k_residual √S⁰_ii, else 0, with S⁰ the innovation covariance at
+    the nominal R (S⁰ = S − (scale − 1) R on the diagonal); A = diag(a): the component's row of
     H̃ = A H is switched off and its measurement replaced by artificial white noise ζ of
     variance ``switch_noise`` × R_ii (R̃ = A R + (I − A) ζ), which leaves K's column for it
-    ≈ 0. Divergence test: νᵀν > γ tr(S) on the components in use.
+    ≈ 0. Divergence test: every component failing and νᵀν > γ tr(S⁰) — the filter no longer
+    explains any of its measurements (an outlier burst lets some through).
 
     Parameters
     ----------
     nu : (m,) innovations;  S : (m, m) their covariance (with the R used)
     scale : (m,) the R multipliers in use (1: switched on)
+    R : (m, m) nominal measurement covariance (measurement units²)
     tuning : ``k_residual``, ``switch_noise``, ``diverge_gamma``
 
     Returns
     -------
     (new multipliers (m,): 1 or ``switch_noise``, diverging)
     """
-    on = np.asarray(scale) <= 1.0 + 1e-9
-    ok = residual_ok(nu, S, tuning.k_residual)
+    nu = np.asarray(nu, float)
+    s0 = np.diag(S) - (np.asarray(scale, float) - 1.0) * np.diag(R)
+    ok = np.abs(nu) <= tuning.k_residual * np.sqrt(np.maximum(s0, 0.0))
     new = np.where(ok, 1.0, tuning.switch_noise)
-    d = np.diag(S)[on]
-    diverging = bool(on.any() and float(nu[on] @ nu[on]) > tuning.diverge_gamma * float(d.sum()))
+    diverging = bool(not ok.any() and float(nu @ nu) > tuning.diverge_gamma * float(s0.sum()))
     return new, diverging
 
 
@@ -319,8 +322,8 @@ class FaultTolerantEstimator:
                 ev += self._baro(i, t_s, residual_ok(g.innovation, g.S, self.tuning.k_residual))
             f = self.filters[i]
             if self.adaptive and g.name in getattr(f, "r_scale", {}):
-                f.r_scale[g.name], div = switch_components(g.innovation, g.S,
-                                                           f.r_scale[g.name], self.tuning)
+                f.r_scale[g.name], div = switch_components(
+                    g.innovation, g.S, f.r_scale[g.name], f.nominal_r(g.name), self.tuning)
                 ev += self._divergence(i, t_s, g, div)
         return ev
 

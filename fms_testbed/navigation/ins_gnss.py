@@ -56,6 +56,7 @@ from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, Senso
 from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter,
                                                PredictionInterval, _w_eb, can_share_prediction)
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
+from fms_testbed.navigation.recording import SensorRecorder
 from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor
 from fms_testbed.sensors.baro import BaroAltimeter, BaroSpec
 from fms_testbed.sensors.gnss import GnssReceiver, GnssSpec, Interval, OutlierBurst, Ramp
@@ -206,6 +207,7 @@ class InsGnssNavigation(NavigationSourceBase):
         self._mean_P_cache: dict[tuple, tuple] = {}
         self._anp = math.nan
         self._interval: PredictionInterval | None = None      # built at the first step
+        self.recorder: SensorRecorder | None = None   # navigation.record_sensors
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "InsGnssNavigation":
@@ -240,6 +242,8 @@ class InsGnssNavigation(NavigationSourceBase):
                   DEFAULT_ALERT_DELAY_S if b.alert_delay_s is None else b.alert_delay_s, fdi)
         src.seed = sd
         src.truth_model = b.truth_model
+        if b.record_sensors:
+            src.recorder = SensorRecorder(b.imu, dict(spec.get("gnss") or {}))
         if b.n_ins == 3:
             src.refdesc = ReferenceDescriptionMonitor([f.imu for f in filters])
         return src
@@ -309,9 +313,13 @@ class InsGnssNavigation(NavigationSourceBase):
         prev = self._prev_truth
         fixes = self.receiver.update(truth)
         reading = self.baro.update(truth) if self.baro is not None else None
+        if self.recorder is not None:
+            self._record(truth, prev, fixes)
         if prev is None:
             for i, f in enumerate(self.filters):
                 f.initialise(ins[i], self._alignment_s())
+            if self.recorder is not None:
+                self.recorder.start(ins[0], self.filters[0].P, self._alignment_s())
         elif t > prev.t_s:
             # an interval ends where a measurement is valid: at a GNSS epoch (the fix, delivered
             # later, is then used at the filters' time, its time of validity) and at a baro
@@ -355,6 +363,23 @@ class InsGnssNavigation(NavigationSourceBase):
                 self.events += self.ft.check(i, t, [g])
         self._prev_truth, self._prev_ins = truth, ins
         return self.solution(truth, ins)
+
+    def _record(self, truth: AircraftState, prev: AircraftState | None, fixes) -> None:
+        """Record unit 0's raw step increments, the delivered fixes and the truth."""
+        rec = self.recorder
+        rec.true_state(truth)
+        for fix in fixes:
+            rec.fix(fix)
+        if prev is not None and truth.t_s > prev.t_s:
+            f, w = self.bank.measured(0)
+            comp = self.bank.comp[0] if isinstance(self.bank, StrapdownBank) else \
+                self.bank.compensation[0]
+            rec.step(truth.t_s, np.concatenate([f, w]) + comp, truth.t_s - prev.t_s)
+
+    def recorded_sensors(self) -> dict | None:
+        """The recorded sensors (:meth:`~.recording.SensorRecorder.tables`; None: not
+        recording)."""
+        return None if self.recorder is None else self.recorder.tables()
 
     def _alignment_s(self) -> float | None:
         """The stationary alignment's duration of a strapdown bank (its white-noise means are

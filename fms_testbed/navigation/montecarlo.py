@@ -107,6 +107,46 @@ def _group_update(P, gidx, xhat, z, Hm, R, q_lag, gate, allow=None):
     return out, gidx, nis, ok
 
 
+def _channel_update(P, gidx, xhat, z, Hm, R, q_lag, k, allow, hold_rows, hold_comp, no_alt):
+    """Seed 001's fault-tolerant correction (eq. 8) for all members at once, per component.
+
+    ν = z − H_m x̂; component i is used when |ν_i| ≤ k √S_ii (and ``allow`` (M,)): the gain
+    K = C S⁻¹ of :func:`_group_update` has the columns of the failed components zeroed, and, for
+    members with ``no_alt`` (M,) whose component ``hold_comp`` failed, the rows ``hold_rows``
+    (n,) bool as well — those states keep their prediction (the vertical channel held). P is
+    corrected with that gain in the Joseph form (P − K Cᵀ − C Kᵀ + K S Kᵀ, valid for any K);
+    members of a covariance group that take different gains are split into groups. Returns
+    (P, gidx, NIS over the used components (M,), their count (M,), used (M,))."""
+    C = (P - q_lag) @ Hm.T
+    S = Hm @ C + R
+    S = 0.5 * (S + np.swapaxes(S, 1, 2))
+    nu = z - xhat @ Hm.T
+    sd = np.sqrt(np.diagonal(S, axis1=1, axis2=2))
+    ok = (np.abs(nu) <= k * sd[gidx]) & allow[:, None]
+    freeze = no_alt & ~ok[:, hold_comp]
+    code = (ok * (1 << np.arange(ok.shape[1]))).sum(axis=1) * 2 + freeze
+    keys, new_g = np.unique(np.stack([gidx, code], axis=1), axis=0, return_inverse=True)
+    new_g = new_g.ravel()
+    out = np.empty((keys.shape[0],) + P.shape[1:])
+    nis = np.zeros(ok.shape[0])
+    for j, (g, c) in enumerate(keys):
+        use = np.array([(c >> (i + 1)) & 1 for i in range(ok.shape[1])], bool)
+        K = np.zeros_like(C[g])
+        if use.any():
+            Si = np.linalg.inv(S[g][np.ix_(use, use)])
+            K[:, use] = C[g][:, use] @ Si
+        if c & 1:
+            K[hold_rows] = 0.0
+        KC = K @ C[g].T
+        Pn = P[g] - KC - KC.T + K @ S[g] @ K.T
+        out[j] = 0.5 * (Pn + Pn.T)
+        mem = new_g == j
+        xhat[mem] += nu[mem] @ K.T
+        if use.any():
+            nis[mem] = np.einsum("mi,ij,mj->m", nu[mem][:, use], Si, nu[mem][:, use])
+    return out, new_g.astype(gidx.dtype), nis, ok.sum(axis=1), ok.any(axis=1)
+
+
 def _compact(P, gidx):
     """Drop covariance groups without members."""
     keep, inv = np.unique(gidx, return_inverse=True)
@@ -117,6 +157,11 @@ def _compact(P, gidx):
 
 NL = 33
 """States of the truth model per unit."""
+
+_HOLD_VERTICAL = np.zeros(22, bool)
+_HOLD_VERTICAL[[2, 5, 21]] = True
+"""Filter states held when the vertical channel has no altitude measurement: δh, δV_U and the
+baro bias (seed 001: ẑ_H and Ŵ_Z frozen)."""
 
 
 class _Batch:
@@ -143,7 +188,7 @@ class _Batch:
                                   s0.heading_rad, {}))
         self.P, self.gidx = f0.P[None].copy(), np.zeros(self.M, np.int64)
         self.xhat, self.comp = np.zeros((self.M, n)), np.zeros((self.M, 6))
-        self.fdi = TwoStage(Rn, U, cfg.fdi)
+        self.fdi = TwoStage(Rn, U, cfg.fdi, track_stats=True)
         self.sensor: SensorPairTest | None = None
         self.sd_sensor = None
         self.next_fix = self.next_baro = s0.t_s
@@ -263,10 +308,15 @@ def _deliver(mc: "MonteCarlo", b: _Batch, t: float) -> None:
         else:
             ql, Hp, Hv = np.zeros((n, n)), f0._H_pos, f0._H_vel
         for Hm, z, Rm in ((Hp, zp, f0._r_pos), (Hv, zv, f0._r_vel)):
-            b.P, b.gidx, nis, ok = _group_update(b.P, b.gidx, b.xhat, z, Hm, Rm, ql,
-                                                 mc.cfg.tuning.gate_sigma, allow)
-            b.fdi.add_innovation(t, nis.reshape(b.Rn, N_UNITS),
-                                 np.where(allow, 3, 0).reshape(b.Rn, N_UNITS))
+            if mc.cfg.component_channels:
+                b.P, b.gidx, nis, dof, ok = _channel_update(
+                    b.P, b.gidx, b.xhat, z, Hm, Rm, ql, mc.cfg.fdi.k_residual, allow,
+                    _HOLD_VERTICAL[:n], 2, np.repeat(b.fdi.baro_failed, N_UNITS))
+            else:
+                b.P, b.gidx, nis, ok = _group_update(b.P, b.gidx, b.xhat, z, Hm, Rm, ql,
+                                                     mc.cfg.tuning.gate_sigma, allow)
+                dof = np.where(allow, 3, 0)
+            b.fdi.add_innovation(t, nis.reshape(b.Rn, N_UNITS), dof.reshape(b.Rn, N_UNITS))
             used_any |= ok
         b.last_used[used_any.reshape(b.Rn, N_UNITS).any(axis=1)] = t_m
     if used_any.any():

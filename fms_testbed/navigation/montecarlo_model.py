@@ -70,6 +70,10 @@ class McConfig:
     imu : IMU preset of the three units;  gnss, baro : sensor models (``gnss.outages`` are the
     outages of every realisation);  tuning, fdi : filter and identification settings
     rnp_m : RNP for the containment statistics, m
+    component_channels : seed 001's fault-tolerant correction per measured component instead of
+        the all-or-nothing gate: a GNSS component failing |ν_i| ≤ k_residual √S_ii has its gain
+        column zeroed, and with the baro named failed a failed vertical component also zeroes
+        the gain rows of the vertical channel (ẑ_H, Ŵ_Z held, :func:`~.montecarlo._channel_update`)
     """
 
     imu: str = "STIM300"
@@ -78,6 +82,7 @@ class McConfig:
     tuning: FilterTuning = FilterTuning()
     fdi: FdiTuning = FdiTuning()
     rnp_m: float = 555.6
+    component_channels: bool = False
 
 
 @dataclass

@@ -263,8 +263,8 @@ _ERR_SIGMA = (("err_north_m", "nav_north_sigma_m"), ("err_east_m", "nav_east_sig
 
 def error_stats(err: pd.DataFrame, sol: pd.DataFrame) -> dict:
     """Summary statistics of :func:`error_table`: horizontal error 50/95 % and max (m), RMS of
-    every error, and RMS(error/σ) per state (1 for an honest covariance; pyins' tests ask
-    < 1.5).
+    every error, and RMS(error/σ) per state over the samples with σ > 0 (1 for an honest
+    covariance; pyins' tests ask < 1.5).
 
     Parameters
     ----------
@@ -280,7 +280,8 @@ def error_stats(err: pd.DataFrame, sol: pd.DataFrame) -> dict:
     for e, s in _ERR_SIGMA:
         x = err[e].to_numpy()
         out["rms"][e[4:]] = round(float(np.sqrt(np.mean(x ** 2))), 4)
-        z = x / sig[s].to_numpy()
+        sd = sig[s].to_numpy()
+        z = x[sd > 0] / sd[sd > 0]          # the start may be known exactly (σ 0)
         out["rms_error_over_sigma"][e[4:]] = round(float(np.sqrt(np.mean(z ** 2))), 3)
     return out
 

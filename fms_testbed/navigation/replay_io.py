@@ -164,7 +164,7 @@ def read_truth(path: str | Path) -> np.ndarray:
 
 def read_init(path: str | Path) -> dict:
     """The init JSON (module docstring), checked: every :data:`PVA_COLS` key a finite number,
-    ``sigma`` with :data:`SIGMA_KEYS` > 0, ``imu`` a string (may be given on the command line
+    ``sigma`` with :data:`SIGMA_KEYS` >= 0, ``imu`` a string (may be given on the command line
     instead), ``alignment_s`` > 0 when present.
 
     Parameters
@@ -193,10 +193,10 @@ def read_init(path: str | Path) -> dict:
         raise ReplayInputError(f"{p}: field 'sigma': expected {{{', '.join(SIGMA_KEYS)}}}")
     for k in SIGMA_KEYS:
         v = sig.get(k)
-        if not isinstance(v, (int, float)) or not v > 0 or not math.isfinite(v):
-            raise ReplayInputError(f"{p}: field 'sigma.{k}': expected a number > 0, got {v!r}")
-    if "imu" in d and not isinstance(d["imu"], str):
-        raise ReplayInputError(f"{p}: field 'imu': expected a preset name")
+        if not isinstance(v, (int, float)) or not v >= 0 or not math.isfinite(v):
+            raise ReplayInputError(f"{p}: field 'sigma.{k}': expected a number >= 0, got {v!r}")
+    if "imu" in d and not isinstance(d["imu"], (str, dict)):
+        raise ReplayInputError(f"{p}: field 'imu': expected a preset name (or an IMU mapping)")
     a = d.get("alignment_s")
     if a is not None and not (isinstance(a, (int, float)) and a > 0):
         raise ReplayInputError(f"{p}: field 'alignment_s': expected a number > 0 s")

@@ -37,7 +37,7 @@ from dataclasses import dataclass
 
 from geographiclib.geodesic import Geodesic
 
-from fms_testbed.core.geodesy import wrap180, wrap360
+from fms_testbed.core.geodesy import inverse, wrap180, wrap360
 from fms_testbed.core.units import KT_MPS, NM_M
 from fms_testbed.legs.model import Finding
 from fms_testbed.legs.types import LEG_TYPES
@@ -85,6 +85,20 @@ def geodesic(lat1_deg: float, lon1_deg: float, lat2_deg: float, lon2_deg: float
     return g["s12"], wrap360(g["azi1"]), wrap360(g["azi2"])
 
 
+def fast_geodesic(lat1_deg: float, lon1_deg: float, lat2_deg: float, lon2_deg: float
+                  ) -> tuple[float, float, float]:
+    """(distance m, initial azimuth deg, final azimuth deg) by the package's compiled
+    Vincenty inverse (within 1 mm and 1e-5° of :func:`geodesic`): the screening pass."""
+    s, az1, az2 = inverse(lat1_deg, lon1_deg, lat2_deg, lon2_deg)
+    return s, wrap360(az1), wrap360(az2)
+
+
+SCREEN_M = 0.01
+"""Screening margin on distances, m (the compiled inverse is within 1 mm of geographiclib)."""
+SCREEN_DEG = 1e-4
+"""Screening margin on courses, deg."""
+
+
 def _finding(i: int, kind: str, leg, field: str, coded: str, geom: str, what: str) -> Finding:
     r = leg.rec
     ident = r.fix.ident if r.fix else ""
@@ -100,37 +114,40 @@ def _course_tol(leg) -> float:
     return TOL.course_deg + variation_tol_deg(leg.magvar_deg, leg.rec.course_true)
 
 
-def _track_checks(i: int, leg, prev) -> list[Finding]:
-    """TF/CF route distance and course against the geodesic from the previous fix."""
+def _track_checks(i: int, leg, prev, geo=geodesic, m_m: float = 0.0, m_deg: float = 0.0
+                  ) -> list[Finding]:
+    """TF/CF route distance and course against the geodesic from the previous fix (``geo``;
+    the tolerances less the screening margins ``m_m``, ``m_deg``)."""
     r, f = leg.rec, leg.fix
     out = []
-    d, az1, az2 = geodesic(prev.lat_deg, prev.lon_deg, f.lat_deg, f.lon_deg)
+    d, az1, az2 = geo(prev.lat_deg, prev.lon_deg, f.lat_deg, f.lon_deg)
     if d < 1.0:
         return out
-    if r.distance_m is not None and abs(r.distance_m - d) > TOL.distance_m:
+    if r.distance_m is not None and abs(r.distance_m - d) > TOL.distance_m - m_m:
         out.append(_finding(i, "distance", leg, "route distance (cols 75-78)",
                             _nm(r.distance_m), _nm(d), f"fixes {prev.ident}-{f.ident} give"))
     crs = leg.course_true_deg
     if crs is not None:
         geo = az1 if r.path_term == "TF" else az2
         err = abs(wrap180(crs - geo))
-        if err > _course_tol(leg) and not (r.path_term == "CF" and err > 90.0):
+        if err > _course_tol(leg) - m_deg and not (r.path_term == "CF" and err > 90.0):
             out.append(_finding(i, "course", leg, "course (cols 71-74) + variation "
                                 f"{leg.magvar_deg:+.1f}°", f"{crs:.1f}° true", f"{geo:.1f}°",
                                 f"the geodesic {prev.ident}-{f.ident} gives"))
     return out
 
 
-def _rf_checks(i: int, leg, prev) -> list[Finding]:
+def _rf_checks(i: int, leg, prev, geo=geodesic, m_m: float = 0.0, m_deg: float = 0.0
+               ) -> list[Finding]:
     """RF radius against both fixes, route distance against the arc, course against the
-    tangent at the end fix."""
+    tangent at the end fix (``geo``, margins as :func:`_track_checks`)."""
     r, f, c = leg.rec, leg.fix, leg.centre
     out = []
-    d1, a1, _ = geodesic(c.lat_deg, c.lon_deg, f.lat_deg, f.lon_deg)
-    d0, a0, _ = geodesic(c.lat_deg, c.lon_deg, prev.lat_deg, prev.lon_deg)
+    d1, a1, _ = geo(c.lat_deg, c.lon_deg, f.lat_deg, f.lon_deg)
+    d0, a0, _ = geo(c.lat_deg, c.lon_deg, prev.lat_deg, prev.lon_deg)
     if r.arc_radius_m:
         for d, which in ((d0, prev.ident), (d1, f.ident)):
-            if abs(d - r.arc_radius_m) > TOL.radius_m:
+            if abs(d - r.arc_radius_m) > TOL.radius_m - m_m:
                 out.append(_finding(i, "rf_radius", leg, "arc radius (cols 57-62)",
                                     f"{r.arc_radius_m / NM_M:.3f} NM", f"{d / NM_M:.3f} NM",
                                     f"centre {c.ident}-{which} gives"))
@@ -139,33 +156,36 @@ def _rf_checks(i: int, leg, prev) -> list[Finding]:
     sweep = (a1 - a0) % 360.0 if turn == "R" else (a0 - a1) % 360.0
     if r.distance_m is not None:
         arc = 0.5 * (d0 + d1) * math.radians(sweep)
-        if abs(r.distance_m - arc) > TOL.distance_m:
+        if abs(r.distance_m - arc) > TOL.distance_m - m_m \
+                - math.radians(2.0 * m_deg) * (d0 + d1):
             out.append(_finding(i, "distance", leg, "route distance (cols 75-78)",
                                 _nm(r.distance_m), _nm(arc),
                                 f"the {sweep:.1f}° arc {prev.ident}-{f.ident} gives"))
     if leg.course_true_deg is not None:
         tangent = wrap360(a1 + (90.0 if turn == "R" else -90.0))
-        if abs(wrap180(leg.course_true_deg - tangent)) > _course_tol(leg):
+        if abs(wrap180(leg.course_true_deg - tangent)) > _course_tol(leg) - m_deg:
             out.append(_finding(i, "rf_tangent", leg, "course (cols 71-74) + variation "
                                 f"{leg.magvar_deg:+.1f}°", f"{leg.course_true_deg:.1f}° true",
                                 f"{tangent:.1f}°", f"the tangent at {f.ident} is"))
     return out
 
 
-def _af_checks(i: int, leg) -> list[Finding]:
-    """AF rho and theta against the end fix's distance and bearing from the navaid's DME."""
+def _af_checks(i: int, leg, geo=geodesic, m_m: float = 0.0, m_deg: float = 0.0
+               ) -> list[Finding]:
+    """AF rho and theta against the end fix's distance and bearing from the navaid's DME
+    (``geo``, margins as :func:`_track_checks`)."""
     r, f, n = leg.rec, leg.fix, leg.navaid
     out = []
     lat = n.dme_lat_deg if n.dme_lat_deg is not None else n.lat_deg
     lon = n.dme_lon_deg if n.dme_lon_deg is not None else n.lon_deg
-    d, az, _ = geodesic(lat, lon, f.lat_deg, f.lon_deg)
-    if r.rho_m is not None and abs(r.rho_m - d) > TOL.distance_m:
+    d, az, _ = geo(lat, lon, f.lat_deg, f.lon_deg)
+    if r.rho_m is not None and abs(r.rho_m - d) > TOL.distance_m - m_m:
         out.append(_finding(i, "af_rho", leg, "rho (cols 67-70)", _nm(r.rho_m), _nm(d),
                             f"{n.ident}-{f.ident} gives"))
     if r.theta_deg is not None:
         theta = wrap360(r.theta_deg + leg.magvar_deg)
-        if abs(wrap180(theta - az)) > TOL.course_deg + variation_tol_deg(leg.magvar_deg,
-                                                                          False):
+        if abs(wrap180(theta - az)) > TOL.course_deg - m_deg + variation_tol_deg(
+                leg.magvar_deg, False):
             out.append(_finding(i, "af_theta", leg, "theta (cols 63-66) + variation "
                                 f"{leg.magvar_deg:+.1f}°", f"{theta:.1f}° true", f"{az:.1f}°",
                                 f"the bearing {n.ident}-{f.ident} is"))
@@ -189,11 +209,17 @@ def record_checks(legs, prev_fixes) -> list[Finding]:
         if leg.fix is None:
             continue
         if pt in ("TF", "CF") and prev is not None:
-            out += _track_checks(i, leg, prev)
+            check, args = _track_checks, (i, leg, prev)
         elif pt == "RF" and prev is not None and leg.centre is not None:
-            out += _rf_checks(i, leg, prev)
+            check, args = _rf_checks, (i, leg, prev)
         elif pt == "AF" and leg.navaid is not None:
-            out += _af_checks(i, leg)
+            check, args = _af_checks, (i, leg)
+        else:
+            continue
+        # screened with the compiled inverse at the tolerances less its margins; a leg that
+        # may disagree is decided (and reported) with geographiclib
+        if check(*args, fast_geodesic, SCREEN_M, SCREEN_DEG):
+            out += check(*args)
     return out
 
 

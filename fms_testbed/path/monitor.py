@@ -107,8 +107,6 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                 g: float) -> list[Finding]:
     """(R, Ω, γ) checks of the coded arcs (RF, AF) with the γ and V,γ corrections."""
     out = []
-    gplan = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
-    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for lg in path.legs:
         kind = LEG_TYPES[lg.path_term]
         if kind.arc_centre is None:
@@ -142,31 +140,37 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                                    f"{lg.path_term} radius coded {coded_r / NM_M:.3f} NM, fixes "
                                    f"give {arc.radius_m / NM_M:.3f} NM: path follows the fixes",
                                    "R"))
-        v = lg.speed_mps
-        # the ground speed on an arc reaches TAS + wind (class 1): the wind at the leg's
-        # planned altitude
-        w = params.wind_at(lg.start.alt_m)[0]
-        why = arc_conditions_text(v, w, params.isa_dev_c, lg.start.alt_m, arc.radius_m, gplan, g)
-        for _ in range(params.max_iterations):
-            g_req = math.degrees(math.atan((v + w) ** 2 / (arc.radius_m * g)))
-            if g_req <= gplan + 1e-9:
-                break
-            if g_req <= gmax:
-                out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
-                                   f"{arc.radius_m / NM_M:.2f} NM at {v / KT_MPS:.0f} kt: bank "
-                                   f"{gplan:.0f} -> {g_req:.1f}°{why}", "γ"))
-                break
-            v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax))) - w
-            if v_reg >= perf.tas_min_mps:
-                out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
-                                   f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT_MPS:.0f} -> "
-                                   f"{v_reg / KT_MPS:.0f} kt at bank {gmax:.0f}°{why}", "V,γ"))
-                break
-            out.append(Finding(lg.index, "impossible", f"{lg.path_term} radius "
-                               f"{arc.radius_m / NM_M:.2f} NM needs bank {g_req:.0f}° > "
-                               f"{gmax:.0f}° even at the minimum speed {v_reg / KT_MPS:.0f} kt"))
-            break
+        out += _arc_bank_findings(lg, arc, perf, params, g)
     return out
+
+
+def _arc_bank_findings(lg, arc, perf: Performance, params: BuildParams, g: float
+                       ) -> list[Finding]:
+    """(γ; V,γ) of one coded arc: the bank its radius needs at the planned speed and the
+    wind at the leg's planned altitude, γ = atan((V + W)² / (R g)); raised up to the limit,
+    else the speed lowered to V = √(R g tan γ_max) − W, else impossible."""
+    gplan = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    v = lg.speed_mps
+    # the ground speed on an arc reaches TAS + wind (class 1): the wind at the leg's
+    # planned altitude
+    w = params.wind_at(lg.start.alt_m)[0]
+    why = arc_conditions_text(v, w, params.isa_dev_c, lg.start.alt_m, arc.radius_m, gplan, g)
+    g_req = math.degrees(math.atan((v + w) ** 2 / (arc.radius_m * g)))
+    if g_req <= gplan + 1e-9:
+        return []
+    if g_req <= gmax:
+        return [Finding(lg.index, "correction", f"{lg.path_term} radius "
+                        f"{arc.radius_m / NM_M:.2f} NM at {v / KT_MPS:.0f} kt: bank "
+                        f"{gplan:.0f} -> {g_req:.1f}°{why}", "γ")]
+    v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax))) - w
+    if v_reg >= perf.tas_min_mps:
+        return [Finding(lg.index, "correction", f"{lg.path_term} radius "
+                        f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT_MPS:.0f} -> "
+                        f"{v_reg / KT_MPS:.0f} kt at bank {gmax:.0f}°{why}", "V,γ")]
+    return [Finding(lg.index, "impossible", f"{lg.path_term} radius "
+                    f"{arc.radius_m / NM_M:.2f} NM needs bank {g_req:.0f}° > "
+                    f"{gmax:.0f}° even at the minimum speed {v_reg / KT_MPS:.0f} kt")]
 
 
 def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
@@ -207,6 +211,17 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                                 climb_top_m=top, descent_gradient_max=g_desc,
                                 descent_rate_mps=perf.descent_rate_max_mps,
                                 alt_max_m=perf.alt_plan_max_m)
+    out += _climb_window_findings(path, perf, params, prof, v, theta_perf)
+    out += _descent_findings(path, perf, prof, v)
+    return out, prof
+
+
+def _climb_window_findings(path: ProcedurePath, perf: Performance, params: BuildParams,
+                           prof, v: float, theta_perf: float) -> list[Finding]:
+    """(V,Θ) of every 'at or above' window of a climb the profile misses at the gradient
+    ``theta_perf``: the speed lowered (bounded iterations) until the aircraft's gradient
+    there makes it, else impossible. ``v``: the planned TAS, m/s."""
+    out = []
     for w in prof.windows:
         k = w.leg_index + 1
         if not prof.climb[k] or w.lo_m is None or prof.alt_m[k] >= w.lo_m - 1.0:
@@ -244,6 +259,14 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                                f"{w.lo_m / FT_M:.0f} ft needs {100 * need:.2f}% climb, aircraft "
                                f"max {100 * perf.climb_gradient_at(perf.tas_min_mps):.2f}% at "
                                "minimum speed"))
+    return out
+
+
+def _descent_findings(path: ProcedurePath, perf: Performance, prof, v: float
+                      ) -> list[Finding]:
+    """(V,Θ) of every descent piece steeper than the descent rate allows at ``v`` (m/s):
+    V = w_d / gradient when that is above the minimum speed, else impossible."""
+    out = []
     grads = prof.gradients()
     for k in range(1, len(prof.alt_m)):
         if prof.climb[k] or not grads[k - 1] < 0:
@@ -263,7 +286,7 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
             out.append(Finding(k - 1, "impossible", f"descent to {ident} needs "
                                f"{100 * need:.1f}% (> {100 * perf.descent_rate_max_mps / perf.tas_min_mps:.1f}% "
                                "at minimum speed)"))
-    return out, prof
+    return out
 
 
 LONG_WAY_TURN_DEG = 270.0

@@ -53,18 +53,22 @@ from pathlib import Path
 import numpy as np
 
 from fms_testbed.data import procedures_dir
-from fms_testbed.procedures.database import EMBEDDED_NAME, Database, _read, load_text
+from fms_testbed.procedures.database import EMBEDDED_NAME, Database, Sequence, _read, load_text
+from fms_testbed.procedures.integrity import Defect
+from fms_testbed.procedures.legrecord import FixRef, LegRecord
 from fms_testbed.procedures.loader import split_lines
 from fms_testbed.procedures.records import Fix
 
 log = logging.getLogger(__name__)
 
-INDEX_FORMAT = 2
+INDEX_FORMAT = 3
 """Version of the index layout; part of the cache key."""
 
 #: Modules of this package that do not read records (not part of the parser hash).
 _NOT_PARSER = frozenset({"index.py", "catalogue.py", "synth.py"})
 _FIX_FIELDS = tuple(f.name for f in dataclasses.fields(Fix))
+_FAST_CLASSES = (LegRecord, FixRef, Sequence, Defect)
+"""Frozen slotted dataclasses of the parsed procedures, pickled as field tuples."""
 
 
 @lru_cache(maxsize=1)
@@ -159,9 +163,10 @@ def line_digests(text: str) -> np.ndarray:
     return out
 
 
-#: Database fields held packed (:class:`PackedMapping`): read-only after loading, and large.
+#: Database fields held packed (:class:`PackedMapping`): read-only after loading, and large
+#: (``_parsed``: every airport's procedure transitions, parsed when the index is written).
 PACKED_FIELDS = ("fixes", "terminal", "airports", "_raw_procs", "_key_lines",
-                 "_keys_by_airport")
+                 "_keys_by_airport", "_parsed")
 _MISSING = object()
 
 
@@ -220,12 +225,15 @@ class PackedMapping(Mapping):
 
 
 def packed(db: Database) -> Database:
-    """The database with its large read-only tables packed (:data:`PACKED_FIELDS`).
+    """The database with every airport's procedures parsed (their rejected records in
+    ``issues``) and its large read-only tables packed (:data:`PACKED_FIELDS`).
 
     Parameters
     ----------
-    db : a loaded database (before any airport is parsed: ``_parsed`` is not packed)
+    db : a loaded database
     """
+    for airport in db.airport_idents():
+        db.sequences(airport)
     repl = {f: PackedMapping.pack(getattr(db, f)) for f in PACKED_FIELDS
             if isinstance(getattr(db, f, None), dict)}
     return dataclasses.replace(db, **repl)
@@ -241,12 +249,23 @@ def _reduce_fix(f: Fix):
     return Fix, tuple(getattr(f, n) for n in _FIX_FIELDS)
 
 
+def _reducer(cls):
+    """A pickle reducer of a frozen slotted dataclass to its field tuple (unpickled by one
+    constructor call, not field by field)."""
+    names = tuple(f.name for f in dataclasses.fields(cls))
+
+    def reduce(obj):
+        return cls, tuple(getattr(obj, n) for n in names)
+    return reduce
+
+
 def _dump(obj) -> bytes:
     """Pickle with fixes reduced to their field tuples (a frozen slotted dataclass unpickles
     field by field otherwise: 2.5 times slower for the CIFP's 107,000 fixes)."""
     buf = io.BytesIO()
     p = pickle.Pickler(buf, protocol=pickle.HIGHEST_PROTOCOL)
-    p.dispatch_table = {**copyreg.dispatch_table, Fix: _reduce_fix}
+    p.dispatch_table = {**copyreg.dispatch_table, Fix: _reduce_fix,
+                        **{c: _reducer(c) for c in _FAST_CLASSES}}
     p.dump(obj)
     return buf.getvalue()
 

@@ -163,8 +163,10 @@ def test_a_failed_write_leaves_no_half_part_and_stops(small_run, tmp_path, monke
     err = capsys.readouterr().err.strip()
     assert "No space left on device" in err and "the run stops" in err
     assert len(err.splitlines()) == 1, err
+    # the first part is whole (3 rows, or fewer when the 15-s flush came first); the second,
+    # half written when the disk filled, is gone with its temporary file
     assert len(part_files(out)) == 1 and not list((out / "flights").glob(".part-*"))
-    assert len(read_flights(out)) == 3
+    assert 1 <= len(read_flights(out)) <= 3
     monkeypatch.setattr(BatchWriter, "write", staticmethod(real))
     assert regress(*argv) == 0                    # the same command resumes
     pd.testing.assert_frame_equal(comparable(read_flights(out)),

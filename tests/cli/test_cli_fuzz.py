@@ -38,8 +38,8 @@ class Work(BaseException):
     """Raised where a command's work would begin (not an Exception: nothing catches it)."""
 
 
-WORK = [
-    ("fms_testbed.run.api", "run_scenario"), ("fms_testbed.run", "run_scenario"),
+WORK = [   # a lazy re-export before its source: its saved value must be the real function
+    ("fms_testbed.run", "run_scenario"), ("fms_testbed.run.api", "run_scenario"),
     ("fms_testbed.loop.flight.Flight", "__init__"),
     ("fms_testbed.campaign.runner", "run_local"), ("fms_testbed.campaign.runner", "run_dask"),
     ("fms_testbed.sensors.mems.static_test", "run_static_test"),
@@ -59,8 +59,18 @@ def _stub(*args, **kwargs):
 
 @pytest.fixture
 def work_stubbed(monkeypatch):
+    """Every work function replaced by :func:`_stub` for the test. The whole package is imported
+    first, so no module imported during the fuzz keeps a stub under its own name afterwards."""
     import importlib
+    import pkgutil
 
+    import fms_testbed
+
+    for m in pkgutil.walk_packages(fms_testbed.__path__, "fms_testbed."):
+        if not m.name.endswith("__main__"):
+            importlib.import_module(m.name)
+    for name in getattr(fms_testbed, "__all__", ()):      # lazy exports resolved now
+        getattr(fms_testbed, name)
     for mod, name in WORK:
         head, _, tail = mod.rpartition(".")
         try:
@@ -235,15 +245,21 @@ def _fuzz(n: int, seed0: int, tmp_path, regress_case, capsys, monkeypatch) -> Co
     counts: Counter = Counter()
     by_cmd: Counter = Counter()
     t0 = time.monotonic()
+    failures = []
     for seed in range(seed0, seed0 + n):
-        outcome, cmd = one_run(seed, tmp_path, regress_case, capsys, monkeypatch)
+        try:
+            outcome, cmd = one_run(seed, tmp_path, regress_case, capsys, monkeypatch)
+        except AssertionError as exc:
+            failures.append(str(exc).splitlines()[0][:400])
+            outcome, cmd = "FAILED", "?"
         counts[outcome] += 1
         by_cmd[cmd] += 1
     counts["wall_s"] = round(time.monotonic() - t0)
     if os.environ.get("FUZZ_REPORT"):
         Path(os.environ["FUZZ_REPORT"]).write_text(json.dumps(
-            {"runs": n, "seeds": [seed0, seed0 + n - 1], **counts, "commands": by_cmd},
-            indent=1))
+            {"runs": n, "seeds": [seed0, seed0 + n - 1], **counts, "commands": by_cmd,
+             "failures": failures}, indent=1))
+    assert not failures, "\n".join(failures)
     return counts
 
 

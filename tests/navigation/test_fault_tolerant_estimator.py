@@ -55,15 +55,19 @@ def test_component_switching_turns_off_the_failed_component_and_flags_divergence
     noise ζ (switch_noise × R) —, back to 1 when it passes; νᵀν > γ tr(S) is divergence."""
     tune = FdiTuning()
     S = np.diag([1.0, 1.0, 4.0])
+    R = np.diag([0.5, 0.5, 0.5])
     nu = np.array([0.3, 10.0, -1.0])                          # component 2: 10 > 5√1
-    scale, div = switch_components(nu, S, np.ones(3), tune)
+    scale, div = switch_components(nu, S, np.ones(3), R, tune)
     np.testing.assert_array_equal(scale, [1.0, tune.switch_noise, 1.0])
-    assert div == (100.09 + 1.0 > tune.diverge_gamma * 6.0)
-    scale, div = switch_components(np.zeros(3), S, scale, tune)
+    assert not div                                             # two components pass
+    S_off = S + np.diag((scale - 1.0) * 0.5)                  # the filter's S with ζ
+    scale2, _ = switch_components(nu, S_off, scale, R, tune)  # tested at the nominal S
+    np.testing.assert_array_equal(scale2, scale)              # still off while it fails
+    scale, div = switch_components(np.zeros(3), S_off, scale, R, tune)
     np.testing.assert_array_equal(scale, [1.0, 1.0, 1.0])
     assert not div
     big = np.full(3, 20.0)                                     # 1200 > 25 × 6
-    assert switch_components(big, S, np.ones(3), tune)[1]
+    assert switch_components(big, S, np.ones(3), R, tune)[1]
 
 
 def test_declared_sensor_noise_is_the_presets_vrw_arw_and_scale_factor_misalignment():

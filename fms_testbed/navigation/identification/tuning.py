@@ -64,7 +64,7 @@ class FdiTuning:
     baro_window_s: float = 10.0
     switch_noise: float = 1e4
     diverge_gamma: float = 25.0
-    diverge_count: int = 5
+    diverge_count: int = 10
 
 
     def __post_init__(self):

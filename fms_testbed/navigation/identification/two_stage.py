@@ -57,6 +57,7 @@ class TwoStage:
     Parameters
     ----------
     n_real : R;  n_units : U (2 or 3);  tuning : thresholds
+    track_stats : keep :attr:`stat_max` (the statistics' maxima, for calibration)
 
     Attributes
     ----------
@@ -78,8 +79,10 @@ class TwoStage:
     excluded_by : (R, U) int, reason of each exclusion (:data:`BY_TABLE`, :data:`BY_INNOVATION`)
     """
 
-    def __init__(self, n_real: int, n_units: int, tuning: FdiTuning = FdiTuning()):
+    def __init__(self, n_real: int, n_units: int, tuning: FdiTuning = FdiTuning(),
+                 track_stats: bool = False):
         R, U = n_real, n_units
+        self.track_stats = bool(track_stats)
         self.n_real, self.n, self.tuning = R, U, tuning
         self.used = np.ones((R, U), bool)
         self.isolated = np.zeros((R, U), bool)
@@ -186,7 +189,7 @@ class TwoStage:
     def _stage1(self, t_s, y, sig, nu_sensor, mask) -> None:
         tu, live = self.tuning, self.used
         raw = pair_flags(y, sig, tu.k_pair, live, mask)
-        for a, b in PAIRS:
+        for a, b in PAIRS if self.track_stats else ():
             if b < self.n:
                 r = np.where(live[:, a] & live[:, b],
                              ratio(y[:, a], y[:, b], sig[:, a], sig[:, b], mask), 0.0)
@@ -236,9 +239,11 @@ class TwoStage:
                               self.tuning.k_est, mask)
         v[~self.used] = -1
         self.verdict = v
-        r = np.where(self.used & ok[:, None],
-                     ratio(y, zhat[:, None], sig, shat[:, None], mask), 0.0)
-        np.maximum(self.stat_max[:, 2], np.nan_to_num(r).max(axis=1), out=self.stat_max[:, 2])
+        if self.track_stats:
+            r = np.where(self.used & ok[:, None],
+                         ratio(y, zhat[:, None], sig, shat[:, None], mask), 0.0)
+            np.maximum(self.stat_max[:, 2], np.nan_to_num(r).max(axis=1),
+                       out=self.stat_max[:, 2])
         bad = v == UNIT_FAILED
         s = self._s2_since
         s[bad & np.isnan(s)] = t_s
