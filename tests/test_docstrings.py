@@ -34,6 +34,10 @@ MODULES = [
     "guidance.replan", "guidance.vnav", "guidance.step_log", "guidance.profile_kernel",
     "guidance.speed_plan", "guidance.active_path", "run.summary", "run.schemas", "run.api",
     "evaluation.records", "evaluation.flight_errors", "evaluation.threshold",
+    # the INS/GNSS filter on measurements and its replay
+    "navigation.measurements", "navigation.replay", "navigation.replay_io",
+    "navigation.recording", "navigation.strapdown_sins", "navigation.prediction",
+    "cli.nav_replay", "viz.replay", "sensors.gnss",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")
