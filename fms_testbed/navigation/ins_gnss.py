@@ -248,6 +248,13 @@ class InsGnssNavigation(NavigationSourceBase):
             src.refdesc = ReferenceDescriptionMonitor([f.imu for f in filters])
         return src
 
+    def install_imu(self, lever_arm_m) -> None:
+        """The IMU's position from the CG (the aircraft file's ``imu_lever_arm_m``, body axes,
+        m), set before the first update; the linear model has none."""
+        if isinstance(self.bank, StrapdownBank):
+            self.bank.set_lever_arm(lever_arm_m)
+            self.frame_properties = tuple(self.bank.frame_properties)
+
     # -- faults ----------------------------------------------------------------------------
     def check_fault(self, fault: dict) -> None:
         """Raise ConfigError when a scenario fault names a unit this source does not have."""
