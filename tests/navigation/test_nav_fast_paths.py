@@ -17,7 +17,7 @@ import numpy as np
 from fms_testbed.navigation import make_source
 from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
 
-SPEC = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}
+SPEC = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 3, "truth_model": "linear"}
 
 
 def _states():
