@@ -14,7 +14,7 @@ from functools import lru_cache
 from pathlib import Path
 from typing import Annotated
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, model_validator
+from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.units import KT_MPS
@@ -52,9 +52,11 @@ class Limits(_Frozen):
     climb_gradient_max: Annotated[float, Field(gt=0, lt=0.5)] = Field(
         description="max climb gradient (rise over run) at the planned speed, dimensionless")
     descent_rate_max_mps: Pos = Field(description="max planned descent rate, m/s")
-    climb_tas_mps: Pos = Field(
-        description="planned terminal-area speed for path building and guidance, m/s: the TAS "
-                    "at sea level, flown as that CAS at altitude")
+    climb_cas_mps: Pos = Field(
+        validation_alias=AliasChoices("climb_cas_mps", "climb_tas_mps"),
+        description="planned terminal-area speed for path building and guidance, a CAS, m/s "
+                    "(its TAS at each leg's planned altitude); the older key climb_tas_mps is read "
+                    "as the same CAS")
 
     @model_validator(mode="after")
     def _order(self):
@@ -138,6 +140,26 @@ class CoupledLawGains(_Frozen):
     T_H_s: Pos = Field(description="altitude-channel time constant, s")
     xi_H: Pos = Field(description="altitude-channel damping ratio")
     dH_limit_m: Pos = Field(100.0, description="altitude-error limit (level-change mode), m")
+
+
+class SchedulePoint(_Frozen):
+    """One row of the coupled law's gain schedule: the scheduling variables and the tuning."""
+
+    qbar_pa: Pos = Field(description="dynamic pressure, Pa")
+    mass_kg: Pos = Field(description="mass, kg")
+    T_V_s: Pos = Field(description="speed-channel time constant, s")
+    xi_V: Pos = Field(description="speed-channel damping ratio")
+    T_H_s: Pos = Field(description="altitude-channel time constant, s")
+    xi_H: Pos = Field(description="altitude-channel damping ratio")
+    ny_trim_tau_s: Pos = Field(description="n_y tracking-error integrator time constant, s")
+
+
+class CoupledLawSchedule(_Frozen):
+    """Gain schedule of the coupled law in dynamic pressure and mass (``fms-testbed tune
+    --envelope``): a table, piecewise linear in ln q̄ per mass level and linear in mass
+    (:mod:`fms_testbed.control.schedule`)."""
+
+    points: list[SchedulePoint] = Field(min_length=1)
 
 
 class FlapDetent(_Frozen):
@@ -283,6 +305,9 @@ class AircraftConfig(_Frozen):
     inner_loops: InnerLoopGains
     inner_spec: InnerLoopSpec = Field(default_factory=InnerLoopSpec)
     coupled_law: CoupledLawGains | None = None
+    coupled_law_schedule: CoupledLawSchedule | None = Field(
+        None, description="gains of the coupled law scheduled in dynamic pressure and mass "
+                          "(replace T_V_s, xi_V, T_H_s, xi_H of coupled_law in flight)")
     approach: ApproachSettings | None = Field(
         None, description="approach speeds and configuration (None: flown clean at the "
                           "planned approach speed)")

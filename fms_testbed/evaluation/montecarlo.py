@@ -5,7 +5,8 @@ Phases: one **fault-free** phase (N realisations of the whole trajectory, option
 and one phase per **fault** (kind and size, injected on INS 2 at ``fault_at_s``). Statistics per
 phase (one row of :meth:`McReport.to_pandas`):
 
-* fault-free: false exclusions (any unit excluded), false detections (any stage-1 detection),
+* fault-free: false exclusions (any removal by any layer: a unit isolated or excluded, the GNSS
+  or the baro named failed), false detections (any detection),
   the false-exclusion rate per hour and its 95 % upper confidence bound (Poisson: χ²_{0.95}(2k+2)
   / 2T for k events in T hours — 3/T for k = 0, the rule of three);
 * fault: fraction detected (stage 1 after the fault), fraction with the faulty unit excluded,
@@ -14,7 +15,8 @@ phase (one row of :meth:`McReport.to_pandas`):
 * both: NSE95 of the output (horizontal, pooled over realisations and samples) with a GNSS fix
   used within two fix periods and while coasting, m; during outages the 95th percentile over
   realisations of the largest horizontal NSE, the largest ANP, and the fraction of outage samples
-  with NSE ≤ RNP and with ANP ≤ RNP (RNP containment and the monitor's view of it).
+  with NSE ≤ RNP and with ANP ≤ RNP (RNP containment and the monitor's view of it); NSE95 of the
+  whole output and, beside it, of the majority-voting baseline on the raw outputs, m.
 """
 
 from __future__ import annotations
@@ -110,7 +112,8 @@ class McReport:
         row = {"phase": label, "runs": n, "duration_s": round(r.duration_s, 1),
                "hours": round(hours, 2)}
         if r.fault is None:
-            excl = np.isfinite(r.t_exclude_s).any(axis=1)
+            excl = (np.isfinite(r.t_exclude_s).any(axis=1) | np.isfinite(r.t_isolate_s).any(1)
+                    | np.isfinite(r.t_gnss_s) | np.isfinite(r.t_baro_s))
             k = int(excl.sum())
             row.update(false_exclusions=k, false_detections=int(np.isfinite(r.t_detect_s).sum()),
                        false_exclusion_rate_per_h=k / hours if hours else math.nan,
@@ -129,6 +132,8 @@ class McReport:
                        tte_median_s=_q(ex - t0, 50), tte_p95_s=_q(ex - t0, 95))
         row.update(nse95_gnss_m=percentile_from_hist(r.hist_gnss, 95),
                    nse95_coast_m=percentile_from_hist(r.hist_coast, 95),
+                   nse95_vote_m=percentile_from_hist(r.hist_vote, 95),
+                   nse95_output_m=percentile_from_hist(r.hist_gnss + r.hist_coast, 95),
                    nse_max_p95_m=_q(r.nse_max_m, 95))
         if r.outage_samples:
             row.update(outage_nse_max_p95_m=_q(r.nse_outage_max_m, 95),

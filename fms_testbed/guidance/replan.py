@@ -120,7 +120,7 @@ def rebuild_rest(db, whole: FlyablePath, spec, cfg, gains: LateralGains, next_le
     The rebuilt rest, or None when there is no database to build from, nothing is left or the
     rest cannot be built.
     """
-    v = gs_mps if gs_mps and gs_mps > 0.0 else cfg.limits.climb_tas_mps
+    v = gs_mps if gs_mps and gs_mps > 0.0 else cfg.limits.climb_cas_mps
     la, lo, trk = roll_out_state(math.degrees(lat_rad), math.degrees(lon_rad), track_rad, v,
                                  roll_rad, gains)
     lead = anticipation_m(v, math.radians(PLANNED_BANK_DEG), gains)
@@ -199,7 +199,7 @@ class Replanner:
     def leg_ended(self, w: Where, nav: NavSolution) -> tuple[list[int], Rebuild | None]:
         """The conditional leg flown ended: (the DF legs after it already passed, the rebuild
         of the legs after those — None when nothing is left)."""
-        v = self.cfg.limits.climb_tas_mps
+        v = self.cfg.limits.climb_cas_mps
         passed = passed_direct_legs(self.whole, w.leg + 1, nav.lat_rad, nav.lon_rad, w.trk_rad,
                                     v)
         nxt = (passed[-1] if passed else w.leg) + 1

@@ -83,8 +83,8 @@ class VerticalGuidance:
         self.top_m = climb_top_m(fp, cfg, spec)
         self.approach = fp.path.proc_type == "F"
         self.speed = SpeedPlan(planned_limits(fp.seq.legs, fp.path.proc_type, lim.cas_min_mps),
-                               fp.path.proc_type in ("E", "F"), lim.climb_tas_mps,
-                               lim.cas_min_mps, lim.climb_tas_mps,
+                               fp.path.proc_type in ("E", "F"), lim.climb_cas_mps,
+                               lim.cas_min_mps, lim.climb_cas_mps,
                                isa_dev_c=fp.params.isa_dev_c if fp.params is not None else 0.0,
                                bank_max_deg=lim.bank_max_deg if bank_max_deg is None
                                else bank_max_deg)

@@ -57,7 +57,7 @@ def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
                 if sg.geom.length_m() >= 50.0), seg0.start_course_deg)
     # start one roll-in anticipation before the path start on its initial course, so that a
     # turn beginning at the path start (a fly-by at the DER) is flown like any planned turn
-    lead = anticipation_m(cfg.limits.climb_tas_mps, math.radians(PLANNED_BANK_DEG),
+    lead = anticipation_m(cfg.limits.climb_cas_mps, math.radians(PLANNED_BANK_DEG),
                           LateralGains.for_aircraft(cfg))
     lat, lon, _ = direct(seg0.start[0], seg0.start[1], crs + 180.0, lead)
     alt = fp.path.legs[0].start.alt_m
@@ -66,7 +66,7 @@ def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     lo, hi = cas_band(planned_limits(fp.seq.legs, fp.path.proc_type,
                                      cfg.limits.cas_min_mps)[0], None)
     dev = fp.params.isa_dev_c if fp.params is not None else 0.0
-    tas = tas_target_mps(cas_to_tas_scalar(cfg.limits.climb_tas_mps, alt, dev), alt, lo, hi,
+    tas = tas_target_mps(cas_to_tas_scalar(cfg.limits.climb_cas_mps, alt, dev), alt, lo, hi,
                          cfg.limits.cas_min_mps, dev)
     hdg = fp.path.segments[0].heading_deg   # a heading leg: its heading (drift in the plan)
     return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,
@@ -178,10 +178,10 @@ def prepare(raw: dict, source: str = "<scenario>", db=None
     raw.setdefault("initial", initial_from_path(fp, cfg))
     actual = _wind_or_none(raw.get("wind"))
     w_max = max(wind.max_speed_mps if wind else 0.0, actual.max_speed_mps if actual else 0.0)
-    v_min = max(cfg.limits.climb_tas_mps - w_max,
-                0.5 * cfg.limits.climb_tas_mps)   # into the wind
+    v_min = max(cfg.limits.climb_cas_mps - w_max,
+                0.5 * cfg.limits.climb_cas_mps)   # into the wind
     # + two full turns: a path rebuilt in flight after a conditional leg may loop back
-    r_turn = cfg.limits.climb_tas_mps ** 2 / (G0_MPS2 * math.tan(math.radians(PLANNED_BANK_DEG)))
+    r_turn = cfg.limits.climb_cas_mps ** 2 / (G0_MPS2 * math.tan(math.radians(PLANNED_BANK_DEG)))
     raw.setdefault("duration_s", min(6 * 3600.0, (1.6 * fp.path.length_m()
                                                   + 4.0 * math.pi * r_turn) / v_min + 120.0))
     raw.setdefault("name", f"{spec.airport}-{spec.procedure}".lower())

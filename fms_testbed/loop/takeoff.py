@@ -23,7 +23,7 @@ in once the aircraft rolls faster than twice the wind speed (at rest a tailwind 
    the acceleration height (the approach settings' ``acceleration_height_m``, else
    :data:`ACCEL_HEIGHT_M`) the pitch target eases (≤ 1 deg/s) to accelerate to the planned
    climb speed (the guidance's speed target once LNAV is on, else
-   ``limits.climb_tas_mps``, which holds a CAS)
+   ``limits.climb_cas_mps``, which holds a CAS)
    and the flaps come up on the go-around retraction schedule
    (:class:`~fms_testbed.loop.steps.ConfigStep`).
 4. **LNAV** from :data:`LNAV_HEIGHT_M` above the runway and no earlier than where the airborne
@@ -317,10 +317,10 @@ class TakeoffPhase:
         self.config = self._config_step() if ap is not None else None
         self.n_guided = 0
         # LNAV from where the airborne start starts: one roll-in anticipation before the DER
-        self.lnav_lead_m = anticipation_m(cfg.limits.climb_tas_mps, math.radians(PLANNED_BANK_DEG),
+        self.lnav_lead_m = anticipation_m(cfg.limits.climb_cas_mps, math.radians(PLANNED_BANK_DEG),
                                           LateralGains.for_aircraft(cfg))
-        # planned climb speed, a CAS (limits.climb_tas_mps holds a CAS; the guidance's once on)
-        self.v_plan_cas_mps = cfg.limits.climb_tas_mps
+        # planned climb speed, a CAS (limits.climb_cas_mps holds a CAS; the guidance's once on)
+        self.v_plan_cas_mps = cfg.limits.climb_cas_mps
         self.t0 = ac.fdm.get_sim_time()
         self.bank_cmd_rad, self.throttle = 0.0, self.throttle_idle
         self._s, self._wow = None, True           # this step's state, on the wheels

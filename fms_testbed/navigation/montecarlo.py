@@ -12,8 +12,15 @@ What one realisation is — the same models as the per-flight source
 * one error-state filter per unit (:mod:`.ins_filter`: 22 states, innovation gate, the
   delayed-measurement correction of :func:`~.kalman.correct_delayed` for GNSS, Joseph form for
   the baro, feedback of the INS block at every used fix);
-* the raw IMU output errors and the two-stage identification (:mod:`.array_fdi`, the rules and
-  tuning of :class:`~.fdi.TwoStageFdi`); the output is the mean of the units in use.
+* the raw IMU output errors and the two-stage identification
+  (:class:`~.identification.two_stage.TwoStage` over all realisations at once — the same object
+  the per-flight source holds with R = 1), the GNSS and baro checks of the different-type rules
+  (every unit's innovations failing together names the GNSS; every unit's baro residual, the
+  baro); the output is the mean of the units the identification keeps;
+* the majority-voting baseline on the **raw** outputs: a copy of each unit's error without
+  feedback (the free inertial solution), voted with table 1 at ε_N = k_pair √2 σ_free (σ_free
+  from the declared model propagated along the route); its output is the mean of the voted
+  units' corrected outputs (NSE histogram beside the identified output's).
 
 Since the error model is linear, the measurements are differences of errors (z_p = δp_INS(t_m) -
 δp_GNSS(t_m), z_v likewise, z_h = δh_INS - δh_baro) and no geodetic solution is formed.
@@ -40,155 +47,37 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field
 
 import numpy as np
 
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
-from fms_testbed.core.units import DPH_RPS, G0_MPS2
-from fms_testbed.navigation.array_fdi import ArrayFdi, ArraySensorComparator
-from fms_testbed.navigation.fdi import FdiTuning, channel_sigmas, unmodelled_variances
-from fms_testbed.navigation.ins_filter import (N_INS, FilterTuning, InsGnssFilter,
-                                               _filter_phi_q)
+from fms_testbed.core.units import G0_MPS2
+from fms_testbed.navigation.fdi import channel_sigmas, unmodelled_variances
+from fms_testbed.navigation.identification.rules import pair_flags, vote
+from fms_testbed.navigation.identification.sensor import SensorPairTest
+from fms_testbed.navigation.identification.two_stage import TwoStage
+from fms_testbed.navigation.ins_filter import N_INS, InsGnssFilter, _filter_phi_q
+from fms_testbed.navigation.montecarlo_model import (_NSE_EDGES_M, BLOCK_STEPS, FAULT_KINDS,
+                                                     N_UNITS, McConfig, McFault, McResult,
+                                                     percentile_from_hist, realisation_rng)
 from fms_testbed.navigation.sins import _sins_step
-from fms_testbed.sensors.baro import BaroSpec
-from fms_testbed.sensors.gnss import GnssSpec
 from fms_testbed.sensors.sins._blas import single_thread_blas
 from fms_testbed.sensors.sins.analysis import SinsOptions, horizontal_radius, initial_map
 from fms_testbed.sensors.sins.euler import eps_to_euler_errors
 from fms_testbed.sensors.sins.presets import ImuModel, load_imu
 from fms_testbed.sensors.sins.simulate import FACTOR_RTOL
 
-BLOCK_STEPS = 100
-"""Steps of noise a realisation draws per call of its generator (fixed: part of the stream)."""
 
-N_UNITS = 3
-_AXIS = {"x": 0, "y": 1, "z": 2}
-_NSE_EDGES_M = np.concatenate([[0.0], np.logspace(-3, 5, 1601)])
-"""Histogram bin edges of the horizontal NSE, m (0.5 % wide bins from 1 mm to 100 km)."""
-
-FAULT_KINDS = ("gyro_bias_step", "accel_bias_step")
-
-
-@dataclass(frozen=True)
-class McFault:
-    """A fault injected on the truth side of unit ``unit`` (0..2) at ``t_s``: ``kind``
-    ``gyro_bias_step`` (``size`` deg/h) or ``accel_bias_step`` (``size`` µg) on ``axis``."""
-
-    kind: str
-    size: float
-    t_s: float
-    unit: int = 1
-    axis: str = "x"
-
-    def __post_init__(self):
-        if self.kind not in FAULT_KINDS:
-            raise ConfigError(f"montecarlo fault: kind {self.kind!r}; choose one of "
-                              f"{', '.join(FAULT_KINDS)}")
-        if self.axis not in _AXIS:
-            raise ConfigError(f"montecarlo fault: axis {self.axis!r}; choose x, y or z")
-        if self.unit not in range(N_UNITS):
-            raise ConfigError(f"montecarlo fault: unit {self.unit + 1} (ins1..ins3)")
-
-    @property
-    def label(self) -> str:
-        """e.g. ``gyro_bias_step z 20 deg/h``."""
-        return f"{self.kind} {self.axis} {self.size:g} {'deg/h' if 'gyro' in self.kind else 'ug'}"
-
-    def delta(self) -> tuple[int, float]:
-        """(state index, step in state units: rad/s or m/s²)."""
-        if self.kind == "gyro_bias_step":
-            return 12 + _AXIS[self.axis], self.size * DPH_RPS
-        return 9 + _AXIS[self.axis], self.size * 1e-6 * G0_MPS2
-
-
-@dataclass(frozen=True)
-class McConfig:
-    """The models of a Monte-Carlo run (SI).
-
-    imu : IMU preset of the three units;  gnss, baro : sensor models (``gnss.outages`` are the
-    outages of every realisation);  tuning, fdi : filter and identification settings
-    rnp_m : RNP for the containment statistics, m
-    """
-
-    imu: str = "STIM300"
-    gnss: GnssSpec = GnssSpec()
-    baro: BaroSpec = BaroSpec()
-    tuning: FilterTuning = FilterTuning()
-    fdi: FdiTuning = FdiTuning()
-    rnp_m: float = 555.6
-
-
-@dataclass
-class McResult:
-    """Per-realisation outcomes of a batch (arrays over realisations) and pooled histograms.
-
-    index : (R,) realisation indices;  t_detect_s, t_isolate_s, t_exclude_s : first detection (R,),
-    isolation and exclusion (R, 3) times, s (NaN never);  nse_max_m : (R,) max horizontal NSE of
-    the output, m;  nse_outage_max_m : (R,) its max during GNSS outages (NaN: none), m;
-    hist_gnss, hist_coast : pooled sample counts of the horizontal NSE per bin of
-    :data:`_NSE_EDGES_M` with a fix used recently / coasting;  outage_samples, outage_nse_in,
-    outage_anp_in : counts of outage samples, of those with NSE ≤ RNP and with ANP ≤ RNP;
-    anp_max_outage_m : (R,) max ANP in outages, m;  duration_s : simulated time per realisation;
-    wall_s : wall time of the batch, s;  n_cov_groups_max : most covariance groups held at once
-    """
-
-    index: np.ndarray
-    t_detect_s: np.ndarray
-    t_isolate_s: np.ndarray
-    t_exclude_s: np.ndarray
-    nse_max_m: np.ndarray
-    nse_outage_max_m: np.ndarray
-    anp_max_outage_m: np.ndarray
-    hist_gnss: np.ndarray
-    hist_coast: np.ndarray
-    outage_samples: int = 0
-    outage_nse_in: int = 0
-    outage_anp_in: int = 0
-    duration_s: float = 0.0
-    wall_s: float = 0.0
-    n_cov_groups_max: int = 1
-    fault: McFault | None = None
-    extra: dict = field(default_factory=dict)
-
-    @staticmethod
-    def concat(parts: list["McResult"]) -> "McResult":
-        """Join batches of the same configuration (histograms and counts summed)."""
-        a = parts[0]
-        cat = lambda name: np.concatenate([getattr(p, name) for p in parts])  # noqa: E731
-        return McResult(cat("index"), cat("t_detect_s"), cat("t_isolate_s"), cat("t_exclude_s"),
-                        cat("nse_max_m"), cat("nse_outage_max_m"), cat("anp_max_outage_m"),
-                        sum(p.hist_gnss for p in parts), sum(p.hist_coast for p in parts),
-                        sum(p.outage_samples for p in parts), sum(p.outage_nse_in for p in parts),
-                        sum(p.outage_anp_in for p in parts), a.duration_s,
-                        sum(p.wall_s for p in parts), max(p.n_cov_groups_max for p in parts),
-                        a.fault)
-
-
-def percentile_from_hist(hist: np.ndarray, q: float) -> float:
-    """The ``q`` (0..100) percentile of pooled samples from a histogram over
-    :data:`_NSE_EDGES_M` (upper edge of the bin reaching it: ≤ 0.5 % high), m; NaN if empty."""
-    n = hist.sum()
-    if n == 0:
-        return math.nan
-    k = int(np.searchsorted(np.cumsum(hist), q / 100.0 * n))
-    return float(_NSE_EDGES_M[min(k + 1, len(_NSE_EDGES_M) - 1)])
-
-
-def realisation_rng(seed: int, index: int) -> np.random.Generator:
-    """Realisation ``index``'s generator: ``default_rng(SeedSequence([seed, index]))``."""
-    return np.random.default_rng(np.random.SeedSequence([int(seed), int(index)]))
-
-
-def _group_update(P, gidx, xhat, z, Hm, R, q_lag, gate):
+def _group_update(P, gidx, xhat, z, Hm, R, q_lag, gate, allow=None):
     """One measurement group for all members (flattened realisation × unit) at once.
 
     Per covariance group g: C = (P_g - Q_lag) H_mᵀ, S = H_m C + R, K = C S⁻¹ (the
     delayed-measurement correction of :func:`~.kalman.correct_delayed`; Φ = I, Q_lag = 0 is the
     Joseph form); per member ν = z - H_m x̂, NIS = νᵀ S⁻¹ ν, gate |ν_i| ≤ gate √S_ii, and x̂ += K ν
-    when it passes. A group whose members disagree at the gate is split: the members that
-    rejected keep the predicted P in a new group. Returns (P, gidx, NIS (M,), used (M,))."""
+    when it passes (and ``allow`` (M,), if given, is true). A group whose members disagree at
+    the gate is split: the members that rejected keep the predicted P in a new group. Returns
+    (P, gidx, NIS (M,), used (M,))."""
     G = P.shape[0]
     C = (P - q_lag) @ Hm.T                               # (G, n, m)
     S = Hm @ C + R
@@ -199,6 +88,8 @@ def _group_update(P, gidx, xhat, z, Hm, R, q_lag, gate):
     nis = np.einsum("mi,mij,mj->m", nu, Si[gidx], nu)
     sd = np.sqrt(np.diagonal(S, axis1=1, axis2=2))       # (G, m)
     ok = (np.abs(nu) <= gate * sd[gidx]).all(axis=1)
+    if allow is not None:
+        ok &= allow
     xhat[ok] += np.einsum("mij,mj->mi", K[gidx[ok]], nu[ok])
     KC = K @ np.swapaxes(C, 1, 2)
     Pn = P - KC - np.swapaxes(KC, 1, 2) + K @ S @ np.swapaxes(K, 1, 2)
@@ -216,12 +107,340 @@ def _group_update(P, gidx, xhat, z, Hm, R, q_lag, gate):
     return out, gidx, nis, ok
 
 
+def _channel_update(P, gidx, xhat, z, Hm, R, q_lag, k, allow, hold_rows, hold_comp, no_alt):
+    """Seed 001's fault-tolerant correction (eq. 8) for all members at once, per component.
+
+    ν = z − H_m x̂; component i is used when |ν_i| ≤ k √S_ii (and ``allow`` (M,)): the gain
+    K = C S⁻¹ of :func:`_group_update` has the columns of the failed components zeroed, and, for
+    members with ``no_alt`` (M,) whose component ``hold_comp`` failed, the rows ``hold_rows``
+    (n,) bool as well — those states keep their prediction (the vertical channel held). P is
+    corrected with that gain in the Joseph form (P − K Cᵀ − C Kᵀ + K S Kᵀ, valid for any K);
+    members of a covariance group that take different gains are split into groups. Returns
+    (P, gidx, NIS over the used components (M,), their count (M,), used (M,))."""
+    C = (P - q_lag) @ Hm.T
+    S = Hm @ C + R
+    S = 0.5 * (S + np.swapaxes(S, 1, 2))
+    nu = z - xhat @ Hm.T
+    sd = np.sqrt(np.diagonal(S, axis1=1, axis2=2))
+    ok = (np.abs(nu) <= k * sd[gidx]) & allow[:, None]
+    freeze = no_alt & ~ok[:, hold_comp]
+    code = (ok * (1 << np.arange(ok.shape[1]))).sum(axis=1) * 2 + freeze
+    keys, new_g = np.unique(np.stack([gidx, code], axis=1), axis=0, return_inverse=True)
+    new_g = new_g.ravel()
+    out = np.empty((keys.shape[0],) + P.shape[1:])
+    nis = np.zeros(ok.shape[0])
+    for j, (g, c) in enumerate(keys):
+        use = np.array([(c >> (i + 1)) & 1 for i in range(ok.shape[1])], bool)
+        K = np.zeros_like(C[g])
+        if use.any():
+            Si = np.linalg.inv(S[g][np.ix_(use, use)])
+            K[:, use] = C[g][:, use] @ Si
+        if c & 1:
+            K[hold_rows] = 0.0
+        KC = K @ C[g].T
+        Pn = P[g] - KC - KC.T + K @ S[g] @ K.T
+        out[j] = 0.5 * (Pn + Pn.T)
+        mem = new_g == j
+        xhat[mem] += nu[mem] @ K.T
+        if use.any():
+            nis[mem] = np.einsum("mi,ij,mj->m", nu[mem][:, use], Si, nu[mem][:, use])
+    return out, new_g.astype(gidx.dtype), nis, ok.sum(axis=1), ok.any(axis=1)
+
+
 def _compact(P, gidx):
     """Drop covariance groups without members."""
     keep, inv = np.unique(gidx, return_inverse=True)
     if keep.size == P.shape[0]:
         return P, gidx
     return P[keep], inv.astype(gidx.dtype)
+
+
+NL = 33
+"""States of the truth model per unit."""
+
+_HOLD_VERTICAL = np.zeros(22, bool)
+_HOLD_VERTICAL[[2, 5, 21]] = True
+"""Filter states held when the vertical channel has no altitude measurement: δh, δV_U and the
+baro bias (seed 001: ẑ_H and Ŵ_Z frozen)."""
+
+
+class _Batch:
+    """Run-time state of one batch of R realisations (truth, sensors, filters, decisions,
+    statistics). Built by :meth:`MonteCarlo._start`, advanced by the engine's step functions."""
+
+    def __init__(self, mc: "MonteCarlo", idx: np.ndarray):
+        Rn, U, n, imu, cfg, f0 = idx.size, N_UNITS, mc.n, mc.imu, mc.cfg, mc.filt
+        self.idx, self.Rn, self.M = idx, Rn, Rn * U
+        self.rngs = [realisation_rng(mc.seed, i) for i in idx]
+        s0 = mc.states[0]
+        init = np.array([g.standard_normal(U * NL + 7) for g in self.rngs])
+        A = initial_map(s0.lat_rad, (s0.roll_rad, s0.pitch_rad, s0.heading_rad), imu,
+                        SinsOptions())
+        z0 = init[:, :U * NL].reshape(Rn, U, NL) * np.sqrt(imu.p0_var)
+        self.X = (z0 @ A.T).reshape(self.M, NL)
+        self.X_free = self.X.copy()                      # no feedback: the raw outputs
+        self.P_free = (A * imu.p0_var) @ A.T             # their declared covariance
+        gs, bs = cfg.gnss, cfg.baro
+        self.markov = gs.markov_sigma * init[:, U * NL:U * NL + 6]
+        self.bias = bs.markov_sigma_m * init[:, U * NL + 6]
+        f0.initialise(NavSolution(s0.t_s, s0.lat_rad, s0.lon_rad, s0.alt_m,
+                                  np.asarray(s0.v_enu_mps), s0.roll_rad, s0.pitch_rad,
+                                  s0.heading_rad, {}))
+        self.P, self.gidx = f0.P[None].copy(), np.zeros(self.M, np.int64)
+        self.xhat, self.comp = np.zeros((self.M, n)), np.zeros((self.M, 6))
+        self.fdi = TwoStage(Rn, U, cfg.fdi, track_stats=True)
+        self.sensor: SensorPairTest | None = None
+        self.sd_sensor = None
+        self.next_fix = self.next_baro = s0.t_s
+        self.t_markov = self.t_bias = None
+        self.queue: list = []                            # (t_m, t_deliv, zp, zv)
+        self.lag: list = []
+        self.last_used = np.full(Rn, -math.inf)
+        nb = len(_NSE_EDGES_M) - 1
+        self.hist_g, self.hist_c, self.hist_v = (np.zeros(nb, np.int64) for _ in range(3))
+        self.nse_max, self.out_max = np.zeros(Rn), np.full(Rn, np.nan)
+        self.anp_out_max = np.full(Rn, np.nan)
+        self.o_samples = self.o_nse = self.o_anp = 0
+        self.groups_max = 1
+        self.sf_var = np.array([unmodelled_variances(imu)] * U)
+        self.noise = np.empty((Rn, BLOCK_STEPS, K_ALL))
+        self.fault_on = False
+        self.baro_step_m = 0.0
+        self.drift_unit, self.drift_factor = -1, 1.0
+        self.vote_in = np.zeros((Rn, U))
+        self.vote_n = 0
+
+    def result(self, mc: "MonteCarlo", fault, wall_s: float) -> McResult:
+        """The batch's :class:`McResult`."""
+        st, f = mc.states, self.fdi
+        return McResult(self.idx, f.t_detect_s, f.t_isolate_s, f.t_exclude_s, self.nse_max,
+                        self.out_max, self.anp_out_max, self.hist_g, self.hist_c,
+                        self.o_samples, self.o_nse, self.o_anp, st[-1].t_s - st[0].t_s,
+                        wall_s, self.groups_max, fault, f.t_gnss_s, f.t_baro_s, self.hist_v,
+                        self.vote_in / max(self.vote_n, 1), f.stat_max)
+
+
+K_INS = N_UNITS * NL + N_UNITS * 6
+"""Normal draws per step for the INS process noise and the raw-sensor white noise."""
+K_ALL = K_INS + 6 + 6 + 1 + 1
+"""... plus the GNSS Markov and white noise and the baro bias and white noise."""
+
+
+def _propagate(mc: "MonteCarlo", b: _Batch, p: AircraftState, t_s: float, nz) -> None:
+    """Truth errors (with and without feedback), the filters and the raw-output envelope from
+    ``p`` to ``t_s``."""
+    imu, f0, n = mc.imu, mc.filt, mc.n
+    dt = t_s - p.t_s
+    rpy = np.array([p.roll_rad, p.pitch_rad, p.heading_rad])
+    w_eb = np.array([p.p_rps, p.q_rps, p.r_rps])
+    v, fb = np.asarray(p.v_enu_mps, float), np.asarray(p.f_body_mps2, float)
+    _, phi, L, status = _sins_step(np.zeros(NL), np.zeros(NL), p.lat_rad, p.alt_m, v, rpy,
+                                   w_eb, fb, imu.decay_rps, imu.q_psd, 0.0, 0.0, dt, 1e-12,
+                                   FACTOR_RTOL)
+    if status:
+        raise ConfigError(f"montecarlo: truth model discretisation failed at t = {p.t_s} s "
+                          f"(status {status})")
+    w = nz[:, :N_UNITS * NL].reshape(b.Rn, N_UNITS, NL)
+    if b.drift_unit >= 0:
+        w = w.copy()
+        w[:, b.drift_unit, 12:15] *= b.drift_factor
+    drive = w.reshape(b.M, NL) @ L.T
+    b.X = b.X @ phi.T + drive
+    b.X_free = b.X_free @ phi.T + drive
+    b.P_free = phi @ b.P_free @ phi.T + L @ L.T
+    phf, qkf, status = _filter_phi_q(n, p.lat_rad, p.alt_m, v, rpy, w_eb, fb, f0._decay24,
+                                     f0.decay, f0._process_noise(p), dt, 1e-12)
+    if status:
+        raise ConfigError(f"montecarlo: filter discretisation failed at t = {p.t_s} s")
+    b.xhat = b.xhat @ phf.T
+    b.P = phf @ b.P @ phf.T + qkf
+    b.P = 0.5 * (b.P + np.swapaxes(b.P, 1, 2))
+    b.lag.append((p.t_s, phf, qkf))
+    del b.lag[:-64]
+    if b.sensor is None:
+        q_w = imu.q_psd[3:9]
+        b.sd_sensor = np.sqrt(q_w / dt)
+        b.sensor = SensorPairTest(b.Rn, N_UNITS, np.array([q_w] * N_UNITS), dt, b.sf_var,
+                                  mc.cfg.fdi)
+
+
+def _gnss_fix(mc: "MonteCarlo", b: _Batch, t: float, fx) -> None:
+    """A GNSS fix taken at ``t`` (Markov exact between epochs, ramps, outlier bursts), queued
+    for delivery after the latency unless in an outage."""
+    gs = mc.cfg.gnss
+    if t < b.next_fix - 1e-9:
+        return
+    if b.t_markov is not None:
+        a = np.exp(-(t - b.t_markov) / gs.markov_tau_s)
+        b.markov = a * b.markov + gs.markov_sigma * np.sqrt(1.0 - a * a) * fx[:, :6]
+    b.t_markov = t
+    white = np.array(gs.white_sigma, float) * np.ones(6)
+    for o in gs.outliers:
+        if t in o.during:
+            white[:3] = np.hypot(white[:3], o.sigma_m)
+    err = b.markov + white * fx[:, 6:12]
+    for r in gs.ramps:
+        err[:, :3] += r.offset_m(t)
+    if not any(t in o for o in gs.outages):
+        Xr = b.X.reshape(b.Rn, N_UNITS, NL)
+        b.queue.append((t, t + gs.latency_s,
+                        (Xr[:, :, 0:3] - err[:, None, :3]).reshape(b.M, 3),
+                        (Xr[:, :, 3:6] - err[:, None, 3:6]).reshape(b.M, 3)))
+    while b.next_fix <= t + 1e-9:
+        b.next_fix += 1.0 / gs.rate_hz
+
+
+def _deliver(mc: "MonteCarlo", b: _Batch, t: float) -> None:
+    """The fixes due at ``t``: corrected at their time of validity for every filter (the
+    realisations whose GNSS is named failed do not use them), then fed back."""
+    f0, n = mc.filt, mc.n
+    used_any = np.zeros(b.M, bool)
+    allow = np.repeat(~b.fdi.gnss_failed, N_UNITS)
+    while b.queue and b.queue[0][1] <= t + 1e-9:
+        t_m, _, zp, zv = b.queue.pop(0)
+        steps = [(ph, q) for t0, ph, q in b.lag if t0 >= t_m - 1e-9]
+        if steps:
+            phl, ql = steps[0]
+            for ph, q in steps[1:]:
+                phl, ql = ph @ phl, ph @ ql @ ph.T + q
+            Hp = np.linalg.solve(phl.T, f0._H_pos.T).T
+            Hv = np.linalg.solve(phl.T, f0._H_vel.T).T
+        else:
+            ql, Hp, Hv = np.zeros((n, n)), f0._H_pos, f0._H_vel
+        for Hm, z, Rm in ((Hp, zp, f0._r_pos), (Hv, zv, f0._r_vel)):
+            if mc.cfg.component_channels:
+                b.P, b.gidx, nis, dof, ok = _channel_update(
+                    b.P, b.gidx, b.xhat, z, Hm, Rm, ql, mc.cfg.fdi.k_residual, allow,
+                    _HOLD_VERTICAL[:n], 2, np.repeat(b.fdi.baro_failed, N_UNITS))
+            else:
+                b.P, b.gidx, nis, ok = _group_update(b.P, b.gidx, b.xhat, z, Hm, Rm, ql,
+                                                     mc.cfg.tuning.gate_sigma, allow)
+                dof = np.where(allow, 3, 0)
+            b.fdi.add_innovation(t, nis.reshape(b.Rn, N_UNITS), dof.reshape(b.Rn, N_UNITS))
+            used_any |= ok
+        b.last_used[used_any.reshape(b.Rn, N_UNITS).any(axis=1)] = t_m
+    if used_any.any():
+        dx = b.xhat[used_any, :N_INS]
+        b.X[used_any, :N_INS] -= dx
+        b.comp[used_any] += dx[:, 9:15]
+        b.xhat[used_any, :N_INS] = 0.0
+
+
+def _baro(mc: "MonteCarlo", b: _Batch, t: float, fx) -> None:
+    """The baro reading at ``t`` for every filter (not once the baro is named failed) and the
+    channel test of each unit's residual."""
+    bs, f0 = mc.cfg.baro, mc.filt
+    if t < b.next_baro - 1e-9:
+        return
+    while b.next_baro <= t + 1e-9:
+        b.next_baro += 1.0 / bs.rate_hz
+    if b.t_bias is not None:
+        a = math.exp(-(t - b.t_bias) / bs.markov_tau_s)
+        b.bias = a * b.bias + bs.markov_sigma_m * math.sqrt(1.0 - a * a) * fx[:, 12]
+    b.t_bias = t
+    err = b.bias + bs.white_sigma_m * fx[:, 13] + b.baro_step_m
+    zb = b.X[:, 2] - np.repeat(err, N_UNITS)
+    allow = np.repeat(~b.fdi.baro_failed, N_UNITS)
+    b.P, b.gidx, nis, _ = _group_update(b.P, b.gidx, b.xhat, zb[:, None], f0._H_baro,
+                                        f0._r_baro, np.zeros((mc.n, mc.n)),
+                                        mc.cfg.tuning.gate_sigma, allow)
+    b.fdi.add_baro_test(t, (nis > mc.cfg.fdi.k_residual ** 2).reshape(b.Rn, N_UNITS))
+
+
+def _comparison(e: np.ndarray, s: AircraftState) -> np.ndarray:
+    """(R, 3, 9) comparison vectors of navigation errors ``e`` (R, 3, 9: δp m, δV m/s, ε rad):
+    position and velocity, then roll, pitch, heading errors (rad) at the true attitude."""
+    dr, dp, dh = eps_to_euler_errors(e[..., 6], e[..., 7], e[..., 8], s.pitch_rad,
+                                     s.heading_rad)
+    return np.concatenate([e[..., :6], np.stack([dr, dp, dh], axis=-1)], axis=-1)
+
+
+def _identify(mc: "MonteCarlo", b: _Batch, s: AircraftState, nz) -> np.ndarray:
+    """Both stages on the corrected outputs and the raw sensor outputs; returns the corrected
+    navigation errors (R, 3, 9)."""
+    e = (b.X[:, :9] - b.xhat[:, :9]).reshape(b.Rn, N_UNITS, 9)
+    y = _comparison(e, s)
+    # the units' attitude: the truth's (their errors, < 0.1°, change σ by < 1e-3)
+    n_load = float(np.linalg.norm(s.f_body_mps2)) / G0_MPS2
+    sig_g = np.array([channel_sigmas(Pg, (b.sf_var[0, 0], b.sf_var[0, 1]), s.roll_rad,
+                                     s.pitch_rad, n_load) for Pg in b.P])
+    sig = sig_g[b.gidx].reshape(b.Rn, N_UNITS, 9)
+    nu_s = None
+    if b.sensor is not None:
+        w = np.array([s.p_rps, s.q_rps, s.r_rps])
+        f = np.asarray(s.f_body_mps2, float)
+        errs = _sensor_errors(b.X.reshape(b.Rn, N_UNITS, NL), b.comp.reshape(b.Rn, N_UNITS, 6),
+                              f, w, b.sd_sensor, nz[:, N_UNITS * NL:K_INS].reshape(b.Rn,
+                                                                                 N_UNITS, 6))
+        nu_s = b.sensor.update(errs, f, w)
+        np.maximum(b.fdi.stat_max[:, 1], np.abs(b.sensor.last_z).max(axis=(1, 2)),
+                   out=b.fdi.stat_max[:, 1])
+    b.fdi.update(s.t_s, y, sig, nu_s)
+    return e
+
+
+def _vote_raw(mc: "MonteCarlo", b: _Batch, s: AircraftState, e: np.ndarray) -> np.ndarray:
+    """The majority-voting baseline: table 1 of this instant on the raw (free inertial)
+    outputs at ε_N = k_pair √2 σ_free; returns (R, 3) bool, the units voted in."""
+    raw = _comparison(b.X_free[:, :9].reshape(b.Rn, N_UNITS, 9), s)
+    d = np.sqrt(np.maximum(np.diag(b.P_free)[:9], 0.0))
+    d[6] = d[7] = max(d[6], d[7])
+    sig = np.broadcast_to(d, raw.shape)
+    voted = vote(pair_flags(raw, sig, mc.cfg.fdi.k_pair), N_UNITS)
+    if b.fault_on or mc._fault is None:
+        b.vote_in += voted
+        b.vote_n += 1
+    eh = (e[..., :2] * voted[..., None]).sum(axis=1) / voted.sum(axis=1)[:, None]
+    b.hist_v += np.histogram(np.hypot(eh[:, 0], eh[:, 1]), _NSE_EDGES_M)[0]
+    return voted
+
+
+def _output(mc: "MonteCarlo", b: _Batch, s: AircraftState, e: np.ndarray) -> None:
+    """The output (mean of the units the identification keeps; the smallest position trace
+    when it keeps none) and its statistics."""
+    t, gs, P = s.t_s, mc.cfg.gnss, b.P
+    used = b.fdi.output_units
+    valid = used.any(axis=1)
+    g2 = b.gidx.reshape(b.Rn, N_UNITS)
+    tr = np.trace(P[:, :3, :3], axis1=1, axis2=2)[g2]
+    pick = np.where(valid[:, None], used,
+                    np.arange(N_UNITS)[None] == np.argmin(tr, 1)[:, None])
+    cnt = pick.sum(axis=1)
+    eh = (e[..., :2] * pick[..., None]).sum(axis=1) / cnt[:, None]
+    nse = np.hypot(eh[:, 0], eh[:, 1])
+    np.maximum(b.nse_max, nse, out=b.nse_max)
+    coast = t - b.last_used > 2.0 / gs.rate_hz + gs.latency_s + 1e-6
+    b.hist_g += np.histogram(nse[~coast], _NSE_EDGES_M)[0]
+    b.hist_c += np.histogram(nse[coast], _NSE_EDGES_M)[0]
+    if any(t in o for o in gs.outages):
+        ph = np.stack([P[:, 0, 0], P[:, 1, 1], P[:, 0, 1]], axis=1)[g2]     # (R, U, 3)
+        pm = (ph * pick[..., None]).sum(axis=1) / cnt[:, None]
+        uniq, inv = np.unique(pm, axis=0, return_inverse=True)
+        anp = np.array([horizontal_radius(*row) for row in uniq])[inv.ravel()]
+        b.out_max = np.fmax(b.out_max, nse)
+        b.anp_out_max = np.fmax(b.anp_out_max, anp)
+        b.o_samples += b.Rn
+        b.o_nse += int((nse <= mc.cfg.rnp_m).sum())
+        b.o_anp += int((anp <= mc.cfg.rnp_m).sum())
+
+
+def _inject(mc: "MonteCarlo", b: _Batch, t: float, fault: McFault) -> None:
+    """The fault at its time (detection times then count from it)."""
+    Xr = b.X.reshape(b.Rn, N_UNITS, NL)
+    Xf = b.X_free.reshape(b.Rn, N_UNITS, NL)
+    if fault.kind in ("gyro_bias_step", "accel_bias_step"):
+        j, d = fault.delta()
+        Xr[:, fault.unit, j] += d
+        Xf[:, fault.unit, j] += d
+    elif fault.kind == "gyro_drift_scale":
+        excess = (fault.size - 1.0) * np.sqrt(mc.imu.p0_var[12:15])
+        Xr[:, fault.unit, 12:15] += excess
+        Xf[:, fault.unit, 12:15] += excess
+        b.drift_unit, b.drift_factor = fault.unit, float(fault.size)
+    else:                                                    # baro_step
+        b.baro_step_m = float(fault.size)
+    b.fdi.t_detect_s[:] = np.nan
+    b.fault_on = True
 
 
 class MonteCarlo:
@@ -240,8 +459,8 @@ class MonteCarlo:
         self.imu: ImuModel = load_imu(cfg.imu)
         self.filt = InsGnssFilter(self.imu, cfg.gnss, cfg.baro, cfg.tuning)
         self.n = self.filt.n
+        self._fault: McFault | None = None
 
-    # -- one batch -------------------------------------------------------------------------
     def run(self, indices, fault: McFault | None = None, progress=None, probe=None) -> McResult:
         """Run realisations ``indices`` (their seeds: :func:`realisation_rng`) together, on one
         BLAS thread (OpenBLAS threads make these small products many times slower on a busy
@@ -253,200 +472,39 @@ class MonteCarlo:
 
     def _run(self, indices, fault, progress, probe) -> McResult:
         t_wall = time.perf_counter()
-        idx = np.asarray(indices, int)
-        Rn, U, n, imu, cfg, f0 = idx.size, N_UNITS, self.n, self.imu, self.cfg, self.filt
-        M = Rn * U
-        rngs = [realisation_rng(self.seed, i) for i in idx]
+        self._fault = fault
+        b = _Batch(self, np.asarray(indices, int))
         st = self.states
-        s0 = st[0]
-        # initial draws per realisation: 3 × 33 INS, 6 GNSS Markov, 1 baro bias
-        init = np.array([g.standard_normal(U * 33 + 7) for g in rngs])
-        A = initial_map(s0.lat_rad, (s0.roll_rad, s0.pitch_rad, s0.heading_rad), imu,
-                        SinsOptions())
-        z0 = init[:, :U * 33].reshape(Rn, U, 33) * np.sqrt(imu.p0_var)
-        X = (z0 @ A.T).reshape(M, 33)
-        gs, bs = cfg.gnss, cfg.baro
-        gsig, gtau, gwhite = gs.markov_sigma, gs.markov_tau_s, gs.white_sigma
-        markov = gsig * init[:, U * 33:U * 33 + 6]
-        bias = bs.markov_sigma_m * init[:, U * 33 + 6]
-        sol0 = NavSolution(s0.t_s, s0.lat_rad, s0.lon_rad, s0.alt_m, np.asarray(s0.v_enu_mps),
-                           s0.roll_rad, s0.pitch_rad, s0.heading_rad, {})
-        f0.initialise(sol0)
-        P = f0.P[None].copy()
-        gidx = np.zeros(M, np.int64)
-        xhat = np.zeros((M, n))
-        comp = np.zeros((M, 6))
-        H_pos, H_vel, H_baro = f0._H_pos, f0._H_vel, f0._H_baro
-        r_pos, r_vel, r_baro = f0._r_pos, f0._r_vel, f0._r_baro
-        fdi = ArrayFdi(Rn, cfg.fdi)
-        sd_sensor = None
-        comparator = None
-        # timing of GNSS epochs (from the first sample, every period) and baro readings
-        period, lat_s = 1.0 / gs.rate_hz, gs.latency_s
-        next_fix, next_baro, t_markov, t_bias = s0.t_s, s0.t_s, None, None
-        queue: list[tuple[float, float, np.ndarray, np.ndarray]] = []   # (t_m, t_deliv, zp, zv)
-        lag: list[tuple[float, np.ndarray, np.ndarray]] = []
-        last_used = np.full(Rn, -math.inf)     # as the source's nav_mode: coasting until a fix
-        hist_g = np.zeros(len(_NSE_EDGES_M) - 1, np.int64)
-        hist_c = np.zeros_like(hist_g)
-        nse_max = np.zeros(Rn)
-        out_max = np.full(Rn, np.nan)
-        anp_out_max = np.full(Rn, np.nan)
-        o_samples = o_nse = o_anp = 0
-        groups_max = 1
-        q_w = imu.q_psd[3:9]
-        sf_var = np.array([unmodelled_variances(imu)] * U)
-        noise = None
-        fault_done = fault is None
-        NL = 33
-        K_INS = U * NL + U * 6            # per step: INS process noise, raw-sensor white noise
-        K_FIX = 6 + 6 + 1 + 1             # per step (used at epochs): Markov, white, baro ×2
-        K = K_INS + K_FIX
         for k, s in enumerate(st):
-            t = s.t_s
-            b = k % BLOCK_STEPS
-            if b == 0:
-                if noise is None:
-                    noise = np.empty((Rn, BLOCK_STEPS, K))
-                for r, g in enumerate(rngs):
-                    g.standard_normal(out=noise[r])
-            nz = noise[:, b]                                    # (R, K)
-            if k > 0:
-                p = st[k - 1]
-                dt = t - p.t_s
-                rpy = np.array([p.roll_rad, p.pitch_rad, p.heading_rad])
-                w_eb = np.array([p.p_rps, p.q_rps, p.r_rps])
-                v = np.asarray(p.v_enu_mps, float)
-                fb = np.asarray(p.f_body_mps2, float)
-                _, phi, L, status = _sins_step(np.zeros(33), np.zeros(33), p.lat_rad, p.alt_m, v,
-                                               rpy, w_eb, fb, imu.decay_rps, imu.q_psd, 0.0, 0.0,
-                                               dt, 1e-12, FACTOR_RTOL)
-                if status:
-                    raise ConfigError(f"montecarlo: truth model discretisation failed at "
-                                      f"t = {p.t_s} s (status {status})")
-                X = X @ phi.T + nz[:, :U * NL].reshape(M, NL) @ L.T
-                phf, qkf, status = _filter_phi_q(n, p.lat_rad, p.alt_m, v, rpy, w_eb, fb,
-                                                 f0._decay24, f0.decay, f0._process_noise(p),
-                                                 dt, 1e-12)
-                if status:
-                    raise ConfigError(f"montecarlo: filter discretisation failed at t = "
-                                      f"{p.t_s} s")
-                xhat = xhat @ phf.T
-                P = phf @ P @ phf.T + qkf
-                P = 0.5 * (P + np.swapaxes(P, 1, 2))
-                lag.append((p.t_s, phf, qkf))
-                del lag[:-64]
-                if sd_sensor is None:
-                    sd_sensor = np.sqrt(q_w / dt)
-                    comparator = ArraySensorComparator(Rn, np.array([q_w] * U), dt, sf_var,
-                                                       cfg.fdi)
-            # GNSS fix taken at this sample (Markov exact between epochs), delivered later
-            fx = nz[:, K_INS:]
-            if t >= next_fix - 1e-9:
-                if t_markov is not None:
-                    a = np.exp(-(t - t_markov) / gtau)
-                    markov = a * markov + gsig * np.sqrt(1.0 - a * a) * fx[:, :6]
-                t_markov = t
-                err = markov + gwhite * fx[:, 6:12]
-                for r in gs.ramps:
-                    err[:, :3] += r.offset_m(t)
-                if not any(t in o for o in gs.outages):
-                    Xr = X.reshape(Rn, U, 33)
-                    queue.append((t, t + lat_s, (Xr[:, :, 0:3] - err[:, None, :3]).reshape(M, 3),
-                                  (Xr[:, :, 3:6] - err[:, None, 3:6]).reshape(M, 3)))
-                while next_fix <= t + 1e-9:
-                    next_fix += period
-            used_any = np.zeros(M, bool)
-            while queue and queue[0][1] <= t + 1e-9:
-                t_m, _, zp, zv = queue.pop(0)
-                steps = [(ph, q) for t0, ph, q in lag if t0 >= t_m - 1e-9]
-                if steps:
-                    phl, ql = steps[0]
-                    for ph, q in steps[1:]:
-                        phl, ql = ph @ phl, ph @ ql @ ph.T + q
-                    Hp = np.linalg.solve(phl.T, H_pos.T).T
-                    Hv = np.linalg.solve(phl.T, H_vel.T).T
-                else:
-                    ql, Hp, Hv = np.zeros((n, n)), H_pos, H_vel
-                for Hm, z, Rm in ((Hp, zp, r_pos), (Hv, zv, r_vel)):
-                    P, gidx, nis, ok = _group_update(P, gidx, xhat, z, Hm, Rm, ql,
-                                                     cfg.tuning.gate_sigma)
-                    fdi.add_innovation(t, nis.reshape(Rn, U), 3)
-                    used_any |= ok
-                last_used[used_any.reshape(Rn, U).any(axis=1)] = t_m
-            if used_any.any():
-                dx = xhat[used_any, :N_INS]
-                X[used_any, :N_INS] -= dx
-                comp[used_any] += dx[:, 9:15]
-                xhat[used_any, :N_INS] = 0.0
-            # baro reading at this sample
-            if t >= next_baro - 1e-9:
-                while next_baro <= t + 1e-9:
-                    next_baro += 1.0 / bs.rate_hz
-                if t_bias is not None:
-                    a = math.exp(-(t - t_bias) / bs.markov_tau_s)
-                    bias = a * bias + bs.markov_sigma_m * math.sqrt(1.0 - a * a) * fx[:, 12]
-                t_bias = t
-                zb = X[:, 2] - np.repeat(bias + bs.white_sigma_m * fx[:, 13], U)
-                P, gidx, _, _ = _group_update(P, gidx, xhat, zb[:, None], H_baro, r_baro,
-                                              np.zeros((n, n)), cfg.tuning.gate_sigma)
-            P, gidx = _compact(P, gidx)
-            groups_max = max(groups_max, P.shape[0])
-            # identification and output
-            e = (X[:, :9] - xhat[:, :9]).reshape(Rn, U, 9)
-            dr, dp, dh = eps_to_euler_errors(e[..., 6], e[..., 7], e[..., 8], s.pitch_rad,
-                                             s.heading_rad)
-            y = np.concatenate([e[..., :6], np.stack([dr, dp, dh], axis=-1)], axis=-1)
-            # the units' attitude: the truth's (their errors, < 0.1°, change σ by < 1e-3)
-            n_load = float(np.linalg.norm(s.f_body_mps2)) / G0_MPS2
-            sig_g = np.array([channel_sigmas(Pg, (sf_var[0, 0], sf_var[0, 1]), s.roll_rad,
-                                             s.pitch_rad, n_load) for Pg in P])
-            sig = sig_g[gidx].reshape(Rn, U, 9)
-            if comparator is not None:
-                Xr = X.reshape(Rn, U, 33)
-                w = np.array([s.p_rps, s.q_rps, s.r_rps])
-                f = np.asarray(s.f_body_mps2, float)
-                errs = _sensor_errors(Xr, comp.reshape(Rn, U, 6), f, w, sd_sensor,
-                                      nz[:, U * NL:K_INS].reshape(Rn, U, 6))
-                nu_s = comparator.update(errs, f, w)
-            else:
-                nu_s = np.zeros((Rn, 3), np.int64)
-            fdi.update(t, y, sig, nu_s)
-            used = fdi.used
-            valid = used.any(axis=1)
-            g2 = gidx.reshape(Rn, U)
-            tr = np.trace(P[:, :3, :3], axis1=1, axis2=2)[g2]
-            pick = np.where(valid[:, None], used, np.arange(U)[None] == np.argmin(tr, 1)[:, None])
-            cnt = pick.sum(axis=1)
-            eh = (e[..., :2] * pick[..., None]).sum(axis=1) / cnt[:, None]
-            nse = np.hypot(eh[:, 0], eh[:, 1])
-            np.maximum(nse_max, nse, out=nse_max)
-            coast = t - last_used > 2.0 * period + lat_s + 1e-6
-            hist_g += np.histogram(nse[~coast], _NSE_EDGES_M)[0]
-            hist_c += np.histogram(nse[coast], _NSE_EDGES_M)[0]
-            in_outage = any(t in o for o in gs.outages)
-            if in_outage:
-                ph = np.stack([P[:, 0, 0], P[:, 1, 1], P[:, 0, 1]], axis=1)[g2]   # (R, U, 3)
-                pm = (ph * pick[..., None]).sum(axis=1) / cnt[:, None]
-                uniq, inv = np.unique(pm, axis=0, return_inverse=True)
-                anp = np.array([horizontal_radius(*row) for row in uniq])[inv.ravel()]
-                out_max = np.fmax(out_max, nse)
-                anp_out_max = np.fmax(anp_out_max, anp)
-                o_samples += Rn
-                o_nse += int((nse <= cfg.rnp_m).sum())
-                o_anp += int((anp <= cfg.rnp_m).sum())
-            if not fault_done and t >= fault.t_s - 1e-9:
-                j, d = fault.delta()
-                X.reshape(Rn, U, 33)[:, fault.unit, j] += d
-                fdi.t_detect_s[:] = np.nan           # detection times count from the fault
-                fault_done = True
+            self._step(b, k, s, fault)
             if probe is not None:
-                probe(t, X.reshape(Rn, U, 33), xhat.reshape(Rn, U, n), P, gidx.reshape(Rn, U))
+                probe(s.t_s, b.X.reshape(b.Rn, N_UNITS, NL), b.xhat.reshape(b.Rn, N_UNITS,
+                                                                            self.n),
+                      b.P, b.gidx.reshape(b.Rn, N_UNITS))
             if progress is not None and k % 1000 == 0:
                 progress(k, len(st))
-        return McResult(idx, fdi.t_detect_s, fdi.t_isolate_s, fdi.t_exclude_s, nse_max, out_max,
-                        anp_out_max, hist_g, hist_c, o_samples, o_nse, o_anp,
-                        st[-1].t_s - s0.t_s, time.perf_counter() - t_wall, groups_max, fault)
+        return b.result(self, fault, time.perf_counter() - t_wall)
+
+    def _step(self, b: _Batch, k: int, s: AircraftState, fault: McFault | None) -> None:
+        """One sample of the trajectory: propagate, sensors, corrections, decisions, output."""
+        t = s.t_s
+        if k % BLOCK_STEPS == 0:
+            for r, g in enumerate(b.rngs):
+                g.standard_normal(out=b.noise[r])
+        nz = b.noise[:, k % BLOCK_STEPS]
+        if k > 0:
+            _propagate(self, b, self.states[k - 1], t, nz)
+        fx = nz[:, K_INS:]
+        _gnss_fix(self, b, t, fx)
+        _deliver(self, b, t)
+        _baro(self, b, t, fx)
+        b.P, b.gidx = _compact(b.P, b.gidx)
+        b.groups_max = max(b.groups_max, b.P.shape[0])
+        e = _identify(self, b, s, nz)
+        _vote_raw(self, b, s, e)
+        _output(self, b, s, e)
+        if fault is not None and not b.fault_on and t >= fault.t_s - 1e-9:
+            _inject(self, b, t, fault)
 
 
 def _sensor_errors(X, comp, f, w, sd, z):

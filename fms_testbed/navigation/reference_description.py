@@ -53,18 +53,15 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
 
-from fms_testbed.core.earth import OMEGA_IE_RPS, radii_m
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.navigation.ins_filter import enu_difference_m
-# navigation.sins first: its import runs the numba-cache guard of this package (the kernels below
-# inline build_F, _picard_sins and the Earth model's radii)
-from fms_testbed.navigation.sins import _c_bn
+from fms_testbed.navigation.reference_kernels import (  # noqa: F401  (tests read them here)
+    _add_feedback, _channel_step, _decide, _distance, _epoch, _measure_into, _propagate_blocks,
+    channel_process_noise)
 from fms_testbed.sensors.sins.analysis import SinsOptions
 from fms_testbed.sensors.sins.discretize import (PICARD_MAX_ORDER, PICARD_MAX_RATE_DT,
-                                                 DiscretisationError, _picard_sins)
-from fms_testbed.sensors.sins.model import build_F
+                                                 DiscretisationError)
 from fms_testbed.sensors.sins.presets import ImuModel
 
 CHANNELS = (0, 1, 3, 4)
@@ -98,28 +95,6 @@ class ReferenceTuning:
     window_s: float = 1200.0
     n_windows: int = 2
     track_tau_s: float = 10.0
-
-
-@njit(cache=True)
-def channel_process_noise(var_v_now, var_v_before, dt_s, track_tau_s):
-    """Acceleration noise density q of the per-channel filter, (m/s²)²·s: the growth of the
-    envelope's velocity variance over the step, and at least that variance over
-    ``track_tau_s``.
-
-    The growth alone is not enough: in a turn the free copy's velocity error turns with the
-    heading (its components change by metres per second in seconds) while the envelope's
-    variance of a component may stall or shrink, and a filter given q → 0 there stops following
-    its measurement — it lagged the measured error by 5 m/s (0.8 σ) in a climbing turn, the cause
-    of healthy units' exclusions (19 in 100 fault-free one-hour runs). With the floor the filter
-    follows the measurement within its noise (the integrated solution's, metres and cm/s against
-    an envelope of hundreds of metres and metres per second), so d is the measured error's.
-
-    Parameters
-    ----------
-    var_v_now, var_v_before : the envelope's velocity variance of the channel after and before
-        the step, (m/s)²;  dt_s : step, s;  track_tau_s : s
-    """
-    return max((var_v_now - var_v_before) / dt_s, var_v_now / track_tau_s, 1e-10)
 
 
 def envelope_start(P_filter: np.ndarray, imu: ImuModel) -> np.ndarray:
@@ -225,270 +200,20 @@ def reference_decision(d: np.ndarray, excluded: np.ndarray, outside_since: np.nd
     return ~new, new, since, rank
 
 
-# --- compiled forms used by the monitor (the same equations as the functions above; tests compare
-# them to rounding): one call per reference epoch does F, (Φ, Q_k), every window's envelopes and
-# free copies, the per-channel filters, the distances and the decision
-
-_N_NAV = 9     # navigation states of the 33-state model; the 24 sensor states have diagonal Φ
-
-
-@njit(cache=True)
-def _sensor_nonzeros(M, nn, nz, cnt):
-    """For each sensor row i of M (rows and columns from ``nn`` on): the columns of its non-zero
-    sensor entries in nz[i, :cnt[i]] (nz, cnt overwritten)."""
-    m = M.shape[0] - nn
-    for i in range(m):
-        cnt[i] = 0
-        for j in range(m):
-            if M[nn + i, nn + j] != 0.0:
-                nz[i, cnt[i]] = nn + j
-                cnt[i] += 1
-
-
-@njit(cache=True, fastmath={"contract"})
-def _propagate_blocks(P, D, phi, qk):
-    """:func:`propagate` for one unit in place, on the blocks of Φ = [[Φ11, Φ12], [0, diag φ22]]
-    (9 navigation states, 24 sensor states): C = Φ P, Pₙ = C Φᵀ + Q_k, P ← ½ (Pₙ + Pₙᵀ), D ← Φ D.
-
-    The sums run in the order of the BLAS product of :func:`propagate` (each element accumulated
-    over k in turn, fused multiply-add), skipping only exact zeros (of Φ, and of the sensor rows
-    of P: the sensor states the filter does not carry stay uncorrelated with each other), so the
-    envelope stays within rounding of :func:`propagate` over a whole window although P carries
-    the free vertical channel's growth. P (33, 33), D (33,), state units² and state units."""
-    n = P.shape[0]
-    nn = _N_NAV
-    m = n - nn
-    nz = np.empty((m, m), np.int64)            # sensor rows of P: their non-zero sensor columns
-    cnt = np.zeros(m, np.int64)
-    _sensor_nonzeros(P, nn, nz, cnt)
-    C = np.zeros((n, n))
-    for r in range(nn):
-        for p in range(n):
-            a = phi[r, p]
-            if a == 0.0:
-                continue
-            if p < nn:
-                for c in range(n):
-                    C[r, c] += a * P[p, c]
-            else:
-                for c in range(nn):
-                    C[r, c] += a * P[p, c]
-                for k in range(cnt[p - nn]):
-                    c = nz[p - nn, k]
-                    C[r, c] += a * P[p, c]
-    for r in range(nn, n):
-        a = phi[r, r]
-        for c in range(n):
-            C[r, c] = a * P[r, c]
-    Ct = C.T.copy()                            # C Φᵀ with the outputs of one k in a row
-    _sensor_nonzeros(Ct, nn, nz, cnt)          # sensor columns of C: their non-zero sensor rows
-    U = np.zeros((nn, n))
-    for c in range(nn):
-        for p in range(n):
-            b = phi[c, p]
-            if b == 0.0:
-                continue
-            if p < nn:
-                for r in range(n):
-                    U[c, r] += Ct[p, r] * b
-            else:
-                for r in range(nn):
-                    U[c, r] += Ct[p, r] * b
-                for k in range(cnt[p - nn]):
-                    r = nz[p - nn, k]
-                    U[c, r] += Ct[p, r] * b
-    T = np.empty((n, n))
-    for r in range(n):
-        for c in range(nn):
-            T[r, c] = U[c, r] + qk[r, c]
-        for c in range(nn, n):
-            T[r, c] = C[r, c] * phi[c, c] + qk[r, c]
-    for r in range(n):
-        for c in range(r, n):
-            v = 0.5 * (T[r, c] + T[c, r])
-            P[r, c] = v
-            P[c, r] = v
-    dn = np.zeros(nn)
-    for r in range(nn):
-        for p in range(n):
-            dn[r] += phi[r, p] * D[p]
-    for r in range(nn):
-        D[r] = dn[r]
-    for r in range(nn, n):
-        D[r] = phi[r, r] * D[r]
-
-
-@njit(cache=True)
-def _channel_step(x, Pc, z0, z1, r0, r1, q, dt):
-    """:func:`channel_filter_step` for one unit and axis in place, closed form (2×2 inverse):
-    x (2,) [δp m, δV m/s], Pc (2, 2), z0, z1 the measurement, r0, r1 its variances, q the
-    acceleration noise density (m/s²)²·s, dt s."""
-    q00, q01, q11 = q * (dt ** 3 / 3), q * (dt ** 2 / 2), q * dt
-    x0 = x[0] + dt * x[1]
-    x1 = x[1]
-    a00, a01, a10, a11 = Pc[0, 0], Pc[0, 1], Pc[1, 0], Pc[1, 1]
-    b00, b01, b10, b11 = a00 + dt * a10, a01 + dt * a11, a10, a11           # F Pc
-    p00 = b00 + b01 * dt + q00                                              # F Pc Fᵀ + q Qb
-    p01 = b01 + q01
-    p10 = b10 + b11 * dt + q01
-    p11 = b11 + q11
-    s00, s01, s10, s11 = p00 + r0, p01, p10, p11 + r1                     # S = Pc + R
-    det = s00 * s11 - s01 * s10
-    i00, i01, i10, i11 = s11 / det, -s01 / det, -s10 / det, s00 / det
-    k00 = i00 * p00 + i01 * p10            # K = (S⁻¹ Pc)ᵀ
-    k10 = i00 * p01 + i01 * p11
-    k01 = i10 * p00 + i11 * p10
-    k11 = i10 * p01 + i11 * p11
-    v0, v1 = z0 - x0, z1 - x1
-    x[0] = x0 + k00 * v0 + k01 * v1
-    x[1] = x1 + k10 * v0 + k11 * v1
-    a00, a01, a10, a11 = 1.0 - k00, -k01, -k10, 1.0 - k11                  # A = I - K
-    c00 = a00 * p00 + a01 * p10            # A Pc
-    c01 = a00 * p01 + a01 * p11
-    c10 = a10 * p00 + a11 * p10
-    c11 = a10 * p01 + a11 * p11
-    Pc[0, 0] = c00 * a00 + c01 * a01 + (k00 * r0 * k00 + k01 * r1 * k01)  # A Pc Aᵀ + K R Kᵀ
-    Pc[0, 1] = c00 * a10 + c01 * a11 + (k00 * r0 * k10 + k01 * r1 * k11)
-    Pc[1, 0] = c10 * a00 + c11 * a01 + (k10 * r0 * k00 + k11 * r1 * k01)
-    Pc[1, 1] = c10 * a10 + c11 * a11 + (k10 * r0 * k10 + k11 * r1 * k11)
-
-
-@njit(cache=True)
-def _add_feedback(D, feedback):
-    """D[:, :, :m] += feedback (u, m) in every window slot (the free copies' Σ dx)."""
-    for w in range(D.shape[0]):
-        for i in range(feedback.shape[0]):
-            for j in range(feedback.shape[1]):
-                D[w, i, j] += feedback[i, j]
-
-
-@njit(cache=True)
-def _measure_into(z, D, ins, s):
-    """z (u, 2, 2) of :meth:`ReferenceDescriptionMonitor._measure`: free copies (offsets D (u, 33))
-    of the units ``ins`` (u, 5: lat rad, lon rad, alt m, V_E, V_N m/s) against the integrated
-    solution s[0:5] (lat, lon, alt, V_E, V_N); position difference in ENU at the unit (radii of
-    curvature at its latitude, :func:`.ins_filter.enu_difference_m`)."""
-    for i in range(ins.shape[0]):
-        rm, rn = radii_m(ins[i, 0])
-        z[i, 0, 0] = (ins[i, 1] - s[1]) * (rn + ins[i, 2]) * math.cos(ins[i, 0]) + D[i, 0]
-        z[i, 1, 0] = (ins[i, 0] - s[0]) * (rm + ins[i, 2]) + D[i, 1]
-        z[i, 0, 1] = (ins[i, 3] - s[3]) + D[i, 3]
-        z[i, 1, 1] = (ins[i, 4] - s[4]) + D[i, 4]
-
-
-@njit(cache=True)
-def _distance(P, Pc, x):
-    """:func:`normalised_distance` of one unit from its window's P (33, 33), Pc (2, 2, 2), x (2, 2);
-    NaN if any channel is NaN (as ``np.max``)."""
-    best = -np.inf
-    for c in range(4):
-        ax, k = c % 2, c // 2                  # pE, pN, vE, vN
-        st = 3 * k + ax
-        v = abs(x[ax, k]) / math.sqrt(P[st, st] + Pc[ax, k, k])
-        if math.isnan(v):
-            return np.nan
-        if v > best:
-            best = v
-    return best
-
-
-@njit(cache=True)
-def _decide(d, excluded, since, t_s, k_sigma, persist_s):
-    """:func:`reference_decision` on scalars: (used, excluded, since, rank), new arrays."""
-    n = d.size
-    out = d > k_sigma
-    new_since = np.empty(n)
-    new = np.empty(n, np.bool_)
-    for i in range(n):
-        if out[i]:
-            new_since[i] = t_s if math.isnan(since[i]) else since[i]
-        else:
-            new_since[i] = np.nan
-        persisted = out[i] and t_s - new_since[i] >= persist_s - 1e-9
-        new[i] = excluded[i] or persisted
-    rank = np.empty(n, np.int64)               # stable argsort, NaN last (as numpy)
-    for i in range(n):
-        j = i
-        while j > 0:
-            a, b = d[rank[j - 1]], d[i]
-            if not (math.isnan(b) or (not math.isnan(a) and a <= b)):
-                rank[j] = rank[j - 1]
-                j -= 1
-            else:
-                break
-        rank[j] = i
-    all_new = True
-    for i in range(n):
-        all_new = all_new and new[i]
-    if all_new:
-        used = np.zeros(n, np.bool_)
-        used[rank[0]] = True
-        return used, excluded.copy(), new_since, rank
-    return np.logical_not(new), new, new_since, rank
-
-
-@njit(cache=True)
-def _epoch(P, D, X, PC, slots, s, ins, decay, q_psd, model, tol, excluded, since, detected,
-           k_sigma, persist_s, track_tau_s):
-    """One reference epoch (the body of :meth:`ReferenceDescriptionMonitor.update`), compiled.
-
-    P (W, u, 33, 33), D (W, u, 33), X (W, u, 2, 2), PC (W, u, 2, 2, 2): the window slots, updated
-    in place for ``slots`` (oldest first); s: the integrated solution (lat, lon, alt, V (3),
-    roll, pitch, heading), the body rates p, q, r rad/s, specific force (3) m/s², the
-    integrated solution's variances (E p, E v, N p, N v; m², (m/s)²), Δt s and t s; ins (u, 5); decay, q_psd (m, 33) per IMU model, model (u,) each unit's. F at the
-    integrated solution and (Φ, Q_k) once per model (:func:`system_matrix` with a free vertical,
-    :func:`step_discrete` Picard). Returns (status 0 ok, 1 Δt/τ beyond the Picard range, 2 no
-    convergence, 3 Φ not of the block form [[Φ11, Φ12], [0, diag]] — nothing updated then; d, used, excluded, since, rank; notify: a unit newly
-    outside or a change of the latch; all_out: every unit excluded or outside).
-    """
-    n_mod, n = q_psd.shape
-    u = ins.shape[0]
-    dt = s[19]
-    c = _c_bn(s[6], s[7], s[8])
-    lat = s[0]
-    w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(lat), OMEGA_IE_RPS * math.sin(lat)])
-    w_ib = s[9:12] + c.T @ w_ie
-    phis = np.empty((n_mod, n, n))
-    qks = np.empty((n_mod, n, n))
-    d = np.full(u, np.nan)
-    for m in range(n_mod):
-        F = build_F(lat, s[2], s[3:6].copy(), s[12:15].copy(), w_ib, c, decay[m], 0.0, 0.0)
-        rate = 0.0
-        for i in range(n):
-            rate = max(rate, abs(F[i, i]))
-        if rate * dt > PICARD_MAX_RATE_DT:
-            return 1, d, excluded.copy(), excluded.copy(), since.copy(), np.arange(u), False, False
-        phi, qk, _, ok = _picard_sins(F, q_psd[m], dt, tol, PICARD_MAX_ORDER)
-        if not ok:
-            return 2, d, excluded.copy(), excluded.copy(), since.copy(), np.arange(u), False, False
-        for r in range(_N_NAV, n):             # the block form of Φ _propagate_blocks needs
-            for j in range(n):
-                if j != r and phi[r, j] != 0.0:
-                    return 3, d, excluded.copy(), excluded.copy(), since.copy(), np.arange(u), \
-                        False, False
-        phis[m] = phi
-        qks[m] = qk
-    z = np.empty((u, 2, 2))
-    for w in slots:
-        v0 = np.empty((u, 2))
-        for i in range(u):
-            v0[i, 0], v0[i, 1] = P[w, i, 3, 3], P[w, i, 4, 4]
-            _propagate_blocks(P[w, i], D[w, i], phis[model[i]], qks[model[i]])
-        _measure_into(z, D[w], ins, s)
-        for i in range(u):
-            for ax in range(2):
-                q = channel_process_noise(P[w, i, 3 + ax, 3 + ax], v0[i, ax], dt, track_tau_s)
-                _channel_step(X[w, i, ax], PC[w, i, ax], z[i, ax, 0], z[i, ax, 1],
-                              max(s[15 + 2 * ax], 1e-6), max(s[16 + 2 * ax], 1e-6), q, dt)
-    w = slots[0]                                                    # the oldest
-    for i in range(u):
-        d[i] = _distance(P[w, i], PC[w, i], X[w, i])
-    used, exc, since_n, rank = _decide(d, excluded, since, s[20], k_sigma, persist_s)
-    notify, all_out = False, True
-    for i in range(u):
-        notify = notify or (d[i] > k_sigma and not detected[i]) or exc[i] != excluded[i]
-        all_out = all_out and (exc[i] or d[i] > k_sigma)
-    return 0, d, used, exc, since_n, rank, notify, all_out
+def _raise_status(status: int, dt: float) -> None:
+    """The epoch kernel's failures as errors (``status`` of :func:`.reference_kernels._epoch`,
+    ``dt`` the step, s)."""
+    if status == 1:
+        raise DiscretisationError(
+            f"reference description: Picard series not suitable for the envelope step "
+            f"(dt/tau > {PICARD_MAX_RATE_DT}, dt = {dt:g} s); use a smaller step_s")
+    if status == 2:
+        raise DiscretisationError(
+            f"Picard series did not reach tol {_FREE.tol:g} in {PICARD_MAX_ORDER} terms "
+            f"(dt = {dt:g} s)")
+    if status:
+        raise ValueError("reference description: Φ of the SINS model is not of the block form "
+                         "[[Φ11, Φ12], [0, diagonal]] the envelope propagation assumes")
 
 
 @dataclass
@@ -601,46 +326,44 @@ class ReferenceDescriptionMonitor:
         if dt < tn.step_s - 1e-9:
             return []
         self._t_last = t
+        self._fill(truth, ins, out, P_out, dt)
+        status, d, used, excluded, since, rank, notify, all_out = _epoch(
+            self._P, self._D, self._X, self._PC, np.array([w.slot for w in self.windows]),
+            self._s, self._ins, self._decay, self._q_psd, self._model, _FREE.tol, self.excluded,
+            self.since, self._detected, tn.k_sigma, tn.persist_s, tn.track_tau_s)
+        _raise_status(status, dt)
+        was_excluded = self.excluded
+        self.d, self.used, self.excluded, self.since, self.rank = d, used, excluded, since, rank
+        self._restart(t, ins, out, P_out, P_filters)
+        if notify or all_out != self._all_out:
+            return self._events(t, was_excluded)
+        return []
+
+    def _fill(self, truth, ins, out, P_out, dt) -> None:
+        """The epoch kernel's scalars (see :func:`.reference_kernels._epoch`) and unit outputs."""
         s, v, f = self._s, out[3], truth.f_body_mps2
         s[0], s[1], s[2], s[3], s[4], s[5] = out[0], out[1], out[2], v[0], v[1], v[2]
         s[6], s[7], s[8] = out[4], out[5], out[6]
         s[9], s[10], s[11] = truth.p_rps, truth.q_rps, truth.r_rps
         s[12], s[13], s[14] = f[0], f[1], f[2]
         s[15], s[16], s[17], s[18] = P_out[0, 0], P_out[3, 3], P_out[1, 1], P_out[4, 4]
-        s[19], s[20] = dt, t
+        s[19], s[20] = dt, truth.t_s
         a = self._ins
         for i, u in enumerate(ins):
             vu = u.v_enu_mps
             a[i, 0], a[i, 1], a[i, 2], a[i, 3], a[i, 4] = (u.lat_rad, u.lon_rad, u.alt_m,
                                                            vu[0], vu[1])
-        status, d, used, excluded, since, rank, notify, all_out = _epoch(
-            self._P, self._D, self._X, self._PC, np.array([w.slot for w in self.windows]), s, a,
-            self._decay, self._q_psd, self._model, _FREE.tol, self.excluded, self.since,
-            self._detected, tn.k_sigma, tn.persist_s, tn.track_tau_s)
-        if status == 1:
-            raise DiscretisationError(
-                f"reference description: Picard series not suitable for the envelope step "
-                f"(dt/tau > {PICARD_MAX_RATE_DT}, dt = {dt:g} s); use a smaller step_s")
-        if status == 2:
-            raise DiscretisationError(
-                f"Picard series did not reach tol {_FREE.tol:g} in {PICARD_MAX_ORDER} terms "
-                f"(dt = {dt:g} s)")
-        if status:
-            raise ValueError("reference description: Φ of the SINS model is not of the block form "
-                             "[[Φ11, Φ12], [0, diagonal]] the envelope propagation assumes")
-        was_excluded = self.excluded
-        self.d, self.used, self.excluded, self.since, self.rank = d, used, excluded, since, rank
-        # staggered reference epochs: restart the oldest at window_s, open the next in turn
-        w = self.windows[0]
-        if t - w.start_s >= tn.window_s - 1e-9:
+
+    def _restart(self, t, ins, out, P_out, P_filters) -> None:
+        """Staggered reference epochs: restart the oldest at ``window_s``, open the next in
+        turn."""
+        tn = self.tuning
+        if t - self.windows[0].start_s >= tn.window_s - 1e-9:
             self.windows.pop(0)
         last = self.windows[-1].start_s if self.windows else -math.inf
         if not self.windows or (len(self.windows) < tn.n_windows
                                 and t - last >= tn.window_s / tn.n_windows - 1e-9):
             self.windows.append(self._arm(t, ins, out, P_out, P_filters))
-        if notify or all_out != self._all_out:
-            return self._events(t, was_excluded)
-        return []
 
     @staticmethod
     def _r(P_out: np.ndarray) -> np.ndarray:

@@ -211,8 +211,8 @@ def _finish(path, seq, spec, cfg, perf, params, offset: int,
                             descent_gradient_max=perf.descent_rate_max_mps / perf.tas_plan_mps,
                             descent_rate_mps=PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
                             wind=(params.wind_speed_mps, params.wind_from_deg),
-                            start_in_climb=in_missed, cas_plan_mps=cfg.limits.climb_tas_mps,
-                            isa_dev_c=params.isa_dev_c)
+                            start_in_climb=in_missed, cas_plan_mps=cfg.limits.climb_cas_mps,
+                            isa_dev_c=params.isa_dev_c, alt_max_m=perf.alt_plan_max_m)
         if checked.proc_type == "F" and cfg.approach is not None:
             prof = replace(prof, speed=approach_speed_profile(checked, prof, cfg))
         checked = replace(checked, profile=prof)
@@ -225,7 +225,7 @@ def approach_clean_cas_mps(cfg) -> float:
     planned terminal-area speed."""
     from fms_testbed.legs.model import APPROACH_CAS_MPS
 
-    return min(max(APPROACH_CAS_MPS, 1.15 * cfg.limits.cas_min_mps), cfg.limits.climb_tas_mps)
+    return min(max(APPROACH_CAS_MPS, 1.15 * cfg.limits.cas_min_mps), cfg.limits.climb_cas_mps)
 
 
 def approach_speed_profile(path, prof, cfg):

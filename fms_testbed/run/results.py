@@ -93,8 +93,12 @@ class Results:
         return {k: {"path": str(v), "sha256": file_sha256(v)} for k, v in files.items()
                 if v and not str(v).startswith("<")}
 
+    def _input_paths(self) -> list[str]:
+        return [v["path"] for v in self.inputs().values()]
+
     def save(self, out_dir: str | Path, csv: bool = False, plots: bool = True,
-             overwrite: bool = False, command: list[str] | None = None) -> Path:
+             overwrite: bool = False, command: list[str] | None = None,
+             kind: str | None = None) -> Path:
         """Write ``timeseries.parquet``, ``summary.json``, the PNG plots (and ``timeseries.csv``)
         and the tracks for Google Earth/QGIS (``track.geojson``, ``track.kml``: the designed path
         of a procedure flight and the flown 3-D track) into ``out_dir``, atomically
@@ -107,8 +111,11 @@ class Results:
         csv : also write ``timeseries.csv``;  plots : write the PNG figures
         overwrite : replace a folder that holds something other than a testbed run
         command : the command line to record in ``run.json`` (default ``sys.argv``)
+        kind : the kind of run recorded in ``run.json`` (default: the command's word,
+            :func:`~fms_testbed.run.outputs.command_kind`); a previous run of another kind in
+            ``out_dir`` is replaced only with ``overwrite``
         """
-        folder = OutputFolder(out_dir, overwrite)
+        folder = OutputFolder(out_dir, overwrite, kind, self._input_paths())
         try:
             with folder as tmp:
                 self.df.to_parquet(tmp / "timeseries.parquet", index=False)

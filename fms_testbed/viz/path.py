@@ -50,7 +50,30 @@ def plot_path(path: ProcedurePath) -> Figure:
     else:
         fig, ax = subplots(figsize=(9, 8))
         axv = None
-    used = set()
+    used: set[str] = set()
+    _draw_segments(ax, fr, path, used)
+    _label_legs(ax, fr, path)
+    _mark_fixes(ax, fr, path, used)
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.grid(True, alpha=0.3)
+    first = path.legs[0].record.fix if path.legs else None
+    origin = first.ident if first is not None and LEG_TYPES[path.legs[0].path_term].initial \
+        else "start"
+    ax.set_xlabel(f"east of {origin}, NM")
+    ax.set_ylabel(f"north of {origin}, NM")
+    ax.set_title(f"{path.name} — monitor {path.status}, {path.length_m() / NM_M:.1f} NM, "
+                 f"{len(path.legs)} legs\n"
+                 + " ".join(f"{lg.path_term}" for lg in path.legs), fontsize=10)
+    ax.legend(loc="best", fontsize=8)
+    if axv is not None:
+        _profile_panel(axv, path)
+    fig.tight_layout()
+    return fig
+
+
+def _draw_segments(ax, fr: LocalFrame, path: ProcedurePath, used: set[str]) -> None:
+    """Each segment by role (leg, fly-by, join ...) as lines and arcs in NM, arc centres marked;
+    ``used`` collects the legend labels already drawn."""
     for seg in path.segments:
         g = seg.geom
         n = max(2, int(abs(g.sweep_deg) / 3) + 2) if isinstance(g, Arc) else 2
@@ -68,7 +91,10 @@ def plot_path(path: ProcedurePath) -> Figure:
             ax.plot(cx, cy, "+", color="tab:green", ms=9,
                     label=None if "arc centre" in used else "arc centre")
             used.add("arc centre")
-    # leg codes at the middle of each leg's own path
+
+
+def _label_legs(ax, fr: LocalFrame, path: ProcedurePath) -> None:
+    """Each leg's number and path terminator at the middle of its longest own segment."""
     for lg in path.legs:
         segs = [s for s in path.segments if s.leg_index == lg.index and s.role != "flyby"]
         if not segs:
@@ -78,6 +104,10 @@ def plot_path(path: ProcedurePath) -> Figure:
         ax.annotate(f"{lg.index + 1}:{lg.path_term}", (x, y), fontsize=8, color="navy",
                     xytext=(4, 4), textcoords="offset points",
                     bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="navy", alpha=0.7))
+
+
+def _mark_fixes(ax, fr: LocalFrame, path: ProcedurePath, used: set[str]) -> None:
+    """The terminating fixes, fly-by (filled triangle) or fly-over (open circle), named."""
     marked = set()
     for lg in path.legs:
         f = lg.record.fix
@@ -94,21 +124,6 @@ def plot_path(path: ProcedurePath) -> Figure:
                 else ("fly-over fix" if fo else "fly-by fix"))
         used.add("fly-over fix" if fo else "fly-by fix")
         ax.annotate(f.ident, (x, y), fontsize=8, xytext=(5, -10), textcoords="offset points")
-    ax.set_aspect("equal", adjustable="datalim")
-    ax.grid(True, alpha=0.3)
-    first = path.legs[0].record.fix if path.legs else None
-    origin = first.ident if first is not None and LEG_TYPES[path.legs[0].path_term].initial \
-        else "start"
-    ax.set_xlabel(f"east of {origin}, NM")
-    ax.set_ylabel(f"north of {origin}, NM")
-    ax.set_title(f"{path.name} — monitor {path.status}, {path.length_m() / NM_M:.1f} NM, "
-                 f"{len(path.legs)} legs\n"
-                 + " ".join(f"{lg.path_term}" for lg in path.legs), fontsize=10)
-    ax.legend(loc="best", fontsize=8)
-    if axv is not None:
-        _profile_panel(axv, path)
-    fig.tight_layout()
-    return fig
 
 
 def _profile_panel(ax, path: ProcedurePath) -> None:

@@ -116,20 +116,7 @@ def plot_vertical(df, summary, fp) -> Figure:
     if prof is not None:
         ax.plot(np.asarray(prof.along_m) / NM_M, np.asarray(prof.alt_m) / FT_M, "b-o", ms=3,
                 lw=0.9, alpha=0.6, label="planned profile (builder; climbs flown at best rate to the climb top)")
-        for w in prof.windows:
-            x = w.along_m / NM_M
-            lab = w.fix_ident or f"leg {w.leg_index + 1}"
-            if w.lo_m is not None and w.hi_m is not None and abs(w.lo_m - w.hi_m) < 1:
-                ax.plot(x, w.lo_m / FT_M, "kD", ms=7)
-            elif w.lo_m is not None and w.hi_m is not None:
-                ax.vlines(x, w.lo_m / FT_M, w.hi_m / FT_M, colors="k", lw=3)
-            elif w.lo_m is not None:
-                ax.plot(x, w.lo_m / FT_M, "k^", ms=8)
-            else:
-                ax.plot(x, w.hi_m / FT_M, "kv", ms=8)
-            ref = w.lo_m if w.lo_m is not None else w.hi_m
-            ax.annotate(lab, (x, ref / FT_M), fontsize=7, xytext=(3, -12),
-                        textcoords="offset points")
+        _constraint_windows(ax, prof)
     ax.plot([], [], "k^", label="constraint: ▲ at/above  ▼ at/below  ◆ at  | between")
     ax.set_ylabel("altitude, ft")
     ax.grid(alpha=0.3)
@@ -139,22 +126,54 @@ def plot_vertical(df, summary, fp) -> Figure:
     title = (f"{fp.path.name}: vertical profile — {len(cons)} constraints checked, "
              f"{missed} missed")
     if thr.get("crossed"):
-        row = np.searchsorted(df["t_s"].to_numpy(), thr["t_s"])
-        x = df["along_m"].to_numpy()[min(row, len(df) - 1)] / NM_M
-        h_ft = float(np.interp(thr["t_s"], df["t_s"], df["alt_m"])) / FT_M
-        ax.plot(x, h_ft, "g*", ms=12, label=f"threshold {thr['runway']} crossed: "
-                f"{thr['height_ft']:.0f} ft (TCH {thr['tch_ft']}), "
-                f"{thr['path_angle_deg'] if thr['path_angle_deg'] is not None else float('nan'):.2f}°"
-                f" (VPA {thr['vpa_deg']}), {thr['cas_kt']:.0f} kt")
-        title += (f"\nthreshold: CAS − Vapp {thr['cas_minus_vapp_kt']:+.1f} kt, "
-                  f"height − TCH {thr['height_minus_tch_ft']:+.0f} ft, "
-                  f"angle − VPA {thr['path_angle_minus_vpa_deg']:+.2f}°, "
-                  f"{'configured' if thr['configured'] else 'NOT configured'}"
-                  if thr.get("cas_minus_vapp_kt") is not None
-                  and thr.get("height_minus_tch_ft") is not None
-                  and thr.get("path_angle_minus_vpa_deg") is not None else "")
+        title += _threshold_mark(ax, df, thr)
     ax.set_title(title, fontsize=10)
     ax.legend(fontsize=8, loc="best")
+    _speed_panel(ax2, df, summary, prof, s_nm)
+    fig.tight_layout()
+    return fig
+
+
+def _constraint_windows(ax, prof) -> None:
+    """The coded altitude windows of the planned profile, in ft along the path in NM."""
+    for w in prof.windows:
+        x = w.along_m / NM_M
+        lab = w.fix_ident or f"leg {w.leg_index + 1}"
+        if w.lo_m is not None and w.hi_m is not None and abs(w.lo_m - w.hi_m) < 1:
+            ax.plot(x, w.lo_m / FT_M, "kD", ms=7)
+        elif w.lo_m is not None and w.hi_m is not None:
+            ax.vlines(x, w.lo_m / FT_M, w.hi_m / FT_M, colors="k", lw=3)
+        elif w.lo_m is not None:
+            ax.plot(x, w.lo_m / FT_M, "k^", ms=8)
+        else:
+            ax.plot(x, w.hi_m / FT_M, "kv", ms=8)
+        ref = w.lo_m if w.lo_m is not None else w.hi_m
+        ax.annotate(lab, (x, ref / FT_M), fontsize=7, xytext=(3, -12),
+                    textcoords="offset points")
+
+
+def _threshold_mark(ax, df, thr: dict) -> str:
+    """Mark the threshold crossing (height ft, angle deg, CAS kt) on the altitude panel and
+    return the title line with its deviations from TCH, VPA and Vapp ("" when incomplete)."""
+    row = np.searchsorted(df["t_s"].to_numpy(), thr["t_s"])
+    x = df["along_m"].to_numpy()[min(row, len(df) - 1)] / NM_M
+    h_ft = float(np.interp(thr["t_s"], df["t_s"], df["alt_m"])) / FT_M
+    ax.plot(x, h_ft, "g*", ms=12, label=f"threshold {thr['runway']} crossed: "
+            f"{thr['height_ft']:.0f} ft (TCH {thr['tch_ft']}), "
+            f"{thr['path_angle_deg'] if thr['path_angle_deg'] is not None else float('nan'):.2f}°"
+            f" (VPA {thr['vpa_deg']}), {thr['cas_kt']:.0f} kt")
+    return (f"\nthreshold: CAS − Vapp {thr['cas_minus_vapp_kt']:+.1f} kt, "
+            f"height − TCH {thr['height_minus_tch_ft']:+.0f} ft, "
+            f"angle − VPA {thr['path_angle_minus_vpa_deg']:+.2f}°, "
+            f"{'configured' if thr['configured'] else 'NOT configured'}"
+            if thr.get("cas_minus_vapp_kt") is not None
+            and thr.get("height_minus_tch_ft") is not None
+            and thr.get("path_angle_minus_vpa_deg") is not None else "")
+
+
+def _speed_panel(ax2, df, summary, prof, s_nm) -> None:
+    """Flown and planned CAS (kt) along the path, configuration changes and the coded speed
+    limits."""
     ax2.plot(s_nm, df["cas_mps"] / KT_MPS, color="crimson", lw=1.2, label="flown CAS")
     sp = getattr(prof, "speed", None) if prof is not None else None
     if sp is not None:
@@ -175,8 +194,6 @@ def plot_vertical(df, summary, fp) -> Figure:
     ax2.set_xlabel("distance along the path, NM")
     ax2.grid(alpha=0.3)
     ax2.legend(fontsize=8, loc="best")
-    fig.tight_layout()
-    return fig
 
 
 def _config_marks(ax, df, summary) -> None:

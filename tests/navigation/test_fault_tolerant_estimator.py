@@ -7,8 +7,14 @@ import numpy as np
 import pytest
 
 from fms_testbed.navigation import make_source
-from fms_testbed.navigation.fdi import (FdiTuning, adaptive_r, channel_mask, declared_sensor_noise,
-                                        frozen_states, majority, pair_flags, residual_ok)
+from fms_testbed.navigation.fdi import (FdiTuning, channel_mask, declared_sensor_noise,
+                                        frozen_states, majority, residual_ok, switch_components)
+from fms_testbed.navigation.identification.rules import pair_flags as _pair_flags
+
+
+def pair_flags(y, sig, k, mask=None):
+    """Stage 1 of one realisation as ints."""
+    return _pair_flags(y[None], sig[None], k, mask=mask)[0].astype(int)
 from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
 from fms_testbed.sensors.sins.presets import load_imu
 
@@ -44,20 +50,24 @@ def test_residual_ok_is_the_channel_test_per_component():
     assert list(residual_ok(np.array([9.9, -5.1, 14.0]), S, 5.0)) == [True, False, True]
 
 
-def test_adaptive_r_inflates_to_the_innovation_decays_back_and_flags_divergence():
+def test_component_switching_turns_off_the_failed_component_and_flags_divergence():
+    """Seed 001 eq. 7: a_i = 0 for |ν_i| > ε_i — that component's R becomes the artificial
+    noise ζ (switch_noise × R) —, back to 1 when it passes; νᵀν > γ tr(S) is divergence."""
     tune = FdiTuning()
-    R = np.diag([1.0, 1.0, 4.0])
-    hph = np.array([0.5, 0.5, 0.5])
-    scale = np.ones(3)
-    nu = np.array([0.3, 10.0, -1.0])                          # component 2: 10 > 3√1.5
-    scale, div = adaptive_r(scale, nu, np.diag(hph + np.diag(R) * scale), R, tune)
-    np.testing.assert_allclose(scale, [1.0, 100.0 - 0.5, 1.0])
+    S = np.diag([1.0, 1.0, 4.0])
+    R = np.diag([0.5, 0.5, 0.5])
+    nu = np.array([0.3, 10.0, -1.0])                          # component 2: 10 > 5√1
+    scale, div = switch_components(nu, S, np.ones(3), R, tune)
+    np.testing.assert_array_equal(scale, [1.0, tune.switch_noise, 1.0])
+    assert not div                                             # two components pass
+    S_off = S + np.diag((scale - 1.0) * 0.5)                  # the filter's S with ζ
+    scale2, _ = switch_components(nu, S_off, scale, R, tune)  # tested at the nominal S
+    np.testing.assert_array_equal(scale2, scale)              # still off while it fails
+    scale, div = switch_components(np.zeros(3), S_off, scale, R, tune)
+    np.testing.assert_array_equal(scale, [1.0, 1.0, 1.0])
     assert not div
-    scale, div = adaptive_r(scale, np.zeros(3), np.diag(hph + np.diag(R) * scale), R, tune)
-    np.testing.assert_allclose(scale, [1.0, 0.9 * 99.5, 1.0])
-    big = np.array([0.0, 1e3, 0.0])                            # R at its cap cannot explain it
-    scale, div = adaptive_r(scale, big, np.diag(hph + np.diag(R) * scale), R, tune)
-    assert scale[1] == tune.adapt_max and div
+    big = np.full(3, 20.0)                                     # 1200 > 25 × 6
+    assert switch_components(big, S, np.ones(3), R, tune)[1]
 
 
 def test_declared_sensor_noise_is_the_presets_vrw_arw_and_scale_factor_misalignment():
@@ -155,4 +165,4 @@ def test_adaptive_r_rides_out_a_gnss_noise_burst_and_returns_to_nominal():
     assert out[False][0] == 1.0 and out[True][0] > 5.0
     np.testing.assert_allclose(out[True][2], 1.0, atol=1e-3)   # back to nominal after the burst
     assert out[True][1] < out[False][1]                        # the burst pulls it less
-    assert not [e for e in out[True][3] if e["stage"] == "adaptive_r"]
+    assert not [e for e in out[True][3] if e["kind"] == "reset"]

@@ -11,7 +11,7 @@ from fms_testbed.navigation import make_source
 from fms_testbed.navigation.kalman import correct_delayed
 from fms_testbed.navigation.montecarlo import (McConfig, McFault, MonteCarlo, _group_update,
                                                run_chunks)
-from fms_testbed.sensors.gnss import GnssSpec, Interval
+from fms_testbed.sensors.gnss import GnssSpec, Interval, Ramp
 
 
 def test_group_update_is_correct_delayed_member_by_member():
@@ -115,3 +115,76 @@ def test_no_false_exclusion_where_unmodelled_misalignment_once_caused_them():
     r = MonteCarlo(states, cfg, seed=0).run([51, 465, 544])
     assert not np.isfinite(r.t_exclude_s).any(), r.t_exclude_s
     assert not np.isfinite(r.t_detect_s).any(), r.t_detect_s
+
+
+def test_raw_output_voting_keeps_a_drift_the_filters_calibrate_and_drops_a_large_step():
+    """Voting on the free inertial outputs at k_pair √2 σ_free: a drift ×2 on INS 2 stays in
+    the vote (its raw error is inside the declared envelope for minutes), a 100 mg accelerometer
+    step leaves it within the run (10 mg does not within 300 s: the free envelope carries the
+    alignment's heading σ, 150 m/s × δψ of velocity); the NSE of the voted output is logged
+    beside the output's."""
+    states = synthetic_states("manoeuvres", 500.0)
+    mc = MonteCarlo(states, McConfig(), seed=7)
+    drift = mc.run(range(3), McFault("gyro_drift_scale", 2.0, 200.0, 1))
+    step = mc.run(range(3), McFault("accel_bias_step", 100000.0, 200.0, 1, "x"))
+    assert (drift.vote_in[:, 1] > 0.99).all(), drift.vote_in
+    assert (step.vote_in[:, 1] < 0.5).all() and (step.vote_in[:, [0, 2]] > 0.99).all()
+    assert step.hist_vote.sum() == step.hist_gnss.sum() + step.hist_coast.sum()
+
+
+def test_a_gnss_ramp_names_the_gnss_and_no_unit():
+    """Every unit's innovation window failing together, no INS pair disagreeing: table 1 with
+    the GNSS as the odd source out."""
+    ramp = Ramp(Interval(200.0, 1e9), (2.0, 0.0, 0.0))
+    states = synthetic_states("manoeuvres", 260.0)
+    r = MonteCarlo(states, McConfig(gnss=GnssSpec(ramps=(ramp,))), seed=3).run(range(3))
+    assert np.isfinite(r.t_gnss_s).all() and (r.t_gnss_s > 200.0).all()
+    assert (r.t_gnss_s < 215.0).all()
+    assert not np.isfinite(r.t_exclude_s).any() and not np.isfinite(r.t_isolate_s).any()
+
+
+def test_a_failed_vertical_component_holds_the_vertical_states_and_keeps_the_horizontal():
+    """Seed 001's gain zeroing per component: the U component failing its channel test has its
+    gain column zeroed; with no other altitude source (no_alt) the vertical rows too — δh, δV_U
+    keep their prediction although the horizontal components, correlated with them through P,
+    are used. Without the row zeroing the same fix moves δh."""
+    from fms_testbed.navigation.montecarlo import _HOLD_VERTICAL, _channel_update
+
+    rng = np.random.default_rng(1)
+    n = 22
+    A = rng.standard_normal((n, n))
+    P = (A @ A.T + n * np.eye(n))[None]
+    H = np.zeros((3, n))
+    H[:, :3] = np.eye(3)
+    R = 0.25 * np.eye(3)
+    z = np.array([[0.5, -0.4, 80.0]] * 2)                  # U: 80 m, far beyond 5√S
+    out = {}
+    for no_alt in (True, False):
+        x = np.zeros((2, n))
+        Pn, g, nis, dof, used = _channel_update(P.copy(), np.zeros(2, np.int64), x, z, H, R,
+                                                np.zeros((n, n)), 5.0, np.ones(2, bool),
+                                                _HOLD_VERTICAL, 2, np.array([no_alt] * 2))
+        out[no_alt] = (x, Pn[g[0]])
+        assert used.all() and (dof == 2).all()
+    x, Pn = out[True]
+    assert (x[:, [2, 5, 21]] == 0.0).all() and (x[:, :2] != 0.0).all()
+    np.testing.assert_array_equal(Pn[np.ix_([2, 5, 21], [2, 5, 21])],
+                                  P[0][np.ix_([2, 5, 21], [2, 5, 21])])
+    assert (out[False][0][:, [2, 5]] != 0.0).all()          # without the hold: δh, δV_U move
+
+
+def test_component_channels_keep_gnss_horizontal_through_a_vertical_ramp():
+    """Baro named failed (a 100 m step), then a GNSS vertical ramp of 1 m/s: the all-or-nothing
+    gate loses whole fixes and the horizontal coasts; per-component channels keep the
+    horizontal on GNSS with the vertical held, and the GNSS is not named failed."""
+    ramp = Ramp(Interval(100.0, 1e9), (0.0, 0.0, 1.0))
+    states = synthetic_states("manoeuvres", 400.0)
+    base = dict(gnss=GnssSpec(ramps=(ramp,)))
+    fault = McFault("baro_step", 100.0, 40.0)
+    off = MonteCarlo(states, McConfig(**base), seed=5).run(range(2), fault)
+    on = MonteCarlo(states, McConfig(**base, component_channels=True), seed=5).run(range(2),
+                                                                                fault)
+    assert np.isfinite(on.t_baro_s).all() and np.isfinite(off.t_baro_s).all()
+    assert not np.isfinite(on.t_gnss_s).any()
+    assert (on.nse_max_m < 5.0).all(), on.nse_max_m
+    assert (off.nse_max_m > 2.0 * on.nse_max_m).all(), (off.nse_max_m, on.nse_max_m)

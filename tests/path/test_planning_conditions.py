@@ -47,7 +47,7 @@ def test_hold_turns_are_planned_for_the_tas_of_the_day(embedded, b737, dev):
     k, arcs0 = _hold_arcs(base)
     _, arcs = _hold_arcs(day)
     alt = day.path.legs[k].start.alt_m
-    cas = min(b737.limits.climb_tas_mps, 210 * KT_MPS)   # the approach's planned CAS cap
+    cas = min(b737.limits.climb_cas_mps, 210 * KT_MPS)   # the approach's planned CAS cap
     v = cas_to_tas_scalar(max(cas, 1.15 * b737.limits.cas_min_mps), alt, dev)
     assert arcs[0].speed_mps == pytest.approx(v, rel=1e-6)
     g = arcs[0].geom.radius_m * math.tan(math.radians(20.0)) / v ** 2   # the g used

@@ -169,7 +169,7 @@ def test_an_impossible_speed_ends_the_flight_with_a_clear_status(db, tmp_path):
 
     raw = yaml.safe_load((aircraft_dir() / "737.yaml").read_text())
     raw["name"] = "737-slow"
-    raw["limits"]["climb_tas_mps"] = 60.0
+    raw["limits"]["climb_cas_mps"] = 60.0
     raw["limits"]["cas_min_mps"] = 40.0
     raw.pop("approach", None)   # clean throughout: no flaps to slow down with
     p = tmp_path / "737-slow.yaml"

@@ -122,7 +122,6 @@ def discretize(F: np.ndarray, Q: np.ndarray, dt: float, method: str = "picard",
     Q = np.ascontiguousarray(Q, dtype=float)
     if not dt > 0:
         raise DiscretisationError(f"discretize: dt must be > 0 s, got {dt!r}")
-    n = F.shape[0]
     if method == "picard":
         _check_picard_range(F, dt)
         if order is not None and order < 1:
@@ -138,29 +137,42 @@ def discretize(F: np.ndarray, Q: np.ndarray, dt: float, method: str = "picard",
             return phi, qk
         return phi, qk, gam @ np.asarray(B, float)
     if method == "vanloan":
-        A = np.zeros((2 * n, 2 * n))
-        A[:n, :n] = -F
-        A[:n, n:] = Q
-        A[n:, n:] = F.T
-        E = scipy.linalg.expm(A * dt)
-        phi = E[n:, n:].T.copy()
-        qk = phi @ E[:n, n:]
-        qk = 0.5 * (qk + qk.T)
-        if B is None:
-            return phi, qk
-        B = np.asarray(B, float)
-        m = B.shape[1]
-        A2 = np.zeros((n + m, n + m))
-        A2[:n, :n] = F
-        A2[:n, n:] = B
-        return phi, qk, scipy.linalg.expm(A2 * dt)[:n, n:]
+        return _van_loan(F, Q, dt, B)
     if method == "trapezoid":
-        phi = np.eye(n) + F * dt + F @ F * (dt * dt / 2.0)
-        qk = (Q + phi @ Q @ phi.T) * (dt / 2.0)
-        if B is None:
-            return phi, qk
-        return phi, qk, (np.eye(n) * dt + F * (dt * dt / 2.0)) @ np.asarray(B, float)
+        return _trapezoid(F, Q, dt, B)
     raise DiscretisationError(f"discretize: unknown method {method!r}; choose one of {METHODS}")
+
+
+def _van_loan(F, Q, dt, B):
+    """(Φ, Q_k[, B_k]) from the matrix exponential of Van Loan's block matrix
+    [[-F, Q], [0, Fᵀ]] Δt (and of [[F, B], [0, 0]] Δt for B_k)."""
+    n = F.shape[0]
+    A = np.zeros((2 * n, 2 * n))
+    A[:n, :n] = -F
+    A[:n, n:] = Q
+    A[n:, n:] = F.T
+    E = scipy.linalg.expm(A * dt)
+    phi = E[n:, n:].T.copy()
+    qk = phi @ E[:n, n:]
+    qk = 0.5 * (qk + qk.T)
+    if B is None:
+        return phi, qk
+    B = np.asarray(B, float)
+    m = B.shape[1]
+    A2 = np.zeros((n + m, n + m))
+    A2[:n, :n] = F
+    A2[:n, n:] = B
+    return phi, qk, scipy.linalg.expm(A2 * dt)[:n, n:]
+
+
+def _trapezoid(F, Q, dt, B):
+    """(Φ, Q_k[, B_k]) to second order: Φ = I + FΔt + F²Δt²/2, Q_k = (Q + ΦQΦᵀ)Δt/2."""
+    n = F.shape[0]
+    phi = np.eye(n) + F * dt + F @ F * (dt * dt / 2.0)
+    qk = (Q + phi @ Q @ phi.T) * (dt / 2.0)
+    if B is None:
+        return phi, qk
+    return phi, qk, (np.eye(n) * dt + F * (dt * dt / 2.0)) @ np.asarray(B, float)
 
 
 @njit(cache=True)
@@ -179,6 +191,108 @@ def _mm_into(A, B, out):
 
 
 @njit(cache=True)
+def _phi_terms_next(A, C, d, n11, n12, n22, t11, t12, h):
+    """Next Φ series terms in place: N12' = (A N12 + C diag(n22)) h, N11' = A N11 h,
+    N22' = D N22 h."""
+    nn, m = n12.shape
+    _mm_into(A, n12, t12)
+    for r in range(nn):
+        for c in range(m):
+            n12[r, c] = (t12[r, c] + C[r, c] * n22[c]) * h
+    _mm_into(A, n11, t11)
+    for r in range(nn):
+        for c in range(nn):
+            n11[r, c] = t11[r, c] * h
+    for c in range(m):
+        n22[c] = n22[c] * d[c] * h
+
+
+@njit(cache=True)
+def _q_terms_next(A, Ca, da, m11, m12, m22, L, t11, u12, m12t, h):
+    """Next Q_k series terms in place: L = A M11 + C M12ᵀ, M11' = (L + Lᵀ) h,
+    M12' = (A M12 + C M22 + M12 D) h, M22' = 2 D M22 h (noisy sensor columns only)."""
+    nn, na = m12.shape
+    for r in range(na):
+        for c in range(nn):
+            m12t[r, c] = m12[c, r]
+    _mm_into(A, m11, L)
+    _mm_into(Ca, m12t, t11)
+    _mm_into(A, m12, u12)
+    for r in range(nn):
+        for c in range(na):
+            m12[r, c] = (u12[r, c] + Ca[r, c] * m22[c] + m12[r, c] * da[c]) * h
+        for c in range(nn):
+            L[r, c] += t11[r, c]
+    for r in range(nn):
+        for c in range(nn):
+            m11[r, c] = (L[r, c] + L[c, r]) * h
+    for c in range(na):
+        m22[c] = 2.0 * da[c] * m22[c] * h
+
+
+@njit(cache=True)
+def _accumulate(p11, p12, p22, q11, q12, q22, n11, n12, n22, m11, m12, m22, tol):
+    """Add the new terms to the running sums; return the adaptive stop's (largest next Φ term,
+    largest Φ sum, largest next Q_k term, largest Q_k sum, every Q_k diagonal term below tol)."""
+    nn, m = n12.shape
+    na = m12.shape[1]
+    tp = bp = tq = bq = 0.0
+    diag_ok = True
+    for r in range(nn):
+        for c in range(nn):
+            p11[r, c] += n11[r, c]
+            q11[r, c] += m11[r, c]
+            tp = max(tp, abs(n11[r, c]))
+            bp = max(bp, abs(p11[r, c]))
+            tq = max(tq, abs(m11[r, c]))
+            bq = max(bq, abs(q11[r, c]))
+        if abs(m11[r, r]) > tol * abs(q11[r, r]):
+            diag_ok = False
+        for c in range(m):
+            p12[r, c] += n12[r, c]
+            tp = max(tp, abs(n12[r, c]))
+            bp = max(bp, abs(p12[r, c]))
+        for c in range(na):
+            q12[r, c] += m12[r, c]
+            tq = max(tq, abs(m12[r, c]))
+            bq = max(bq, abs(q12[r, c]))
+    for c in range(m):
+        p22[c] += n22[c]
+        tp = max(tp, abs(n22[c]))
+        bp = max(bp, abs(p22[c]))
+    for c in range(na):
+        q22[c] += m22[c]
+        tq = max(tq, abs(m22[c]))
+        bq = max(bq, abs(q22[c]))
+        if abs(m22[c]) > tol * abs(q22[c]):
+            diag_ok = False
+    return tp, bp, tq, bq, diag_ok
+
+
+@njit(cache=True)
+def _assemble(n, act, p11, p12, p22, q11, q12, q22):
+    """Full (Φ, Q_k) from the block sums (Q_k symmetrised on the navigation block)."""
+    nn = p11.shape[0]
+    m = n - nn
+    phi = np.zeros((n, n))
+    qk = np.zeros((n, n))
+    phi[:nn, :nn] = p11
+    phi[:nn, nn:] = p12
+    for r in range(nn):
+        for c in range(nn):
+            qk[r, c] = 0.5 * (q11[r, c] + q11[c, r])
+    for c in range(act.size):
+        j = nn + act[c]
+        qk[j, j] = q22[c]
+        for r in range(nn):
+            qk[r, j] = q12[r, c]
+            qk[j, r] = q12[r, c]
+    for j in range(m):
+        phi[nn + j, nn + j] = p22[j]
+    return phi, qk
+
+
+@njit(cache=True)
 def _picard_sins(F, q_diag, dt, tol, max_order):
     """Block-structured adaptive Picard for the SINS model (same series as :func:`_picard`).
 
@@ -187,7 +301,7 @@ def _picard_sins(F, q_diag, dt, tol, max_order):
     N22' = D N22; M11' = (A M11 + C M12ᵀ) + (·)ᵀ, M12' = A M12 + C M22 + M12 D, M22' = 2 D M22.
     A sensor state without process noise (q = 0: the run-to-run constants) keeps its M12 column
     and M22 entry at exactly zero through the series, so the Q_k terms are carried for the noisy
-    sensor states only (the result is the same to the last bit; 6 of 24 columns for the presets).
+    sensor states only (the result is the same to the last bit).
     Returns (Φ, Q_k, ν, converged).
     """
     n = F.shape[0]
@@ -223,84 +337,15 @@ def _picard_sins(F, q_diag, dt, tol, max_order):
     while i < max_order:
         k = i + 1
         h = dt / k
-        # Φ terms: N12' = A N12 + C diag(n22), N11' = A N11, N22' = D N22
-        _mm_into(A, n12, t12)
-        for r in range(nn):
-            for c in range(m):
-                n12[r, c] = (t12[r, c] + C[r, c] * n22[c]) * h
-        _mm_into(A, n11, t11)
-        for r in range(nn):
-            for c in range(nn):
-                n11[r, c] = t11[r, c] * h
-        for c in range(m):
-            n22[c] = n22[c] * d[c] * h
-        # Q_k terms: L = A M11 + C M12ᵀ, M11' = L + Lᵀ, M12' = A M12 + C M22 + M12 D
-        for r in range(na):
-            for c in range(nn):
-                m12t[r, c] = m12[c, r]
-        _mm_into(A, m11, L)
-        _mm_into(Ca, m12t, t11)
-        _mm_into(A, m12, u12)
-        for r in range(nn):
-            for c in range(na):
-                m12[r, c] = (u12[r, c] + Ca[r, c] * m22[c] + m12[r, c] * da[c]) * h
-            for c in range(nn):
-                L[r, c] += t11[r, c]
-        for r in range(nn):
-            for c in range(nn):
-                m11[r, c] = (L[r, c] + L[c, r]) * h
-        for c in range(na):
-            m22[c] = 2.0 * da[c] * m22[c] * h
-        # accumulate; track the next-term / sum sizes for the adaptive stop
-        tp = bp = tq = bq = 0.0
-        diag_ok = True
-        for r in range(nn):
-            for c in range(nn):
-                p11[r, c] += n11[r, c]
-                q11[r, c] += m11[r, c]
-                tp = max(tp, abs(n11[r, c]))
-                bp = max(bp, abs(p11[r, c]))
-                tq = max(tq, abs(m11[r, c]))
-                bq = max(bq, abs(q11[r, c]))
-            if abs(m11[r, r]) > tol * abs(q11[r, r]):
-                diag_ok = False
-            for c in range(m):
-                p12[r, c] += n12[r, c]
-                tp = max(tp, abs(n12[r, c]))
-                bp = max(bp, abs(p12[r, c]))
-            for c in range(na):
-                q12[r, c] += m12[r, c]
-                tq = max(tq, abs(m12[r, c]))
-                bq = max(bq, abs(q12[r, c]))
-        for c in range(m):
-            p22[c] += n22[c]
-            tp = max(tp, abs(n22[c]))
-            bp = max(bp, abs(p22[c]))
-        for c in range(na):
-            q22[c] += m22[c]
-            tq = max(tq, abs(m22[c]))
-            bq = max(bq, abs(q22[c]))
-            if abs(m22[c]) > tol * abs(q22[c]):
-                diag_ok = False
+        _phi_terms_next(A, C, d, n11, n12, n22, t11, t12, h)
+        _q_terms_next(A, Ca, da, m11, m12, m22, L, t11, u12, m12t, h)
+        tp, bp, tq, bq, diag_ok = _accumulate(p11, p12, p22, q11, q12, q22,
+                                              n11, n12, n22, m11, m12, m22, tol)
         i = k
         if i >= 2 and tp <= tol * bp and tq <= tol * bq and diag_ok:
             ok = True
             break
-    phi = np.zeros((n, n))
-    qk = np.zeros((n, n))
-    phi[:nn, :nn] = p11
-    phi[:nn, nn:] = p12
-    for r in range(nn):
-        for c in range(nn):
-            qk[r, c] = 0.5 * (q11[r, c] + q11[c, r])
-    for c in range(na):
-        j = nn + act[c]
-        qk[j, j] = q22[c]
-        for r in range(nn):
-            qk[r, j] = q12[r, c]
-            qk[j, r] = q12[r, c]
-    for j in range(m):
-        phi[nn + j, nn + j] = p22[j]
+    phi, qk = _assemble(n, act, p11, p12, p22, q11, q12, q22)
     return phi, qk, i, ok
 
 

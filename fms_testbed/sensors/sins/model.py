@@ -82,24 +82,27 @@ def _skew_into(out, r0, c0, v, sign):
 
 
 @njit(cache=True)
-def build_F(lat_rad, alt_m, v_enu_mps, f_b_mps2, w_ib_b_rps, c_bn, decay_rps, k1_rps, k2_rps2):
-    """System matrix F (33×33) of the SINS error model at one true state (paper eq. 6.7, 5.1-5.6).
+def _metres_maps(s, c, mh, nh, drm, drn, lat_dot, h_dot):
+    """T (δp = T δr_geo: geodetic errors to metres E, N, U), T⁻¹ and dT/dt, for the
+    meridian/normal radii ``mh``, ``nh`` (m, height included) and their latitude derivatives."""
+    T = np.zeros((3, 3))
+    T[0, 1] = nh * c
+    T[1, 0] = mh
+    T[2, 2] = 1.0
+    Ti = np.zeros((3, 3))
+    Ti[0, 1] = 1.0 / mh
+    Ti[1, 0] = 1.0 / (nh * c)
+    Ti[2, 2] = 1.0
+    Td = np.zeros((3, 3))
+    Td[0, 1] = (drn * lat_dot + h_dot) * c - nh * s * lat_dot
+    Td[1, 0] = drm * lat_dot + h_dot
+    return T, Ti, Td
 
-    Parameters
-    ----------
-    lat_rad, alt_m : true geodetic latitude (rad) and height (m).
-    v_enu_mps : (3,) true velocity E, N, U, m/s.
-    f_b_mps2 : (3,) true specific force in body FRD, m/s².
-    w_ib_b_rps : (3,) true inertial angular rate in body FRD, rad/s.
-    c_bn : (3, 3) C_B^N, body FRD → ENU.
-    decay_rps : (24,) 1/τ of the sensor states 9..32 (0 for random walk/constant), 1/s.
-    k1_rps, k2_rps2 : baro damping gains of the vertical channel (0, 0 = free), 1/s and 1/s².
 
-    Returns
-    -------
-    F : (33, 33) array, 1/s in the units of the state vector.
-    """
-    F = np.zeros((33, 33))
+@njit(cache=True)
+def _navigation_blocks(F, lat_rad, alt_m, v_enu_mps, f_b_mps2, c_bn):
+    """Rows 0-8 (position m, velocity ENU m/s, attitude rad) of F, columns 0-8, in place
+    (paper eq. 5.1-5.4 with δp = T δr_geo)."""
     vE, vN, vU = v_enu_mps[0], v_enu_mps[1], v_enu_mps[2]
     s, c = math.sin(lat_rad), math.cos(lat_rad)
     t = s / c
@@ -137,19 +140,7 @@ def build_F(lat_rad, alt_m, v_enu_mps, f_b_mps2, w_ib_b_rps, c_bn, decay_rps, k1
     fvr[2, 0] += dg_dlat
     fvr[2, 2] += dg_dh
     fer = die + den
-    # --- metres: δp = T δr_geo ---
-    lat_dot, h_dot = vN / mh, vU
-    T = np.zeros((3, 3))
-    T[0, 1] = nh * c
-    T[1, 0] = mh
-    T[2, 2] = 1.0
-    Ti = np.zeros((3, 3))
-    Ti[0, 1] = 1.0 / mh
-    Ti[1, 0] = 1.0 / (nh * c)
-    Ti[2, 2] = 1.0
-    Td = np.zeros((3, 3))
-    Td[0, 1] = (drn * lat_dot + h_dot) * c - nh * s * lat_dot
-    Td[1, 0] = drm * lat_dot + h_dot
+    T, Ti, Td = _metres_maps(s, c, mh, nh, drm, drn, vN / mh, vU)  # δp = T δr_geo
     F[0:3, 0:3] = T @ frr @ Ti + Td @ Ti
     F[0, 3] = 1.0
     F[1, 4] = 1.0
@@ -162,8 +153,14 @@ def build_F(lat_rad, alt_m, v_enu_mps, f_b_mps2, w_ib_b_rps, c_bn, decay_rps, k1
     F[6:9, 0:3] = fer @ Ti
     F[6:9, 3:6] = dev
     _skew_into(F, 6, 6, w_in, -1.0)
+
+
+@njit(cache=True)
+def _sensor_blocks(F, a, w, c_bn, decay_rps):
+    """Sensor-error columns 9-32 of F in place: accelerometer bias, gyro drift, scale factors,
+    misalignments driven by the specific force ``a`` (m/s²) and rate ``w`` (rad/s) in body
+    axes, and the Gauss-Markov decays on the diagonal (paper eq. 5.5-5.6)."""
     # --- sensor errors ---
-    a, w = f_b_mps2, w_ib_b_rps
     for i in range(3):
         for j in range(3):
             F[3 + i, 9 + j] = c_bn[i, j]
@@ -185,6 +182,29 @@ def build_F(lat_rad, alt_m, v_enu_mps, f_b_mps2, w_ib_b_rps, c_bn, decay_rps, k1
         F[6 + i, 32] = -c_bn[i, 2] * w[1]
     for k in range(24):
         F[9 + k, 9 + k] = -decay_rps[k]
+
+
+@njit(cache=True)
+def build_F(lat_rad, alt_m, v_enu_mps, f_b_mps2, w_ib_b_rps, c_bn, decay_rps, k1_rps, k2_rps2):
+    """System matrix F (33×33) of the SINS error model at one true state (paper eq. 6.7, 5.1-5.6).
+
+    Parameters
+    ----------
+    lat_rad, alt_m : true geodetic latitude (rad) and height (m).
+    v_enu_mps : (3,) true velocity E, N, U, m/s.
+    f_b_mps2 : (3,) true specific force in body FRD, m/s².
+    w_ib_b_rps : (3,) true inertial angular rate in body FRD, rad/s.
+    c_bn : (3, 3) C_B^N, body FRD → ENU.
+    decay_rps : (24,) 1/τ of the sensor states 9..32 (0 for random walk/constant), 1/s.
+    k1_rps, k2_rps2 : baro damping gains of the vertical channel (0, 0 = free), 1/s and 1/s².
+
+    Returns
+    -------
+    F : (33, 33) array, 1/s in the units of the state vector.
+    """
+    F = np.zeros((33, 33))
+    _navigation_blocks(F, lat_rad, alt_m, v_enu_mps, f_b_mps2, c_bn)
+    _sensor_blocks(F, f_b_mps2, w_ib_b_rps, c_bn, decay_rps)
     # --- optional baro damping of the vertical channel (reference height error taken as 0) ---
     F[2, 2] -= k1_rps
     F[5, 2] -= k2_rps2
