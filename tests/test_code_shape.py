@@ -36,6 +36,9 @@ CHECKED = (
     "evaluation/envelope_points.py", "evaluation/envelope_tuning.py",
     "evaluation/linear_check.py", "evaluation/law_tuning.py", "cli/coupled.py", "cli/inner.py",
     "cli/tune_envelope.py",
+    "navigation/ins_filter.py", "navigation/prediction.py", "navigation/measurements.py",
+    "navigation/replay.py", "navigation/replay_io.py", "navigation/recording.py",
+    "navigation/strapdown_sins.py", "cli/nav_replay.py", "viz/replay.py",
 )
 """Modules (or folders, ending in '/') whose shape is enforced, relative to the package."""
 

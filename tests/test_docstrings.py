@@ -41,6 +41,10 @@ MODULES = [
     "navigation.identification.rules", "navigation.identification.sensor",
     "navigation.identification.two_stage", "navigation.identification.tuning",
     "navigation.fdi", "evaluation.detection_limit",
+    # the INS/GNSS filter on measurements and its replay
+    "navigation.measurements", "navigation.replay", "navigation.replay_io",
+    "navigation.recording", "navigation.strapdown_sins", "navigation.prediction",
+    "cli.nav_replay", "viz.replay", "sensors.gnss",
 ]
 #: Parameter names that are self-explanatory in a CLI handler (argparse namespace, sub-parsers).
 CLI_NAMES = ("args", "sub", "subparsers", "res")

@@ -13,7 +13,6 @@ row) and exit 2.
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 

@@ -151,6 +151,9 @@ class Flight:
         where = scn.source_file or scn.name or "scenario"
         try:
             source = make_source(spec, seed=seed)
+            install = getattr(source, "install_imu", None)
+            if install is not None:                  # a strapdown IMU off the CG
+                install(self.cfg.imu_lever_arm_m)
             for ev in scn.events:
                 if ev.fault:
                     source.check_fault(ev.fault.model_dump(exclude_none=True))

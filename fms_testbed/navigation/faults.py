@@ -48,7 +48,10 @@ def inject(source, fault: dict, t_s: float) -> dict:
     check_fault(fault, len(source.bank), source.baro is not None)
     kind, unit = fault["kind"], fault["unit"]
     end = t_s + fault["duration_s"] if "duration_s" in fault else math.inf
-    if unit.startswith("ins"):
+    if unit.startswith("ins") and hasattr(source.bank, "inject"):
+        # a strapdown bank applies the fault to the unit's IMU itself
+        what = source.bank.inject(int(unit[3:]) - 1, fault)
+    elif unit.startswith("ins"):
         i = int(unit[3:]) - 1
         u = source.bank.units[i]
         if kind == "gyro_bias_step":

@@ -53,8 +53,8 @@ from fms_testbed.navigation.faults import check_fault, inject
 from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
                                         TwoStageFdi,
                                         channel_sigmas, declared_sensor_noise)
-from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter,
-                                               PredictionInterval, _w_eb, can_share_prediction)
+from fms_testbed.navigation.ins_filter import FilterTuning, GroupResult, InsGnssFilter, _w_eb
+from fms_testbed.navigation.prediction import PredictionInterval, can_share_prediction
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
 from fms_testbed.navigation.recording import SensorRecorder
 from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor
@@ -248,6 +248,13 @@ class InsGnssNavigation(NavigationSourceBase):
             src.refdesc = ReferenceDescriptionMonitor([f.imu for f in filters])
         return src
 
+    def install_imu(self, lever_arm_m) -> None:
+        """The IMU's position from the CG (the aircraft file's ``imu_lever_arm_m``, body axes,
+        m), set before the first update; the linear model has none."""
+        if isinstance(self.bank, StrapdownBank):
+            self.bank.set_lever_arm(lever_arm_m)
+            self.frame_properties = tuple(self.bank.frame_properties)
+
     # -- faults ----------------------------------------------------------------------------
     def check_fault(self, fault: dict) -> None:
         """Raise ConfigError when a scenario fault names a unit this source does not have."""
@@ -284,7 +291,7 @@ class InsGnssNavigation(NavigationSourceBase):
                  boundary: bool) -> None:
         """Propagate the filters over the step from ``prev`` to ``truth`` (``ins``: the INS
         outputs at its end): added to the current interval
-        (:class:`~.ins_filter.PredictionInterval`), which is discretised and applied when
+        (:class:`~.prediction.PredictionInterval`), which is discretised and applied when
         ``boundary`` (a measurement now, or a GNSS epoch: the delayed correction needs a step
         boundary at a fix's time of validity) or when it has reached
         ``filter.predict_interval_s``; every step and one filter at a time (F at the step's

@@ -41,6 +41,12 @@ class StrapdownSinsNavigation(NavigationSourceBase):
         self.frame_properties = tuple(bank.frame_properties)
         self._t_prev: float | None = None
 
+    def install_imu(self, lever_arm_m) -> None:
+        """The IMU's position from the CG (the aircraft file's ``imu_lever_arm_m``, body axes,
+        m), set before the first update."""
+        self.bank.set_lever_arm(lever_arm_m)
+        self.frame_properties = tuple(self.bank.frame_properties)
+
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "StrapdownSinsNavigation":
         """Build from a ``sins`` block with ``truth_model: strapdown`` (``spec['seed']`` wins).

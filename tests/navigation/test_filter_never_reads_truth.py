@@ -13,7 +13,7 @@ import pytest
 
 from fms_testbed.cli.nav_replay import replay_files
 from fms_testbed.core.earth import ellipsoidal_height_m, radii_m
-from fms_testbed.navigation import ins_filter
+from fms_testbed.navigation import ins_filter, prediction
 from fms_testbed.run.api import run_scenario
 from tests.guidance.test_guidance_never_reads_truth import TruthRead, truth_poisoned
 
@@ -24,7 +24,7 @@ SCN = {"aircraft": "737", "duration_s": 150, "hold": True, "vertical_law": "coup
 _FILTER_METHODS = [(ins_filter.InsGnssFilter, m) for m in
                    ("initialise", "predict", "use", "gnss_update", "baro_update",
                     "take_feedback")] + \
-    [(ins_filter.PredictionInterval, m) for m in ("start", "add", "flush")]
+    [(prediction.PredictionInterval, m) for m in ("start", "add", "flush")]
 
 
 def _poisoned(fn):

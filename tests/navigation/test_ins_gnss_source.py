@@ -112,3 +112,21 @@ def test_profile_is_kinematically_consistent():
     # body z specific force ≈ -g / cos(roll) in a coordinated turn
     assert tr.f_b_mps2[k, 2] == pytest.approx(-9.80665 / math.cos(roll), rel=0.01)
     assert abs(tr.f_b_mps2[k, 1]) < 0.05
+
+
+def test_the_aircraft_files_imu_lever_arm_reaches_the_strapdown_bank():
+    from fms_testbed.config.aircraft import load_aircraft
+    from fms_testbed.config.scenario import parse_scenario
+    from fms_testbed.loop.flight import Flight
+    cfg = load_aircraft("737").model_copy(update={"imu_lever_arm_m": (8.0, 0.0, 1.5)})
+    scn = parse_scenario({"aircraft": "737", "duration_s": 5, "hold": True,
+                          "initial": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 3000,
+                                      "tas_kmh": 400, "heading_deg": 90},
+                          "navigation": {"source": "ins_gnss", "imu": "STIM300"}})
+    fl = Flight(scn, cfg=cfg, progress=False)
+    bank = fl.navigation.bank
+    assert np.array_equal(bank.lever, [8.0, 0.0, 1.5]) and bank.use_rates
+    assert len(fl.navigation.frame_properties) == 9        # rates sampled for the lever arm
+    fl.run()
+    e = bank.errors(0)
+    assert math.hypot(e[0], e[1]) < 5.0                    # output at the CG, not 8 m off

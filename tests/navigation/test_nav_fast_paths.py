@@ -3,7 +3,7 @@
 - One discretisation of the truth model shared by the INS units (``InsBank(share=True)``) and
   the compiled raw-sensor errors give the numbers of the per-unit paths (1e-12 relative;
   measured bitwise equal).
-- The multi-rate prediction (``ins_filter.PredictionInterval``: one F for the three filters at
+- The multi-rate prediction (``prediction.PredictionInterval``: one F for the three filters at
   the mean of their units' states, intervals ending at every GNSS epoch and baro reading, after
   ``predict_interval_s`` or ``predict_rotation_deg`` of body rotation) follows the per-step,
   per-filter prediction: the same fixes used (each at the filters' time, its time of validity,
@@ -17,7 +17,7 @@ import numpy as np
 from fms_testbed.navigation import make_source
 from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
 
-SPEC = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}
+SPEC = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 3, "truth_model": "linear"}
 
 
 def _states():
