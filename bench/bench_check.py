@@ -40,6 +40,9 @@ def markdown(summary: dict, table: pd.DataFrame, cmd: str, wall_s: float) -> str
              ["turns against the coded direction", f"{summary['turn_mismatches']}"],
              ["leg types present but never built",
               ", ".join(summary["leg_types_present_not_built"]) or "none"],
+             ["class 3 (database coding) found", f"{summary['class3_transitions']:,}"],
+             ["highest planned altitude, TAS",
+              f"{table['max_plan_alt_ft'].max():,.0f} ft, {table['max_plan_tas_kt'].max():.0f} kt"],
              ["wall time, workers", f"{wall_s:.1f} s, {summary['workers']}"]]
     legs = [[pt, f"{v['coded']:,}", f"{v['built']:,}"]
             for pt, v in summary["by_leg_type"].items() if v["coded"]]
@@ -60,24 +63,29 @@ def markdown(summary: dict, table: pd.DataFrame, cmd: str, wall_s: float) -> str
     return "\n".join(out)
 
 
-def main() -> int:
+def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--db", default=str(report.CIFP),
                     help="ARINC-424 file (default: the FAA CIFP beside the repository)")
     ap.add_argument("--aircraft", default="737")
     ap.add_argument("--workers", type=int, default=1)
+    ap.add_argument("--airports", nargs="*", default=None, help="only these (quick mode)")
     ap.add_argument("--md", default="cifp_check.md",
                     help="Markdown table in docs/results/ ('' to skip)")
-    args = ap.parse_args()
+    args = ap.parse_args(argv)
     if not Path(args.db).exists():
         raise SystemExit(f"{args.db}: no such ARINC-424 file (give --db)")
     with tempfile.TemporaryDirectory() as tmp:
         argv = ["procedures", "check", "--db", args.db, "--aircraft", args.aircraft,
                 "--workers", str(args.workers), "--no-progress", "--out", tmp]
+        if args.airports:
+            argv += ["--airports", *args.airports]
         _, wall, stdout = report.run_cli(argv, expect=Path(tmp) / "summary.json")
         print(stdout)
         summary = json.loads((Path(tmp) / "summary.json").read_text())
         table = pd.read_csv(Path(tmp) / "procedures_check.csv", keep_default_na=False)
+    report.refuse_degenerate(summary["by_status"], headline=summary["ok_or_corrected_pct"],
+                             what="procedures check")
     cmd = (f"fms-testbed procedures check --db {Path(args.db).name} --aircraft {args.aircraft} "
            f"--workers {args.workers} --no-progress --out DIR")
     report.write(args.md, markdown(summary, table, cmd, wall),

@@ -67,13 +67,62 @@ def table(header: Sequence[str], rows: Iterable[Sequence]) -> str:
     return "\n".join(out)
 
 
+class DegenerateRun(SystemExit):
+    """A bench run whose outcome cannot be published (:func:`refuse_degenerate`)."""
+
+
+def refuse_degenerate(outcomes=None, headline: float | None = None, what: str = "run",
+                      bad: Sequence[str] = ("impossible", "error", "timeout",
+                                            "internal-error")) -> None:
+    """The one guard of every bench: stop (exit with the reason, no page written) when the run
+    is degenerate — no outcome at all (no transitions, no flights), every outcome a failure
+    (``bad``: everything ``impossible``), or a headline figure that is NaN or infinite.
+
+    Parameters
+    ----------
+    outcomes : mapping outcome → count (statuses of the transitions or flights), or None
+    headline : the figure the page leads with (a ratio, a time, a rate), or None
+    what : what ran, for the message
+    bad : the outcomes that count as failures
+    """
+    import math
+
+    if outcomes is not None:
+        n = sum(outcomes.values())
+        if n == 0:
+            raise DegenerateRun(f"{what}: no outcome at all (nothing ran): no page written")
+        if sum(v for k, v in outcomes.items() if k in bad) == n:
+            raise DegenerateRun(f"{what}: every one of its {n} outcomes is a failure "
+                                f"({dict(outcomes)}): no page written")
+    if headline is not None and not math.isfinite(headline):
+        raise DegenerateRun(f"{what}: the headline figure is {headline}: no page written")
+
+
+def _nan_cells(body: str) -> list[str]:
+    """Table rows of ``body`` with a cell that is NaN (a figure that was not measured)."""
+    out = []
+    for line in body.splitlines():
+        if line.startswith("|"):
+            cells = [c.strip().strip("*").lower() for c in line.strip("|").split("|")]
+            if any(c in ("nan", "nan %", "nan s", "nan x", "nan ×") or c.startswith("nan ")
+                   for c in cells):
+                out.append(line)
+    return out
+
+
 def write(name: str | Path | None, body: str, note: str = "") -> Path | None:
     """Write ``docs/results/NAME`` (or the given path): provenance lines, then ``body``.
 
-    ``name`` None or empty: write nothing (``--md ''`` on a bench's command line).
+    ``name`` None or empty: write nothing (``--md ''`` on a bench's command line). A body
+    with a NaN figure in a table is refused (:class:`DegenerateRun`): every bench writes
+    through here, so none publishes a figure it did not measure.
     """
     if not name:
         return None
+    bad = _nan_cells(body)
+    if bad:
+        raise DegenerateRun(f"{name}: {len(bad)} table row(s) with a NaN figure, e.g. "
+                            f"{bad[0][:120]!r}: no page written")
     path = Path(name)
     if not path.is_absolute() and path.parent == Path("."):
         path = RESULTS / path

@@ -13,6 +13,9 @@ MODULES = [
     # the coupled law and its studies
     "control.coupled_law", "control.baselines", "control.pointmass", "control.linear",
     "control.metrics", "evaluation.law_tuning", "evaluation.law_comparison", "viz.control",
+    # envelope tuning
+    "sim.linearise", "control.loops", "control.schedule", "evaluation.envelope_points",
+    "evaluation.envelope_tuning", "evaluation.linear_check", "viz.tuning", "cli.tune_envelope",
     # MEMS gyro drift
     "sensors.mems.preset", "sensors.mems.temperature", "sensors.mems.model",
     "sensors.mems.compensation", "sensors.mems.allan", "sensors.mems.static_test",
@@ -24,7 +27,7 @@ MODULES = [
     "procedures.index", "campaign.cases", "campaign.conditions", "campaign.rows",
     "campaign.worker", "campaign.executors", "campaign.store", "campaign.runner",
     "campaign.diff", "campaign.report", "campaign.figures", "cli.regress",
-    "procedures.testdb", "campaign.manifest",
+    "procedures.testdb", "campaign.manifest", "campaign.audit", "evaluation.navigation_truth",
     # the strapdown IMU and INS
     "sensors.imu.kinematics", "sensors.imu.synthesis", "sensors.imu.errors",
     "navigation.bank", "navigation.inertial.strapdown", "navigation.inertial.alignment",

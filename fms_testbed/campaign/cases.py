@@ -15,9 +15,12 @@ Order: airports sorted, then SIDs, STARs, approaches, each by ident, then the se
 above, then aircraft and condition sets in the order given; ``--limit`` keeps the first cases.
 
 Case id: the first 16 hex digits of a SHA-256 over the airport, type, procedure, runway and
-transition idents, the *records* (:attr:`Case.records_sha256`: the digests of every file line the
-sequence uses — its procedure records, in flying order, then the records of every fix, navaid,
-RF centre, runway and airport reference point they name), the aircraft name and file's SHA-256,
+transition idents, the *records* (:attr:`Case.records_sha256`: the content digests of every file
+line the sequence uses — its procedure records, in flying order, then the records of every fix,
+navaid, RF centre, runway and airport reference point they name, sorted by digest — each without
+its file record number, columns 124-128:
+:func:`~fms_testbed.procedures.index.record_content`; where a record sits in the file changes no
+id, what it says does), the aircraft name and file's SHA-256,
 the condition set (canonical JSON) and the campaign seed. The per-case seed
 (:func:`case_seed`) comes from the case id alone, so a case flies the same on any worker, in any
 order, in any run.
@@ -195,7 +198,15 @@ def records_sha256(index: DatabaseIndex, seqs: list, runway: str, transition: st
     """
     s0 = seqs[0]
     parts = _parts(index.db, s0.airport, s0.proc_id, runway, transition, seqs)
-    return index.record_digest(used_lines(index.db, parts))
+    lines = used_lines(index.db, parts)
+    n_proc = sum(len(p.lines) for p in parts)
+    d = index.line_digests
+    own = np.asarray([n - 1 for n in lines[:n_proc] if n > 0], dtype=np.int64)
+    refs = np.asarray([n - 1 for n in lines[n_proc:] if 0 < n <= d.size], dtype=np.int64)
+    if own.size and own.max() >= d.size:
+        raise ValueError(f"{index.path}: line {int(own.max()) + 1} beyond the file's "
+                         f"{d.size} lines")
+    return hashlib.sha256(np.concatenate([d[own], np.sort(d[refs])]).tobytes()).hexdigest()
 
 
 def make_case(seqs: list, runway: str, transition: str, records: str, aircraft: str,

@@ -37,7 +37,6 @@ import numpy as np
 import pandas as pd
 
 from fms_testbed.campaign.rows import ERROR_COLUMNS
-from fms_testbed.campaign.store import read_flights
 from fms_testbed.config.yamlfile import read_mapping
 from fms_testbed.core.errors import ConfigError, UserError
 
@@ -246,7 +245,9 @@ def diff_frames(a: pd.DataFrame, b: pd.DataFrame, tolerances: dict | None = None
 
 def diff_runs(run_a: str | Path, run_b: str | Path, tolerances: dict | None = None,
               across_conditions: bool = False) -> DiffResult:
-    """Compare the ``flights/`` datasets of two campaign folders (module docstring).
+    """Compare the ``flights/`` datasets of two campaign folders (module docstring); a folder
+    with a damaged part file is refused in one line naming the file and the cases
+    (:func:`~.audit.read_checked`).
 
     Parameters
     ----------
@@ -254,8 +255,11 @@ def diff_runs(run_a: str | Path, run_b: str | Path, tolerances: dict | None = No
     tolerances : per compared column ``{abs, rel}`` (default :data:`DEFAULT_TOLERANCES`)
     across_conditions : match cases without their condition set (:data:`KEY_ACROSS`)
     """
-    return diff_frames(read_flights(run_a), read_flights(run_b), tolerances,
-                       (str(run_a), str(run_b)), KEY_ACROSS if across_conditions else KEY)
+    from fms_testbed.campaign.audit import read_checked
+
+    a, b = (read_checked(r, refuse_damage=True)[0] for r in (run_a, run_b))
+    return diff_frames(a, b, tolerances, (str(run_a), str(run_b)),
+                       KEY_ACROSS if across_conditions else KEY)
 
 
 __all__ = ["COMPARED", "DEFAULT_TOLERANCES", "KEY", "KEY_ACROSS", "DiffResult", "beyond",

@@ -42,6 +42,8 @@ WINDOW_PER_WORKER = 2
 """Cases in flight per local worker (one flying, one queued: the worker never waits)."""
 DASK_CHUNK = 1000
 """Futures held at a time on a Dask cluster (dask/distributed #3898, #4345)."""
+CONNECT_TIMEOUT_S = 5.0
+"""How long ``--scheduler`` waits for the scheduler to answer, s."""
 
 OnRow = Callable[[dict], None]
 
@@ -133,8 +135,81 @@ def _probe_db(path: str, sha: str) -> str:
     return f"{path} has SHA-256 {got[:12]}…, the campaign's is {sha[:12]}…"
 
 
+def parse_scheduler(address: str) -> tuple[str, int]:
+    """``tcp://HOST:PORT`` → (host, port); a one-line :class:`UserError` for anything else.
+
+    Parameters
+    ----------
+    address : the ``--scheduler`` value
+    """
+    from urllib.parse import urlsplit
+
+    try:
+        u = urlsplit(address)
+        port = u.port
+    except ValueError:
+        port, u = None, None
+    if u is None or u.scheme != "tcp" or not u.hostname or port is None or port == 0 \
+            or u.path not in ("", "/") or u.query or u.fragment:
+        raise UserError(f"--scheduler {address!r}: expected tcp://HOST:PORT, e.g. "
+                        "tcp://127.0.0.1:8786")
+    return u.hostname, port
+
+
+def _connect(address: str):
+    try:
+        from distributed import Client
+    except ImportError:
+        raise UserError("--scheduler needs dask.distributed: pip install "
+                        "'fms-testbed[dist]'") from None
+    parse_scheduler(address)
+    try:
+        return Client(address, timeout=f"{CONNECT_TIMEOUT_S:g}s", set_as_default=False)
+    except (OSError, TimeoutError) as exc:
+        raise UserError(f"--scheduler {address}: cannot connect within "
+                        f"{CONNECT_TIMEOUT_S:g} s: {type(exc).__name__}: "
+                        f"{str(exc).splitlines()[0] if str(exc) else 'no answer'}") from None
+
+
+def _check_cluster(client, address: str, opts: FlyOptions) -> None:
+    threads = client.nthreads()
+    if not threads:
+        raise UserError(f"--scheduler {address}: the cluster has no workers")
+    multi = sorted(w for w, n in threads.items() if n != 1)
+    if multi:
+        raise UserError(f"--scheduler {address}: workers {', '.join(multi[:3])} run "
+                        f"{threads[multi[0]]} threads; start them with --nthreads 1 (JSBSim "
+                        "is one instance per process)")
+    bad = {w: e for w, e in client.run(_probe_db, opts.db_path, opts.db_sha256).items() if e}
+    if bad:
+        w, e = next(iter(sorted(bad.items())))
+        raise UserError(f"--scheduler {address}: worker {w}: {e} (the database must be on "
+                        "a filesystem every worker reads)")
+
+
+def _lost(client, address: str) -> UserError:
+    return UserError(f"--scheduler {address}: the scheduler was lost mid-run (client "
+                     f"{client.status}); every row collected so far is written: run the same "
+                     "command again to resume")
+
+
+def _dask_row(client, address: str, f, c) -> dict:
+    """The row of a collected future; a lost scheduler stops the run (never an error row)."""
+    from distributed import CancelledError
+
+    try:
+        return f.result()
+    except CancelledError:
+        raise _lost(client, address) from None
+    except Exception as exc:  # noqa: BLE001 -- the cluster could not run it: an 'error' row
+        if client.status not in ("running", "connecting"):
+            raise _lost(client, address) from None
+        text = " ".join(str(exc).split())
+        return failed_row(c, "error", f"dask: {type(exc).__name__}: {text}", type(exc).__name__)
+
+
 def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
-             chunk: int = DASK_CHUNK) -> None:
+             chunk: int = DASK_CHUNK, fly: Callable = fly_case) -> None:
     """Fly ``cases`` on the dask.distributed cluster at ``address`` (module docstring).
 
     Parameters
@@ -144,60 +219,35 @@ def run_dask(address: str, cases: Iterable, opts: FlyOptions, on_row: OnRow,
     opts : what every case shares (:class:`~fms_testbed.campaign.worker.FlyOptions`)
     on_row : called with each row as it arrives
     chunk : futures held at a time at most
+    fly : the function a worker calls per case (as :func:`run_local`'s)
     """
+    from distributed import as_completed
+
+    client = _connect(address)
     try:
-        from distributed import Client, as_completed
-    except ImportError:
-        raise UserError("--scheduler needs dask.distributed: pip install "
-                        "'fms-testbed[dist]'") from None
-    try:
-        client = Client(address, timeout="20s", set_as_default=False)
-    except (OSError, TimeoutError) as exc:
-        raise UserError(f"--scheduler {address}: cannot connect: {exc}") from None
-    try:
-        threads = client.nthreads()
-        if not threads:
-            raise UserError(f"--scheduler {address}: the cluster has no workers")
-        multi = sorted(w for w, n in threads.items() if n != 1)
-        if multi:
-            raise UserError(f"--scheduler {address}: workers {', '.join(multi[:3])} run "
-                            f"{threads[multi[0]]} threads; start them with --nthreads 1 (JSBSim "
-                            "is one instance per process)")
-        bad = {w: e for w, e in client.run(_probe_db, opts.db_path, opts.db_sha256).items()
-               if e}
-        if bad:
-            w, e = next(iter(sorted(bad.items())))
-            raise UserError(f"--scheduler {address}: worker {w}: {e} (the database must be on "
-                            "a filesystem every worker reads)")
+        _check_cluster(client, address, opts)
         token = uuid.uuid4().hex[:8]
         it = iter(cases)
         held: dict = {}
 
         def submit(c):
-            f = client.submit(fly_case, c, opts, key=f"fly-{c.case_id}-{token}", pure=False)
+            f = client.submit(fly, c, opts, key=f"fly-{c.case_id}-{token}", pure=False)
             held[f.key] = c
             return f
 
-        first = []
-        for c in it:
-            first.append(submit(c))
-            if len(first) >= chunk:
-                break
+        first = [submit(c) for _, c in zip(range(chunk), it)]
         ac = as_completed(first, loop=client.loop)
         for f in ac:
             c = held.pop(f.key)
-            try:
-                row = f.result()
-            except Exception as exc:  # noqa: BLE001 -- the cluster could not run it: an 'error' row
-                row = failed_row(c, "error", f"dask: {type(exc).__name__}: {exc}",
-                                 type(exc).__name__)
+            row = _dask_row(client, address, f, c)
             f.release()
             on_row(row)
             nxt = next(it, None)
             if nxt is not None:
                 ac.add(submit(nxt))
     finally:
-        client.close()
+        client.close(timeout=CONNECT_TIMEOUT_S)
 
 
-__all__ = ["DASK_CHUNK", "WINDOW_PER_WORKER", "run_dask", "run_local"]
+__all__ = ["CONNECT_TIMEOUT_S", "DASK_CHUNK", "WINDOW_PER_WORKER",
+           "parse_scheduler", "run_dask", "run_local"]

@@ -40,7 +40,6 @@ import pandas as pd
 
 from fms_testbed.campaign import figures
 from fms_testbed.campaign.rows import ERROR_CLASSES, NOT_FLOWN, STATUSES
-from fms_testbed.campaign.store import read_flights, read_run_json
 from fms_testbed.core.errors import UserError
 
 log = logging.getLogger(__name__)
@@ -138,7 +137,8 @@ def residual(df: pd.DataFrame) -> dict:
     n = len(tried)
     lo, hi = wilson_interval(k, n)
     return {"flown": n, "residual_errors": k, "rate": k / n if n else float("nan"),
-            "ci_low": lo, "ci_high": hi, "class3": int((df["status"] == "degraded").sum())}
+            "ci_low": lo, "ci_high": hi, "class3": int(((df["status"] == "degraded")
+                                   | (df["monitor_status"] == "coding_suspect")).sum())}
 
 
 def phase_row(folder: Path, df: pd.DataFrame, info: dict) -> dict:
@@ -281,8 +281,107 @@ def _img(fig, alt: str) -> str:
     return f'<img alt="{html.escape(alt)}" src="{png_data_uri(fig)}">'
 
 
+def written_status(found, info: dict) -> tuple[str, str]:
+    """('complete' or 'incomplete', one line) counted from the data: the cases of the plan with
+    a row in a kept part, the missing ones, the damaged parts and the duplicate and foreign
+    rows they hold (:mod:`.audit`; a folder without a plan is counted against ``run.json``'s
+    case count).
+
+    Parameters
+    ----------
+    found : the folder's :class:`~.audit.Audit`; info : its ``run.json``
+    """
+    n_plan = len(found.planned) if found.planned is not None else \
+        (info.get("cases") or {}).get("count")
+    n = len(found.written)
+    missing = found.missing if found.planned is not None else []
+    done = not found.damaged and n_plan is not None and n == n_plan and not missing
+    text = f"{n} of {n_plan if n_plan is not None else '?'} planned cases written"
+    if missing:
+        text += f"; {len(missing)} missing (e.g. {', '.join(missing[:3])})"
+    elif n_plan is not None and n < n_plan:
+        text += f"; {n_plan - n} missing (the folder has no plan.parquet to name them)"
+    if found.damaged:
+        text += (f"; {len(found.damaged)} damaged part file(s) set aside ("
+                 + ", ".join(f"{d.path.name}: {d.reason}" for d in found.damaged[:3])
+                 + f"), holding {found.duplicate_rows} duplicate and {found.foreign_rows} "
+                   "foreign row(s)")
+    return ("complete" if done else "incomplete"), text
+
+
+def _head(folder: Path, df: pd.DataFrame, info: dict, status_line: str) -> list[str]:
+    e = html.escape
+    db = info.get("database", {})
+    sess = (info.get("sessions") or [{}])[-1]
+    rows = (("command", " ".join(map(str, info.get("command", [])))),
+            ("fms-testbed", info.get("version")),
+            ("database", f"{db.get('path')} (SHA-256 {db.get('sha256')})"),
+            ("status", status_line), ("phase", info.get("phase")),
+            ("last session", f"{sess.get('cases_flown')} cases in {sess.get('elapsed_s')} s, "
+                             f"{sess.get('flights_per_hour')} flights/h, workers "
+                             f"{sess.get('workers')}, scheduler {sess.get('scheduler')}"),
+            ("finished (UTC)", info.get("finished_utc")))
+    return [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
+            f"<title>regress report: {e(folder.name)}</title><style>{_CSS}</style></head>"
+            f"<body><h1>Regression run <code>{e(folder.name)}</code></h1>",
+            "<table class='t'>" + "".join(f"<tr><th>{e(k)}</th><td>{e(str(v))}</td></tr>"
+                                          for k, v in rows) + "</table>"]
+
+
+def _outcome_sections(df: pd.DataFrame, info: dict, worst: int, refly: bool) -> list[str]:
+    counts = df["status"].value_counts().reindex([s for s in STATUSES
+                                                  if s in set(df["status"])])
+    parts = ["<h2>Outcomes</h2>", _table(pd.DataFrame({
+        "status": counts.index, "cases": counts.to_numpy(),
+        "share": [f"{100 * v / len(df):.1f} %" for v in counts.to_numpy()]}))]
+    if not len(df):
+        return parts + ["<p>No case written yet.</p>"]
+    parts += [_img(figures.plot_outcomes_by_type(df), "outcome by type"),
+              _img(figures.plot_outcomes_by_airport(df), "outcome by airport"),
+              _img(figures.plot_outcomes_by_leg_code(df), "outcome by leg code"),
+              "<h2>FTE / TSE</h2>",
+              _img(figures.plot_error_distributions(df), "FTE/TSE distributions")]
+    parts += _worst_section(df, info, worst, refly)
+    parts += ["<h2>Monitor findings</h2>", _img(figures.plot_findings(df), "findings")]
+    fc = figures.finding_counts(df)
+    if len(fc):
+        parts.append(_table(fc.rename_axis("class").reset_index(name="cases")))
+    parts += _class_section(df)
+    if info.get("phase") == "test database":
+        parts += _manifest_section(df, info)
+    return parts
+
+
+def _phase_section(folder: Path, df: pd.DataFrame, info: dict, others) -> list[str]:
+    rows = [phase_row(folder, df, info)] + [phase_row(f, d, i) for f, d, i in others]
+    return ["<h2>Residual-error rate per Danilin phase</h2>",
+            "<p class='note'>Residual errors: class 1 or 2 failures, timeouts and exceptions, "
+            "over the cases flown (all but those not built); for the test-database phase, "
+            "the cases whose outcome disagrees with the database's manifest, over the "
+            "manifest's cases. 95 % Wilson interval in brackets. Class 3 (database coding "
+            "errors) counted apart.</p>",
+            _table(pd.DataFrame(rows)),
+            _table(pd.DataFrame(PHASES, columns=["phase", "Danilin (seed 000)",
+                                                 "criterion here"]))]
+
+
+def _raised_section(df: pd.DataFrame) -> list[str]:
+    err = df[df["status"] == "error"]
+    if not len(err):
+        return []
+    parts = ["<h2>Cases that raised</h2>", _table(
+        err.groupby(["error_type"]).agg(cases=("case_id", "size"),
+                                        example=("reason", "first")).reset_index())]
+    tb = err["traceback"].dropna()
+    tb = tb[tb != ""]
+    if len(tb):
+        parts.append(f"<pre>{html.escape(tb.iloc[0])}</pre>")
+    return parts
+
+
 def build_html(folder: Path, df: pd.DataFrame, info: dict, worst: int = 6,
-               others: list[tuple[Path, pd.DataFrame, dict]] = (), refly: bool = True) -> str:
+               others: list[tuple[Path, pd.DataFrame, dict]] = (), refly: bool = True,
+               status_line: str | None = None) -> str:
     """The report page (module docstring) as HTML text.
 
     Parameters
@@ -291,66 +390,16 @@ def build_html(folder: Path, df: pd.DataFrame, info: dict, worst: int = 6,
     worst : worst cases drawn
     others : (folder, flights, run.json) of other runs for the phase table
     refly : fly the worst cases again to draw their tracks
+    status_line : the run's status counted from its data (:func:`written_status`; default:
+        the rows of ``df`` against ``run.json``'s case count)
     """
-    e = html.escape
-    db = info.get("database", {})
-    sess = (info.get("sessions") or [{}])[-1]
-    parts = [f"<!DOCTYPE html><html lang='en'><head><meta charset='utf-8'>"
-             f"<title>regress report: {e(folder.name)}</title><style>{_CSS}</style></head>"
-             f"<body><h1>Regression run <code>{e(folder.name)}</code></h1>",
-             "<table class='t'>" + "".join(
-                 f"<tr><th>{e(k)}</th><td>{e(str(v))}</td></tr>" for k, v in (
-                     ("command", " ".join(map(str, info.get("command", [])))),
-                     ("fms-testbed", info.get("version")),
-                     ("database", f"{db.get('path')} (SHA-256 {db.get('sha256')})"),
-                     ("status", f"{info.get('status')}: {len(df)} of "
-                                f"{info.get('cases', {}).get('count')} cases written"),
-                     ("phase", info.get("phase")),
-                     ("last session", f"{sess.get('cases_flown')} cases in "
-                                      f"{sess.get('elapsed_s')} s, {sess.get('flights_per_hour')} "
-                                      f"flights/h, workers {sess.get('workers')}, scheduler "
-                                      f"{sess.get('scheduler')}"),
-                     ("finished (UTC)", info.get("finished_utc")))) + "</table>"]
-    counts = df["status"].value_counts().reindex([s for s in STATUSES
-                                                  if s in set(df["status"])])
-    parts += ["<h2>Outcomes</h2>", _table(pd.DataFrame({
-        "status": counts.index, "cases": counts.to_numpy(),
-        "share": [f"{100 * v / len(df):.1f} %" for v in counts.to_numpy()]}))]
-    if not len(df):
-        parts.append("<p>No case written yet.</p>")
-    else:
-        parts += [_img(figures.plot_outcomes_by_type(df), "outcome by type"),
-                  _img(figures.plot_outcomes_by_airport(df), "outcome by airport"),
-                  _img(figures.plot_outcomes_by_leg_code(df), "outcome by leg code"),
-                  "<h2>FTE / TSE</h2>",
-                  _img(figures.plot_error_distributions(df), "FTE/TSE distributions")]
-        parts += _worst_section(df, info, worst, refly)
-        parts += ["<h2>Monitor findings</h2>", _img(figures.plot_findings(df), "findings")]
-        fc = figures.finding_counts(df)
-        if len(fc):
-            parts.append(_table(fc.rename_axis("class").reset_index(name="cases")))
-        parts += _class_section(df)
-        if info.get("phase") == "test database":
-            parts += _manifest_section(df, info)
-    rows = [phase_row(folder, df, info)] + [phase_row(f, d, i) for f, d, i in others]
-    parts += ["<h2>Residual-error rate per Danilin phase</h2>",
-              "<p class='note'>Residual errors: class 1 or 2 failures, timeouts and exceptions, "
-              "over the cases flown (all but those not built); for the test-database phase, "
-              "the cases whose outcome disagrees with the database's manifest, over the "
-              "manifest's cases. 95 % Wilson interval in brackets. Class 3 (database coding "
-              "errors) counted apart.</p>",
-              _table(pd.DataFrame(rows)),
-              _table(pd.DataFrame(PHASES, columns=["phase", "Danilin (seed 000)",
-                                                   "criterion here"]))]
-    err = df[df["status"] == "error"]
-    if len(err):
-        parts += ["<h2>Cases that raised</h2>", _table(
-            err.groupby(["error_type"]).agg(cases=("case_id", "size"),
-                                            example=("reason", "first")).reset_index())]
-        tb = err["traceback"].dropna()
-        tb = tb[tb != ""]
-        if len(tb):
-            parts.append(f"<pre>{e(tb.iloc[0])}</pre>")
+    if status_line is None:
+        status_line = (f"{len(df)} of {info.get('cases', {}).get('count')} planned cases "
+                       "written")
+    parts = _head(folder, df, info, status_line)
+    parts += _outcome_sections(df, info, worst, refly)
+    parts += _phase_section(folder, df, info, others)
+    parts += _raised_section(df)
     parts += ["<p class='note' id='render-check'></p>", _RENDER_CHECK, "</body></html>"]
     return "\n".join(parts)
 
@@ -394,8 +443,10 @@ def _class_section(df: pd.DataFrame) -> list[str]:
 
 
 def write_report(folder: str | Path, worst: int = 6, others: list = (),
-                 refly: bool = True) -> Path:
-    """Write ``DIR/report.html`` (module docstring); return its path.
+                 refly: bool = True) -> tuple[Path, str]:
+    """Write ``DIR/report.html`` (module docstring) from the rows of the part files that read
+    and belong to the run (:mod:`.audit`; damage is stated in the page); return its path and
+    the status line counted from the data.
 
     Parameters
     ----------
@@ -403,25 +454,29 @@ def write_report(folder: str | Path, worst: int = 6, others: list = (),
     others : other campaign folders for the phase table
     refly : fly the worst cases again to draw their tracks
     """
+    from fms_testbed.campaign.audit import read_checked
+
     folder = Path(folder)
-    info = read_run_json(folder)
-    if info is None:
-        raise UserError(f"{folder}: not a regress run folder (no run.json)")
-    df = read_flights(folder)
+    df, info, found = read_checked(folder)
+    status, line = written_status(found, info)
+    info = {**info, "status": "complete" if status == "complete" else "running"}
     more = []
     for o in others:
-        o = Path(o)
-        oi = read_run_json(o)
-        if oi is None:
-            raise UserError(f"--with {o}: not a regress run folder (no run.json)")
-        more.append((o, read_flights(o), oi))
-    text = build_html(folder, df, info, worst, more, refly)
+        odf, oinfo, ofound = read_checked(o)
+        ostatus = written_status(ofound, oinfo)[0]
+        more.append((Path(o), odf, {**oinfo, "status": "complete" if ostatus == "complete"
+                                    else "running"}))
+    text = build_html(folder, df, info, worst, more, refly, f"{status}: {line}")
     out = folder / "report.html"
     tmp = folder / ".report.html.tmp"
-    tmp.write_text(text, encoding="utf-8")
-    tmp.replace(out)
-    return out
+    try:
+        tmp.write_text(text, encoding="utf-8")
+        tmp.replace(out)
+    except OSError as exc:
+        tmp.unlink(missing_ok=True)
+        raise UserError(f"{out}: cannot write the report: {exc.strerror or exc}") from None
+    return out, f"{status}: {line}"
 
 
-__all__ = ["PHASES", "build_html", "class_counts", "manifest_check", "phase_row", "png_data_uri",
+__all__ = ["PHASES", "build_html", "written_status", "class_counts", "manifest_check", "phase_row", "png_data_uri",
            "refined_classes", "residual", "wilson_interval", "worst_cases", "write_report"]

@@ -19,7 +19,10 @@ times in s, path length in NM, RNP in NM — the unit is in every name:
 * errors — ``{fte,tse,nse}[_straight|_turns]_{p95,max}_m`` from the summary's ``errors``
   (``all`` has no infix), ``rnp_contained``, ``legs_not_contained``, ``min_rnp_nm``;
   ``constraints_checked``, ``constraints_missed``; ``legs_entered``, ``legs_skipped``,
-  ``legs_repeated`` (counts, from the summary's ``sequencing``);
+  ``legs_repeated`` (counts, from the summary's ``sequencing``); ``vpe_p95_m``, ``vpe_max_m``
+  (vertical path error |h − h_profile(s)| where the planned profile is flown as a path: level
+  and descending parts, :func:`add_path_errors`) and ``spd_err_p95_kt`` (|TAS − TAS target|,
+  kt at this edge);
 * time — ``sim_time_s`` (simulated), ``wall_s`` (the whole case in its worker: build, trim,
   flight, evaluation), ``loop_wall_s`` (the flight loop alone, the summary's
   ``loop_wall_time_s``). Wall times are the only columns that differ between two runs of the
@@ -85,6 +88,7 @@ SCHEMA = pa.schema(
     + [("rnp_contained", _B), ("legs_not_contained", _S), ("min_rnp_nm", _F),
        ("constraints_checked", _I), ("constraints_missed", _I),
        ("legs_entered", _I), ("legs_skipped", _I), ("legs_repeated", _I),
+       ("vpe_p95_m", _F), ("vpe_max_m", _F), ("spd_err_p95_kt", _F),
        ("sim_time_s", _F), ("wall_s", _F), ("loop_wall_s", _F)])
 """Arrow schema of the ``flights/`` dataset (module docstring)."""
 COLUMNS = tuple(SCHEMA.names)
@@ -222,3 +226,43 @@ def table(rows: list[dict]) -> pa.Table:
 __all__ = ["COLUMNS", "ERROR_CLASSES", "ERROR_COLUMNS", "NOT_FLOWN", "RUN_FAILURES", "SCHEMA",
            "STATUSES", "WALL_COLUMNS", "add_sequence", "blank_row", "error_class",
            "failed_row", "flown_row", "stat_column", "table"]
+
+
+def add_path_errors(row: dict, df, profile) -> None:
+    """Set ``vpe_p95_m``, ``vpe_max_m`` and ``spd_err_p95_kt`` of a flown case from its
+    timeseries (module docstring); left null where the flight has no samples for them.
+
+    The vertical path error is ``h − h_p(s)`` with ``h_p`` the planned profile interpolated at
+    the distance flown along the path, taken where the profile does not climb (a climb is flown
+    at the best rate to its target, not along the profile).
+
+    Parameters
+    ----------
+    row : the row, updated in place;  df : the flight's timeseries (``alt_m``, ``along_m``,
+        ``tas_mps``, ``cmd_tas_mps``);  profile : the built path's planned profile
+        (``along_m``, ``alt_m`` arrays, m) or None
+    """
+    import numpy as np
+
+    from fms_testbed.core.units import KT_MPS
+
+    if df is None or len(df) == 0:
+        return
+    if "cmd_tas_mps" in df:
+        e = np.abs(df["tas_mps"].to_numpy() - df["cmd_tas_mps"].to_numpy())
+        e = e[np.isfinite(e)]
+        if len(e):
+            row["spd_err_p95_kt"] = float(np.percentile(e, 95) / KT_MPS)
+    if profile is None or "along_m" not in df:
+        return
+    s_p, h_p = np.asarray(profile.along_m, float), np.asarray(profile.alt_m, float)
+    s = df["along_m"].to_numpy()
+    ok = np.isfinite(s) & (s >= s_p[0]) & (s <= s_p[-1])
+    if len(s_p) < 2 or not ok.any():
+        return
+    seg = np.clip(np.searchsorted(s_p, s[ok], side="right") - 1, 0, len(s_p) - 2)
+    flat = h_p[seg + 1] <= h_p[seg] + 1e-6
+    e = np.abs(df["alt_m"].to_numpy()[ok] - np.interp(s[ok], s_p, h_p))[flat]
+    if len(e):
+        row["vpe_p95_m"] = float(np.percentile(e, 95))
+        row["vpe_max_m"] = float(e.max())

@@ -12,23 +12,26 @@ with ``status: running`` and every finished batch; the same command resumes.
 from __future__ import annotations
 
 import hashlib
+import os
+import shutil
 import sys
 import time
 from collections import Counter
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Callable
 
 from fms_testbed.campaign.cases import (TYPE_NAMES, Case, aircraft_files, enumerate_cases,
                                         sample_airports)
 from fms_testbed.campaign.conditions import Conditions, check_sources
-from fms_testbed.campaign.executors import run_dask, run_local
-from fms_testbed.campaign.store import (CASES, RUN_JSON, BatchWriter, RunLock,
-                                        clean_partial, finished_ids, part_files, read_run_json,
+from fms_testbed.campaign.audit import audit, quarantine, write_plan
+from fms_testbed.campaign.executors import parse_scheduler, run_dask, run_local
+from fms_testbed.campaign.store import (CASES, RUN_JSON, BatchWriter, RunLock, clean_partial,
                                         utc_now, write_json_atomic)
 from fms_testbed.campaign.worker import FlyOptions
 from fms_testbed.core.errors import UserError
 from fms_testbed.procedures.index import DatabaseIndex, cache_dir, load_index, parser_hash
-from fms_testbed.run.outputs import check_out_dir
+from fms_testbed.run.outputs import check_out_dir, previous_run, run_kind
 
 RUN_KIND = "regress-run"
 """``run.json`` ``kind`` of a regression run folder."""
@@ -62,6 +65,9 @@ class RunConfig:
     phase : Danilin phase, ``test-db`` or ``integration`` (None: inferred,
         :func:`phase_label`)
     batch_rows, batch_s : rows per part file, longest a row waits in memory (s)
+    overwrite : replace a folder holding another kind of run, other files or a run of other
+        cases (never an input)
+    say : where the lines on quarantined parts go (default: stderr)
     """
 
     out: Path
@@ -86,6 +92,8 @@ class RunConfig:
     phase: str | None = None
     batch_rows: int = 64
     batch_s: float = 15.0
+    overwrite: bool = False
+    say: Callable[[str], None] | None = None
 
 
 def select_airports(index: DatabaseIndex, cfg: RunConfig) -> list[str]:
@@ -221,15 +229,6 @@ def manifest_record(index: DatabaseIndex) -> dict | None:
             "cases": len(m.get("procedures", []))}
 
 
-def _status_counts(out: Path) -> Counter:
-    import pyarrow.parquet as pq
-
-    c: Counter = Counter()
-    for p in part_files(out):
-        c.update(pq.read_table(p, columns=["status"]).column("status").to_pylist())
-    return c
-
-
 def _bar(total: int, initial: int, progress: bool | None):
     if progress is False:
         return None
@@ -239,6 +238,110 @@ def _bar(total: int, initial: int, progress: bool | None):
                 dynamic_ncols=True, disable=None if progress is None else False)
 
 
+def _say(line: str) -> None:
+    print(f"fms-testbed: {line}", file=sys.stderr)
+
+
+def _check_target(cfg: RunConfig) -> tuple[Path, dict | None]:
+    """The output folder (checked: kind, inputs, permissions) and its previous regress run."""
+    db = None if cfg.db in (None, "embedded") else cfg.db
+    out = check_out_dir(cfg.out, cfg.overwrite, RUN_KIND, [db])
+    prev = previous_run(out)
+    if prev is not None and run_kind(prev) != RUN_KIND:
+        prev = None                 # another kind of run, replaced (--overwrite)
+    if cfg.scheduler is None and cfg.workers < 1:
+        raise UserError(f"--workers {cfg.workers}: must be at least 1")
+    if cfg.scheduler is not None:
+        parse_scheduler(cfg.scheduler)
+    return out, prev
+
+
+def _clear(out: Path) -> None:
+    """Remove the folder's content (``--overwrite``): renamed aside first, then deleted."""
+    if out.exists():
+        old = out.with_name(f".{out.name}.old-{os.getpid()}-{time.time_ns()}")
+        os.rename(out, old)
+        shutil.rmtree(old, ignore_errors=True)
+
+
+def _resume_or_clear(cfg: RunConfig, out: Path, prev: dict | None, set_sha: str) -> dict | None:
+    """The previous run to resume (None: start afresh, the folder cleared when it held
+    anything and ``--overwrite`` was given)."""
+    if prev is not None and prev.get("cases", {}).get("set_sha256") == set_sha:
+        return prev
+    if prev is not None and not cfg.overwrite:
+        old_sha = prev.get("database", {}).get("sha256", "?")
+        raise UserError(f"--out {out}: holds a run of other cases ({prev['cases'].get('count')} "
+                        f"cases, database SHA-256 {old_sha[:12]}…); give the same options to "
+                        "resume it, a new folder, or --overwrite to replace it")
+    if out.exists() and any(out.iterdir()):
+        _clear(out)
+    return None
+
+
+def _run_info(cfg: RunConfig, index, airports: list[str], cases: list[Case], set_sha: str,
+              prev: dict | None) -> dict:
+    n_proc = len({(c.airport, c.procedure) for c in cases})
+    manifest = manifest_record(index)
+    return {
+        "tool": "fms-testbed", "kind": RUN_KIND, "version": _version(),
+        "command": cfg.command if cfg.command is not None else sys.argv,
+        "status": "running",
+        "database": {"path": str(index.path), "sha256": index.sha256,
+                     "parser_sha256": parser_hash(), "index": index.source,
+                     "index_load_s": round(index.load_s, 3)},
+        "cases": {"count": len(cases), "set_sha256": set_sha, "airports": len(airports),
+                  "procedures": n_proc},
+        "phase": phase_label(cfg.phase, len(airports), len(cases), n_proc, manifest is not None),
+        "manifest": manifest,
+        "options": {"airports": airports, "types": [TYPE_NAMES[t] for t in cfg.types],
+                    "aircraft": cfg.aircraft,
+                    "conditions": [c.canonical() for c in cfg.conditions],
+                    "combinations": cfg.combinations, "limit": cfg.limit, "seed": cfg.seed,
+                    "sample": None if cfg.sample_airports is None else {
+                        "airports": cfg.sample_airports, "seed": cfg.sample_seed,
+                        "min_transitions": cfg.sample_min_transitions},
+                    "case_timeout_s": cfg.case_timeout_s, "keep": list(cfg.keep)},
+        "execution": {"workers": None if cfg.scheduler else cfg.workers,
+                      "scheduler": cfg.scheduler},
+        "started_utc": (prev or {}).get("started_utc") or utc_now(),
+        "sessions": list((prev or {}).get("sessions", [])),
+    }
+
+
+def _fly_all(cfg: RunConfig, out: Path, todo: list[Case], opts: FlyOptions, bar) -> dict:
+    """Fly ``todo`` and write the rows; the session's figures."""
+    writer = BatchWriter(out, cfg.batch_rows, cfg.batch_s)
+    session: Counter = Counter()
+    wall = [0.0, 0.0]
+
+    def on_row(row: dict) -> None:
+        writer.add(row)
+        session[row["status"]] += 1
+        wall[0] += row["loop_wall_s"] or 0.0
+        wall[1] += row["wall_s"] or 0.0
+        if bar is not None:
+            bar.update(1)
+            bad = sum(v for k, v in session.items() if k != "ok")
+            bar.set_postfix_str(f"not ok {bad}", refresh=False)
+
+    t0 = time.perf_counter()
+    try:
+        if todo and cfg.scheduler:
+            run_dask(cfg.scheduler, todo, opts, on_row)
+        elif todo:
+            run_local(todo, opts, min(cfg.workers, len(todo)), on_row)
+    finally:
+        if bar is not None:
+            bar.close()
+        writer.flush()
+    elapsed = time.perf_counter() - t0
+    n = sum(session.values())
+    return {"cases_flown": n, "elapsed_s": round(elapsed, 2),
+            "flights_per_hour": round(3600.0 * n / elapsed) if n and elapsed > 0 else None,
+            "sum_wall_s": round(wall[1], 2), "sum_loop_wall_s": round(wall[0], 2)}
+
+
 def run_campaign(cfg: RunConfig) -> dict:
     """Fly a campaign into ``cfg.out`` (module docstring); return the final ``run.json``.
 
@@ -246,94 +349,37 @@ def run_campaign(cfg: RunConfig) -> dict:
     ----------
     cfg : the run's options
     """
-    out = check_out_dir(cfg.out)
-    prev = read_run_json(out)
-    if prev is not None and prev.get("kind") != RUN_KIND:
-        raise UserError(f"--out {out}: holds another kind of testbed run "
-                        f"({prev.get('command', ['?'])[1:2] or '?'}); give a new folder")
-    if cfg.scheduler is None and cfg.workers < 1:
-        raise UserError(f"--workers {cfg.workers}: must be at least 1")
+    out, prev = _check_target(cfg)
     t_plan = time.perf_counter()
     index, airports, cases = plan(cfg)
     t_plan = time.perf_counter() - t_plan
     set_sha = case_set_sha256(cases)
-    if prev is not None and prev.get("cases", {}).get("set_sha256") != set_sha:
-        old_sha = prev.get("database", {}).get("sha256", "?")
-        raise UserError(f"--out {out}: holds a run of other cases ({prev['cases'].get('count')} "
-                        f"cases, database SHA-256 {old_sha[:12]}…); give the same options to "
-                        "resume it, or a new folder")
+    prev = _resume_or_clear(cfg, out, prev, set_sha)
     out.mkdir(parents=True, exist_ok=True)
+    say = cfg.say or _say
     with RunLock(out):
         clean_partial(out)
-        done = finished_ids(out)
-        todo = [c for c in cases if c.case_id not in done]
-        n_proc = len({(c.airport, c.procedure) for c in cases})
-        manifest = manifest_record(index)
-        info = {
-            "tool": "fms-testbed", "kind": RUN_KIND, "version": _version(),
-            "command": cfg.command if cfg.command is not None else sys.argv,
-            "status": "running",
-            "database": {"path": str(index.path), "sha256": index.sha256,
-                         "parser_sha256": parser_hash(), "index": index.source,
-                         "index_load_s": round(index.load_s, 3)},
-            "cases": {"count": len(cases), "set_sha256": set_sha, "airports": len(airports),
-                      "procedures": n_proc},
-            "phase": phase_label(cfg.phase, len(airports), len(cases), n_proc,
-                                 manifest is not None),
-            "manifest": manifest,
-            "options": {"airports": airports, "types": [TYPE_NAMES[t] for t in cfg.types],
-                        "aircraft": cfg.aircraft,
-                        "conditions": [c.canonical() for c in cfg.conditions],
-                        "combinations": cfg.combinations, "limit": cfg.limit, "seed": cfg.seed,
-                        "sample": None if cfg.sample_airports is None else {
-                            "airports": cfg.sample_airports, "seed": cfg.sample_seed,
-                            "min_transitions": cfg.sample_min_transitions},
-                        "case_timeout_s": cfg.case_timeout_s, "keep": list(cfg.keep)},
-            "execution": {"workers": None if cfg.scheduler else cfg.workers,
-                          "scheduler": cfg.scheduler},
-            "started_utc": (prev or {}).get("started_utc") or utc_now(),
-            "sessions": list((prev or {}).get("sessions", [])),
-        }
+        info = _run_info(cfg, index, airports, cases, set_sha, prev)
         write_json_atomic(out / RUN_JSON, info)
+        write_plan(out, cases)
+        found = audit(out)
+        quarantined = quarantine(out, found)
+        for line in quarantined:
+            say(line)
+        todo = [c for c in cases if c.case_id not in found.written]
         opts = FlyOptions(str(index.path), index.sha256, cfg.case_timeout_s, tuple(cfg.keep),
                           str(out / CASES) if cfg.keep else None,
                           cfg.cache_dir or str(cache_dir()))
-        writer = BatchWriter(out, cfg.batch_rows, cfg.batch_s)
-        bar = _bar(len(cases), len(done), cfg.progress)
-        session = Counter()
-        loop_wall = [0.0, 0.0]
-
-        def on_row(row: dict) -> None:
-            writer.add(row)
-            session[row["status"]] += 1
-            loop_wall[0] += row["loop_wall_s"] or 0.0
-            loop_wall[1] += row["wall_s"] or 0.0
-            if bar is not None:
-                bar.update(1)
-                bad = sum(v for k, v in session.items() if k != "ok")
-                bar.set_postfix_str(f"not ok {bad}", refresh=False)
-
-        t0, started = time.perf_counter(), utc_now()
-        try:
-            if todo:
-                if cfg.scheduler:
-                    run_dask(cfg.scheduler, todo, opts, on_row)
-                else:
-                    run_local(todo, opts, min(cfg.workers, len(todo)), on_row)
-        finally:
-            writer.flush()
-            if bar is not None:
-                bar.close()
-        elapsed = time.perf_counter() - t0
-        n = sum(session.values())
+        started = utc_now()
+        sess = _fly_all(cfg, out, todo, opts, _bar(len(cases), len(cases) - len(todo),
+                                                   cfg.progress))
         info["sessions"].append({
-            "started_utc": started, "cases_flown": n, "cases_skipped": len(done),
-            "plan_s": round(t_plan, 2), "elapsed_s": round(elapsed, 2),
-            "flights_per_hour": round(3600.0 * n / elapsed) if n and elapsed > 0 else None,
-            "sum_wall_s": round(loop_wall[1], 2), "sum_loop_wall_s": round(loop_wall[0], 2),
+            "started_utc": started, **sess, "cases_skipped": len(cases) - len(todo),
+            "plan_s": round(t_plan, 2), "quarantined": quarantined,
             "workers": None if cfg.scheduler else cfg.workers, "scheduler": cfg.scheduler})
-        counts = _status_counts(out)
-        info["status"] = "complete" if sum(counts.values()) == len(cases) else "running"
+        final = audit(out)
+        counts = Counter(s for t in final.tables for s in t.column("status").to_pylist())
+        info["status"] = "complete" if not final.missing and not final.damaged else "running"
         info["counts"] = dict(sorted(counts.items()))
         info["finished_utc"] = utc_now()
         write_json_atomic(out / RUN_JSON, info)

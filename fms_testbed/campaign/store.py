@@ -102,16 +102,15 @@ def part_files(out: Path) -> list[Path]:
 
 
 def finished_ids(out: Path) -> set[str]:
-    """Case ids already written (read from the ``case_id`` column of every part file).
+    """Case ids already written: those of the part files :func:`~.audit.audit` keeps.
 
     Parameters
     ----------
     out : the campaign folder
     """
-    ids: set[str] = set()
-    for p in part_files(out):
-        ids.update(pq.read_table(p, columns=["case_id"]).column("case_id").to_pylist())
-    return ids
+    from fms_testbed.campaign.audit import audit
+
+    return audit(out).written
 
 
 def clean_partial(out: Path) -> int:
@@ -175,6 +174,11 @@ class BatchWriter:
         self.n_files = 0
         self.n_rows = 0
 
+    @staticmethod
+    def write(tab, fh) -> None:
+        """Write one part's table into the open file (Parquet, zstd)."""
+        pq.write_table(tab, fh, compression="zstd")
+
     def add(self, row: dict) -> None:
         """Add one row; write the batch when it is due."""
         self.rows.append(row)
@@ -188,18 +192,28 @@ class BatchWriter:
             return
         tab = table(self.rows)
         name = f"part-{time.time_ns():020d}-{os.getpid()}-{self.rows[0]['case_id']}.parquet"
-        fd, tmp = tempfile.mkstemp(prefix=".part-", suffix=".tmp", dir=self.folder)
-        os.fchmod(fd, _FILE_MODE)
+        tmp = None
         try:
+            fd, tmp = tempfile.mkstemp(prefix=".part-", suffix=".tmp", dir=self.folder)
+            os.fchmod(fd, _FILE_MODE)
             with os.fdopen(fd, "wb") as fh:
-                pq.write_table(tab, fh, compression="zstd")
+                self.write(tab, fh)
                 fh.flush()
                 os.fsync(fh.fileno())
             os.replace(tmp, self.folder / name)
+            _fsync_dir(self.folder)
+        except OSError as exc:
+            if tmp is not None:
+                Path(tmp).unlink(missing_ok=True)
+            n, self.rows = len(self.rows), []
+            raise UserError(f"{self.folder}: cannot write a part file: "
+                            f"{exc.strerror or exc}; the run stops ({n} finished case(s) not "
+                            "written, flown again on resume: run the same command once the "
+                            "cause is fixed)") from None
         except BaseException:
-            Path(tmp).unlink(missing_ok=True)
+            if tmp is not None:
+                Path(tmp).unlink(missing_ok=True)
             raise
-        _fsync_dir(self.folder)
         self.n_files += 1
         self.n_rows += len(self.rows)
         self.rows = []
@@ -217,20 +231,14 @@ __all__ = ["CASES", "FLIGHTS", "RUN_JSON", "BatchWriter", "RunLock", "clean_part
 
 def read_flights(out: str | Path):
     """The ``flights/`` dataset of a campaign folder as a DataFrame (every column of
-    :data:`~.rows.SCHEMA`, even when no part file is written yet).
+    :data:`~.rows.SCHEMA`, even when no part file is written yet): the rows of the part files
+    :func:`~.audit.audit` keeps; a folder that is not a regression run is a one-line
+    :class:`UserError`.
 
     Parameters
     ----------
     out : the campaign folder
     """
-    import pandas as pd
+    from fms_testbed.campaign.audit import read_checked
 
-    from fms_testbed.campaign.rows import SCHEMA
-
-    out = Path(out)
-    parts = part_files(out)
-    if not parts:
-        if read_run_json(out) is None:
-            raise UserError(f"{out}: not a regress run folder (no run.json)")
-        return SCHEMA.empty_table().to_pandas()
-    return pd.read_parquet(out / FLIGHTS)
+    return read_checked(out)[0]

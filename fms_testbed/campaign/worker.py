@@ -32,7 +32,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
-from fms_testbed.campaign.rows import add_sequence, failed_row, flown_row
+from fms_testbed.campaign.rows import add_path_errors, add_sequence, failed_row, flown_row
 from fms_testbed.core.errors import UserError
 from fms_testbed.procedures.index import DatabaseIndex, load_index
 
@@ -250,20 +250,14 @@ def fly_on(case, db, db_path: str, timeout_s: float | None = None,
     flight = Flight(scn, procedure=prepared, seed=case.seed, progress=False)
     stage[0] = "flying"
     deadline = None if timeout_s is None else t0 + timeout_s
-    timed_out = False
     while flight.step(STEP_CHUNK):
         if deadline is not None and time.perf_counter() > deadline:
-            timed_out = True
+            flight.stop(f"--case-timeout {timeout_s:g} s reached")
             break
     stage[0] = "evaluating the flight"
     res = results_of(flight)
     row = flown_row(case, res.summary)
-    if timed_out:
-        g = flight.guidance
-        row.update(status="timeout", error_class=None,
-                   reason=f"--case-timeout {timeout_s:g} s reached after "
-                          f"{row['sim_time_s']:.0f} s simulated, on leg {g.leg + 1} of "
-                          f"{len(prepared.path.seq.legs)}")
+    add_path_errors(row, res.df, prepared.path.path.profile)
     return row, res
 
 

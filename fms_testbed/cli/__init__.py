@@ -2,7 +2,8 @@
 
 Each command group lives in its own module exposing ``register(subparsers)``; the handler it sets
 with ``set_defaults(func=...)`` returns an exit code. User errors (:class:`UserError`) print one
-line on stderr and exit 2, without a traceback.
+line on stderr and exit 2, without a traceback; so do usage errors and an operating-system error
+on a path the user gave (a name too long, not a folder, no space left).
 
 Units at the edges, the same in every command:
 
@@ -42,12 +43,20 @@ COMMAND_MODULES = (
     "fms_testbed.cli.imu_test",     # imu-test
     "fms_testbed.cli.regress",      # regress run / diff / report
     "fms_testbed.cli.montecarlo",   # montecarlo
+    "fms_testbed.cli.nav_replay",   # nav-replay
 )
+
+
+class _Parser(argparse.ArgumentParser):
+    """A parser whose usage errors are one line on stderr (exit 2), naming ``--help``."""
+
+    def error(self, message: str):
+        self.exit(2, f"{self.prog}: error: {message} (see {self.prog} --help)\n")
 
 
 def build_parser() -> argparse.ArgumentParser:
     """Build the argument parser with every available command group."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="fms-testbed",
         description="Flight-management-system testbed on JSBSim.")
     parser.add_argument("-v", "--verbose", action="store_true", help="debug logging")
@@ -103,8 +112,9 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     try:
         return int(args.func(args) or 0)
-    except UserError as exc:
-        print(f"fms-testbed: error: {exc}", file=sys.stderr)
+    except UserError as exc:    # one line, whatever the message (a parser's may span several)
+        text = " ".join(part.strip() for part in str(exc).splitlines() if part.strip())
+        print(f"fms-testbed: error: {text}", file=sys.stderr)
         return 2
     except KeyboardInterrupt:
         print("fms-testbed: interrupted", file=sys.stderr)
@@ -112,6 +122,10 @@ def main(argv: list[str] | None = None) -> int:
     except BrokenPipeError:  # output piped into `head`: stop quietly (Python docs, signal)
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return 0
+    except OSError as exc:   # a path the system refuses (name too long, not a folder, no space)
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"fms-testbed: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
     except Exception:
         if _terminated:                # SIGTERM, surfacing through compiled code
             print("fms-testbed: terminated", file=sys.stderr)

@@ -56,6 +56,67 @@ def parse_isa_dev(value) -> float:
     return v
 
 
+SEED_MAX = 2 ** 63 - 1
+"""Largest seed a command takes (the run records hold it as a signed 64-bit integer)."""
+
+
+def bounded_int(lo: int, hi: int, what: str = "a whole number"):
+    """An argparse ``type`` taking a whole number in ``lo..hi`` (anything else: argparse's
+    one-line usage error, exit 2).
+
+    Parameters
+    ----------
+    lo, hi : the bounds (inclusive); what : what the number is, for the message
+    """
+    import argparse
+
+    def parse(text: str) -> int:
+        try:
+            v = int(str(text).strip())
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r}: expected {what}") from None
+        if not lo <= v <= hi:
+            raise argparse.ArgumentTypeError(f"{text!r}: must be within {lo}..{hi}")
+        return v
+
+    parse.__name__ = what
+    return parse
+
+
+def bounded_float(lo: float, hi: float, unit: str, lo_open: bool = False):
+    """An argparse ``type`` taking a finite number in ``lo..hi`` (``unit`` named in the message;
+    ``lo_open``: ``lo`` itself refused).
+
+    Parameters
+    ----------
+    lo, hi : the bounds; unit : the unit of the value (for the message)
+    lo_open : the lower bound is excluded
+    """
+    import argparse
+
+    def parse(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{text!r}: expected a number of {unit}") from None
+        if not (math.isfinite(v) and (lo < v if lo_open else lo <= v) and v <= hi):
+            raise argparse.ArgumentTypeError(
+                f"{text!r}: must be {'>' if lo_open else '>='} {lo:g} and <= {hi:g} {unit}")
+        return v
+
+    parse.__name__ = f"number of {unit}"
+    return parse
+
+
+SEED = bounded_int(0, SEED_MAX, "a seed (whole number >= 0)")
+"""``--seed`` type of the commands that seed numpy only: 0..2**63 - 1."""
+FLIGHT_SEED_MAX = 2 ** 31 - 1
+"""Largest seed of a flight: JSBSim's ``simulation/randomseed`` is a signed 32-bit integer (a
+larger value becomes -2**31, so every larger seed would fly the same turbulence)."""
+FLIGHT_SEED = bounded_int(0, FLIGHT_SEED_MAX, "a seed (whole number >= 0)")
+"""``--seed`` type of the flight commands: 0..2**31 - 1."""
+
+
 def _cell(v) -> str:
     if isinstance(v, (list, tuple)):
         return " ".join(str(x) if str(x) else "-" for x in v)
@@ -110,11 +171,12 @@ def add_override_options(p, aircraft_default: str | None = None) -> None:
                         "sources with an IMU (sins, ins_gnss, attitude_reference; an unknown "
                         "name lists them)")
     p.add_argument("--imu", help="IMU preset of the INS (with a --nav source other than truth)")
-    p.add_argument("--rnp", type=float, help="RNP, NM, where the procedure's records code none")
+    p.add_argument("--rnp", type=bounded_float(0.0, 30.0, "NM", lo_open=True),
+                   help="RNP, NM, where the procedure's records code none")
     p.add_argument("--allow-degraded", action="store_true",
                    help="fly a procedure with a rejected or duplicated record of its own "
                         "(refused by default; the summary lists what is in doubt)")
-    p.add_argument("--seed", type=int, default=0,
+    p.add_argument("--seed", type=FLIGHT_SEED, default=0,
                    help="seed for turbulence and sensor errors (default 0; a scenario's "
                         "navigation.seed seeds the navigation errors instead)")
     p.add_argument("--missed", action="store_true",
@@ -203,6 +265,25 @@ def print_results(res) -> None:
         print(f"  outputs in {res.out_dir}: "
               + ", ".join(["timeseries.parquet", "summary.json"] + s.get("plots", [])
                         + s.get("tracks", [])))
+
+
+def out_path(value: str | None, default=None):
+    """The ``--out`` folder of a command: ``value``, or ``default`` when it is not given; an
+    empty or blank value is refused (a one-line :class:`UserError`), never taken as ``.``.
+
+    Parameters
+    ----------
+    value : the ``--out`` text (None: not given); default : the folder used then
+    """
+    from pathlib import Path
+
+    if value is None:
+        if default is None:
+            raise UserError("--out: give the output folder")
+        return Path(default)
+    if not value.strip():
+        raise UserError(f"--out {value!r}: give a folder name")
+    return Path(value)
 
 
 def add_overwrite_option(p) -> None:

@@ -50,13 +50,37 @@ def _scenario_path(name: str) -> Path:
 
 # --- compare -----------------------------------------------------------------------------------
 
+def _compare_scenario(scn, args, laws, tmp: Path) -> list[dict]:
+    """Fly one scenario with each law; save its plots and timeseries into ``tmp``; return its
+    comparison rows."""
+    from fms_testbed.control.coupled_law import params_from_config
+    from fms_testbed.evaluation.law_comparison import comparison_rows, run_comparison
+    from fms_testbed.viz.control import plot_comparison, plot_paper_fig2
+    from fms_testbed.viz.figure import save
+
+    cfg = load_aircraft(scn.aircraft)
+    params = _with_settings(params_from_config(cfg), args.set or [])
+    cmp = run_comparison(scn, cfg, laws, params, seed=args.seed)
+    scn_rows = comparison_rows(cmp, cfg)
+    runs = dict(cmp.runs)
+    runs["ideal"] = cmp.ideal
+    head = _headline(scn_rows)
+    title = f"{scn.name} — {cfg.name}: {scn.description or ''}" + (f"\n{head}" if head else "")
+    save(plot_comparison(runs, title), tmp / f"{scn.name}-comparison.png")
+    if args.paper_plot or scn.name == "paper-fig2":
+        fig2 = {k: runs[k] for k in ("coupled", "ideal", "pi") if k in runs}
+        save(plot_paper_fig2(fig2, f"{scn.name} — {cfg.name} (layout of the paper's Fig. 2)"
+                             + (f"\n{head}" if head else "")),
+             tmp / f"{scn.name}-paper-fig2.png")
+    for law, df in cmp.runs.items():
+        df.to_parquet(tmp / f"{scn.name}-{law}.parquet", index=False)
+    return scn_rows
+
+
 def cmd_compare(args) -> int:
     """Fly scenarios with each law; print/save the table, the goal checks and plots."""
     from fms_testbed.control import VERTICAL_LAWS
-    from fms_testbed.evaluation.law_comparison import check_goals, comparison_rows, run_comparison
-    from fms_testbed.control.coupled_law import params_from_config
-    from fms_testbed.viz.control import plot_comparison, plot_paper_fig2
-    from fms_testbed.viz.figure import save
+    from fms_testbed.evaluation.law_comparison import check_goals
     from fms_testbed.config.scenario import load_scenario
 
     laws = tuple(s.strip() for s in args.laws.split(",") if s.strip())
@@ -83,23 +107,7 @@ def cmd_compare(args) -> int:
     tmp = folder.open()
     rows = []
     for scn in scns:
-        cfg = load_aircraft(scn.aircraft)
-        params = _with_settings(params_from_config(cfg), args.set or [])
-        cmp = run_comparison(scn, cfg, laws, params, seed=args.seed)
-        scn_rows = comparison_rows(cmp, cfg)
-        rows.extend(scn_rows)
-        runs = dict(cmp.runs)
-        runs["ideal"] = cmp.ideal
-        head = _headline(scn_rows)
-        title = f"{scn.name} — {cfg.name}: {scn.description or ''}" + (f"\n{head}" if head else "")
-        save(plot_comparison(runs, title), tmp / f"{scn.name}-comparison.png")
-        if args.paper_plot or scn.name == "paper-fig2":
-            fig2 = {k: runs[k] for k in ("coupled", "ideal", "pi") if k in runs}
-            save(plot_paper_fig2(fig2, f"{scn.name} — {cfg.name} (layout of the paper's Fig. 2)"
-                                 + (f"\n{head}" if head else "")),
-                 tmp / f"{scn.name}-paper-fig2.png")
-        for law, df in cmp.runs.items():
-            df.to_parquet(tmp / f"{scn.name}-{law}.parquet", index=False)
+        rows.extend(_compare_scenario(scn, args, laws, tmp))
     table = pd.DataFrame(rows)
     goals = check_goals(table) if "coupled" in laws else []
     table.to_csv(tmp / "comparison.csv", index=False)
@@ -186,9 +194,42 @@ def _compare_envelope(args, laws) -> int:
 
 # --- analyse -----------------------------------------------------------------------------------
 
-def cmd_analyse(args) -> int:
-    """Linear analysis of the closed loop: decoupling, poles, Bode and step plots with lags."""
+def _analyse_case(label: str, p, V0: float, case: tuple, w, t, args):
+    """One linear case of ``analyse``: closed loop with lags (s) and n_x choice ``case``;
+    prints its decoupling and poles; returns (W(jω), steps, report entry)."""
     from fms_testbed.control import linear
+
+    tx, ty, meas = case
+    sys = linear.closed_loop(p, V0, tx, ty, use_measured_nx=meas)
+    r = linear.decoupling_report(sys, p, w)
+    fr = linear.frequency_response(sys, w)
+    sv, sh = linear.step_responses(sys, t, args.dv * KMH_MPS, args.dh)
+    rep = {
+        "max|W_V,Hcmd|/max|W_V,Vcmd|": r.off_V_from_H, "max|W_H,Vcmd|/max|W_H,Hcmd|":
+            r.off_H_from_V, "pole_error_rps": r.pole_error,
+        "poles_rps": [complex(x) for x in np.sort_complex(r.poles)],
+        "dc_gain": r.dc_gain.tolist(),
+        f"max|dV| in {args.dh:g} m step, km/h": float(np.abs(sh[0]).max() / KMH_MPS),
+        f"max|dH| in {args.dv:g} km/h step, m": float(np.abs(sv[1]).max())}
+    print(f"\n[{label}]")
+    print(f"  cross terms: |W_V,Hcmd|/|W_V,Vcmd| = {r.off_V_from_H:.3g}, "
+          f"|W_H,Vcmd|/|W_H,Hcmd| = {r.off_H_from_V:.3g}")
+    print(f"  poles: {', '.join(f'{x.real:.4f}{x.imag:+.4f}j' for x in np.sort_complex(r.poles))}")
+    print(f"  desired (T, xi) poles: "
+          f"{', '.join(f'{x.real:.4f}{x.imag:+.4f}j' for x in np.sort_complex(r.desired_poles))}"
+          f"  -> max distance {r.pole_error:.2g} rad/s")
+    print(f"  max|dV| during a {args.dh:g} m step: {np.abs(sh[0]).max() / KMH_MPS:.3g} km/h; "
+          f"max|dH| during a {args.dv:g} km/h step: {np.abs(sv[1]).max():.3g} m")
+    return fr, (sv, sh), rep
+
+
+def cmd_analyse(args) -> int:
+    """Linear analysis of the closed loop: decoupling, poles, Bode and step plots with lags
+    (``--plant jsbsim``: :func:`fms_testbed.cli.tune_envelope.cmd_analyse_jsbsim`)."""
+    if getattr(args, "plant", "pointmass") == "jsbsim":
+        from fms_testbed.cli.tune_envelope import cmd_analyse_jsbsim
+
+        return cmd_analyse_jsbsim(args)
     from fms_testbed.control.coupled_law import params_from_config
     from fms_testbed.viz.control import plot_bode_coupling, plot_linear_steps
     from fms_testbed.viz.figure import save
@@ -217,27 +258,8 @@ def cmd_analyse(args) -> int:
     print(f"{cfg.name}: T_V {p.T_V_s} s, xi_V {p.xi_V}, T_H {p.T_H_s} s, xi_H {p.xi_H}, "
           f"V0 {V0 / KMH_MPS:.0f} km/h")
     for label, (tx, ty, meas) in cases.items():
-        sys = linear.closed_loop(p, V0, tx, ty, use_measured_nx=meas)
-        r = linear.decoupling_report(sys, p, w)
-        freq[label] = linear.frequency_response(sys, w)
-        sv, sh = linear.step_responses(sys, t, args.dv * KMH_MPS, args.dh)
-        steps[label] = (sv, sh)
-        report[label] = {
-            "max|W_V,Hcmd|/max|W_V,Vcmd|": r.off_V_from_H, "max|W_H,Vcmd|/max|W_H,Hcmd|":
-                r.off_H_from_V, "pole_error_rps": r.pole_error,
-            "poles_rps": [complex(x) for x in np.sort_complex(r.poles)],
-            "dc_gain": r.dc_gain.tolist(),
-            f"max|dV| in {args.dh:g} m step, km/h": float(np.abs(sh[0]).max() / KMH_MPS),
-            f"max|dH| in {args.dv:g} km/h step, m": float(np.abs(sv[1]).max())}
-        print(f"\n[{label}]")
-        print(f"  cross terms: |W_V,Hcmd|/|W_V,Vcmd| = {r.off_V_from_H:.3g}, "
-              f"|W_H,Vcmd|/|W_H,Hcmd| = {r.off_H_from_V:.3g}")
-        print(f"  poles: {', '.join(f'{x.real:.4f}{x.imag:+.4f}j' for x in np.sort_complex(r.poles))}")
-        print(f"  desired (T, xi) poles: "
-              f"{', '.join(f'{x.real:.4f}{x.imag:+.4f}j' for x in np.sort_complex(r.desired_poles))}"
-              f"  -> max distance {r.pole_error:.2g} rad/s")
-        print(f"  max|dV| during a {args.dh:g} m step: {np.abs(sh[0]).max() / KMH_MPS:.3g} km/h; "
-              f"max|dH| during a {args.dv:g} km/h step: {np.abs(sv[1]).max():.3g} m")
+        freq[label], steps[label], report[label] = _analyse_case(label, p, V0, (tx, ty, meas),
+                                                                 w, t, args)
     worst = max(report.values(), key=lambda r: r["max|W_V,Hcmd|/max|W_V,Vcmd|"])
     lag_label = max(report, key=lambda k: report[k]["max|W_V,Hcmd|/max|W_V,Vcmd|"])
     save(plot_bode_coupling(w, freq, f"{cfg.name}: closed-loop W(jω) at {V0 / KMH_MPS:.0f} km/h "
@@ -258,8 +280,33 @@ def cmd_analyse(args) -> int:
 
 # --- tune ----------------------------------------------------------------------------------
 
+def _tune_report(cfg, args, res, op, alt: float, tas: float, hist: pd.DataFrame) -> str:
+    """``report.md`` of a single-point ``tune`` (altitude m, TAS m/s)."""
+    from fms_testbed.evaluation.law_tuning import gains_yaml
+
+    b = res.best
+    start, best = res.start.row(), b.row()
+    keys = [k for k in best if k not in ("note",)]
+    tab = pd.DataFrame({"start": [start.get(k) for k in keys], "tuned": [best.get(k) for k in keys]},
+                       index=keys)
+    report = (f"# Tuning of the coupled law — {cfg.name}\n\n"
+              f"Operating point {alt:.0f} m, {tas / KMH_MPS:.0f} km/h TAS; altitude step {op.dH_m:g} m, "
+              f"speed step {op.speed_step_mps / KMH_MPS:.0f} km/h; {len(res.history)} evaluations on "
+              f"{args.plant} (bounded Nelder-Mead). Criteria: see `fms_testbed/evaluation/law_tuning.py` (module docstring)."
+              f"\n\nIdentified inner-loop lags: n_x {res.lags_s[0]:.2f} s, n_y "
+              f"{res.lags_s[1]:.2f} s.\n\n```yaml\n{gains_yaml(b.params)}\n```\n\n"
+              f"{markdown_table(tab.reset_index().rename(columns={'index': 'quantity'}))}\n\n"
+              f"![tuned vs linear](tuned-vs-linear.png)\n\n## History\n\n{markdown_table(hist)}\n")
+    return report
+
+
 def cmd_tune(args) -> int:
-    """Optimise the law's (T, ξ) on JSBSim; write gains, report and plots."""
+    """Optimise the law's (T, ξ) on JSBSim; write gains, report and plots
+    (``--envelope``: :func:`fms_testbed.cli.tune_envelope.cmd_tune_envelope`)."""
+    if getattr(args, "envelope", False):
+        from fms_testbed.cli.tune_envelope import cmd_tune_envelope
+
+        return cmd_tune_envelope(args)
     from fms_testbed.viz.control import plot_tuning_overlay
     from fms_testbed.viz.figure import save
     from fms_testbed.evaluation.law_tuning import (OperatingPoint, gains_yaml, linear_prediction, tune,
@@ -300,18 +347,7 @@ def cmd_tune(args) -> int:
                              f"{b.params.T_H_s:.2f} s, ξ_H {b.params.xi_H:.2f}",
                              plant={"jsbsim": "JSBSim"}.get(args.plant, "point mass")),
          tmp / "tuned-vs-linear.png")
-    start, best = res.start.row(), b.row()
-    keys = [k for k in best if k not in ("note",)]
-    tab = pd.DataFrame({"start": [start.get(k) for k in keys], "tuned": [best.get(k) for k in keys]},
-                       index=keys)
-    report = (f"# Tuning of the coupled law — {cfg.name}\n\n"
-              f"Operating point {alt:.0f} m, {tas / KMH_MPS:.0f} km/h TAS; altitude step {op.dH_m:g} m, "
-              f"speed step {op.speed_step_mps / KMH_MPS:.0f} km/h; {len(res.history)} evaluations on "
-              f"{args.plant} (bounded Nelder-Mead). Criteria: see `fms_testbed/control/tuning.py`."
-              f"\n\nIdentified inner-loop lags: n_x {res.lags_s[0]:.2f} s, n_y "
-              f"{res.lags_s[1]:.2f} s.\n\n```yaml\n{gains_yaml(b.params)}\n```\n\n"
-              f"{markdown_table(tab.reset_index().rename(columns={'index': 'quantity'}))}\n\n"
-              f"![tuned vs linear](tuned-vs-linear.png)\n\n## History\n\n{markdown_table(hist)}\n")
+    report = _tune_report(cfg, args, res, op, alt, tas, hist)
     (tmp / "report.md").write_text(report)
     print(f"\nbest: {gains_yaml(b.params)}  (cost {b.cost:.3f}, start {res.start.cost:.3f})")
     if args.write:
@@ -326,6 +362,12 @@ def cmd_tune(args) -> int:
 
 def register(subparsers) -> None:
     """Add ``compare``, ``analyse`` and ``tune`` to the ``fms-testbed`` parser."""
+    _register_compare(subparsers)
+    _register_analyse(subparsers)
+    _register_tune(subparsers)
+
+
+def _register_compare(subparsers) -> None:
     p = subparsers.add_parser(
         "compare", help="coupled law vs baselines on JSBSim: table, goals, plots",
         description="Fly scenarios with the coupled law and the baselines (PI autothrottle, TECS) "
@@ -354,6 +396,8 @@ def register(subparsers) -> None:
     add_overwrite_option(p)
     p.set_defaults(func=cmd_compare)
 
+
+def _register_analyse(subparsers) -> None:
     p = subparsers.add_parser(
         "analyse", help="linear analysis of the coupled law (python-control)",
         description="Closed-loop transfer matrix W(p) of the linearised point mass + law: "
@@ -369,8 +413,14 @@ def register(subparsers) -> None:
     p.add_argument("--dv", type=float, default=50.0, help="speed step for the plots, km/h")
     p.add_argument("--out", help="output folder (default results/analyse-<aircraft>-<time>)")
     add_overwrite_option(p)
+    p.add_argument("--plant", choices=("pointmass", "jsbsim"), default="pointmass",
+                   help="jsbsim: linearise the trimmed JSBSim aircraft (FGLinearization), print "
+                        "its modes checked against the nonlinear model, the loops' margins and "
+                        "the point-mass comparison")
     p.set_defaults(func=cmd_analyse)
 
+
+def _register_tune(subparsers) -> None:
     p = subparsers.add_parser(
         "tune", help="tune the coupled law's (T_V, xi_V, T_H, xi_H) on JSBSim",
         description="Bounded Nelder-Mead over (T_V, xi_V, T_H, xi_H) on the JSBSim closed loop "
@@ -386,6 +436,16 @@ def register(subparsers) -> None:
     p.add_argument("--plant", choices=("jsbsim", "pointmass"), default="jsbsim")
     p.add_argument("--write", action="store_true",
                    help="write the tuned coupled_law block into the aircraft's YAML file")
+    p.add_argument("--envelope", action="store_true",
+                   help="tune over a grid of design points into a gain schedule in (dynamic "
+                        "pressure, mass): margins on every loop, robustness, nonlinear checks; "
+                        "writes points.csv, schedule.yaml, aircraft.yaml, report.md, figures")
+    p.add_argument("--grid", metavar="FILE.yaml",
+                   help="with --envelope: design points (points: [{alt_m, tas_mps, mass_kg, "
+                        "config: clean|approach}]) instead of the default grid")
+    p.add_argument("--workers", type=int, default=2, help="with --envelope: local processes")
+    p.add_argument("--no-robust", action="store_true",
+                   help="with --envelope: skip the robustness set (mass, CG, actuator delay)")
     p.add_argument("--out", help="output folder (default results/tune-<aircraft>-<time>)")
     add_overwrite_option(p)
     p.set_defaults(func=cmd_tune)

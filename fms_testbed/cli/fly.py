@@ -17,11 +17,14 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fms_testbed.cli.common import (add_override_options, add_overwrite_option, overrides_from_args,
-                                    print_results)
+from fms_testbed.cli.common import (add_override_options, add_overwrite_option, out_path,
+                                    overrides_from_args, print_results)
 from fms_testbed.run.outputs import check_out_dir
 from fms_testbed.core.errors import UserError
 from fms_testbed.data import results_dir
+
+KIND = "fly"
+"""``run.json`` ``kind`` of a ``fly`` output folder."""
 
 
 def scenario_from_args(args) -> dict:
@@ -48,16 +51,18 @@ def cmd_fly(args) -> int:
     else:
         scenario = scenario_from_args(args)
         default = scenario["name"]
-    out = Path(args.out) if args.out else results_dir() / default
-    check_out_dir(out, args.overwrite)                          # before any work
+    out = out_path(args.out, results_dir() / default)
+    inputs = [args.scenario or (scenario["procedure"]["db"] if args.db else None)]
+    check_out_dir(out, args.overwrite, KIND, inputs)            # before any work
     from fms_testbed.evaluation.outcome import EXIT_CODES
     from fms_testbed.run.api import run_scenario
 
-    overrides = overrides_from_args(args)
+    from fms_testbed.cli.run import with_truth_model
+    overrides = with_truth_model(overrides_from_args(args), args)
     if args.takeoff:
         overrides.setdefault("procedure", {})["start"] = "takeoff"
     res = run_scenario(scenario, seed=args.seed, overrides=overrides, progress=None)
-    res.save(out, csv=args.csv, plots=not args.no_plots, overwrite=args.overwrite)
+    res.save(out, csv=args.csv, plots=not args.no_plots, overwrite=args.overwrite, kind=KIND)
     print_results(res)
     if res.summary.get("takeoff"):
         print(takeoff_line(res.summary["takeoff"]))
@@ -92,6 +97,8 @@ def register(sub) -> None:
     p.add_argument("--transition", help="en-route (SID/STAR) or approach transition")
     p.add_argument("--runway", help="runway, e.g. 34R (SID/STAR runway transition)")
     add_override_options(p)
+    from fms_testbed.cli.run import add_truth_model_option
+    add_truth_model_option(p)
     p.add_argument("--takeoff", action="store_true",
                    help="SIDs: start at rest on the runway threshold with a takeoff roll "
                         "(procedure.start: takeoff; default: airborne over the runway end)")

@@ -18,31 +18,65 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
-from fms_testbed.cli.common import add_overwrite_option
+from fms_testbed.cli.common import SEED, add_overwrite_option, out_path
 from fms_testbed.core.errors import UserError
 from fms_testbed.run.outputs import OutputFolder
 from fms_testbed.data import results_dir
 
 DEFAULT_STAGES = "none,temperature,run-to-run,slow-drift"
+MIN_DURATION_S = 60.0
+"""Shortest test, s (the run-to-run stage averages the first 60 s after switch-on)."""
+BYTES_PER_SAMPLE = 300
+"""Peak memory of the test per output sample of the triad, bytes, with the series of every
+stage held whole (an upper bound of the peak RSS over the interpreter's, ``--allan`` included)."""
+MEMORY_SHARE = 0.5
+"""Share of the machine's available memory a test may take."""
 
 
-def cmd_imu_test(args) -> int:
-    """Run the static test, write the CSV, the summary and the plots; print one line per stage."""
-    from fms_testbed.sensors.mems.compensation import parse_stages
-    from fms_testbed.sensors.mems.static_test import run_static_test
+def available_memory_b() -> int | None:
+    """``MemAvailable`` of ``/proc/meminfo``, bytes (None where it cannot be read)."""
+    try:
+        for line in Path("/proc/meminfo").read_text().splitlines():
+            if line.startswith("MemAvailable:"):
+                return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        return None
+    return None
+
+
+def check_duration(duration_h: float, rate_hz: float, memory_b: int | None) -> float:
+    """The test length, s, after the bounds: at least :data:`MIN_DURATION_S`, and no more
+    samples than :data:`MEMORY_SHARE` of the available memory holds at
+    :data:`BYTES_PER_SAMPLE` (a one-line refusal naming the limit otherwise).
+
+    Parameters
+    ----------
+    duration_h : ``--duration-h``, h
+    rate_hz : the preset's output rate, Hz
+    memory_b : available memory, bytes (None: unknown, only the lower bound applies)
+    """
+    import math
+
+    if not (math.isfinite(duration_h) and duration_h * 3600.0 >= MIN_DURATION_S):
+        raise UserError(f"--duration-h {duration_h:g}: must be a finite number of hours >= "
+                        f"{MIN_DURATION_S / 3600.0:.4f} ({MIN_DURATION_S:.0f} s)")
+    if memory_b is not None:
+        limit_h = MEMORY_SHARE * memory_b / BYTES_PER_SAMPLE / rate_hz / 3600.0
+        if duration_h > limit_h:
+            raise UserError(f"--duration-h {duration_h:g}: longer than this machine can hold "
+                            f"in memory: at most {limit_h:.0f} h at {rate_hz:g} Hz "
+                            f"({BYTES_PER_SAMPLE} B per sample, {MEMORY_SHARE:.0%} of "
+                            f"{memory_b / 2**30:.1f} GiB available)")
+    return duration_h * 3600.0
+
+
+def _write(res, stages, tmp: Path) -> dict:
+    """Write the CSV, the plots and ``summary.json`` of a test into ``tmp``; the summary."""
     from fms_testbed.viz.figure import save
     from fms_testbed.viz.mems import (plot_accumulated_angle, plot_allan,
                                       plot_residual_after_run_to_run,
                                       plot_zero_signal_vs_temperature)
 
-    stages = parse_stages(args.stages)
-    if not args.duration_h > 0:
-        raise UserError(f"--duration-h must be > 0 h, got {args.duration_h}")
-    out = Path(args.out) if args.out else results_dir() / f"imu-test-{Path(args.imu).stem}"
-    folder = OutputFolder(out, getattr(args, "overwrite", False))  # checked before the work
-    res = run_static_test(args.imu, args.duration_h * 3600.0, args.temperature_profile, stages,
-                          args.seed, allan=args.allan)
-    tmp = folder.open()
     res.angle_frame().to_csv(tmp / "accumulated_angle.csv", index=False, float_format="%.7g")
     plots = {"accumulated_angle.png": plot_accumulated_angle}
     if res.calibration is not None:
@@ -56,6 +90,29 @@ def cmd_imu_test(args) -> int:
     summary = res.summary()
     summary["outputs"] = ["accumulated_angle.csv", "summary.json", *sorted(plots)]
     (tmp / "summary.json").write_text(json.dumps(summary, indent=1, allow_nan=False) + "\n")
+    return summary
+
+
+def cmd_imu_test(args) -> int:
+    """Run the static test, write the CSV, the summary and the plots; print one line per stage."""
+    from fms_testbed.sensors.mems.compensation import parse_stages
+    from fms_testbed.sensors.mems.preset import load_mems
+    from fms_testbed.sensors.mems.static_test import run_static_test
+
+    stages = parse_stages(args.stages)
+    duration_s = check_duration(args.duration_h, load_mems(args.imu).sample_rate_hz,
+                                available_memory_b())
+    out = out_path(args.out, results_dir() / f"imu-test-{Path(args.imu).stem}")
+    inputs = [f for f in (args.imu, args.temperature_profile) if f and Path(f).suffix]
+    folder = OutputFolder(out, getattr(args, "overwrite", False), "imu-test", inputs)  # first
+    res = run_static_test(args.imu, duration_s, args.temperature_profile, stages,
+                          args.seed, allan=args.allan)
+    try:
+        with folder as tmp:
+            summary = _write(res, stages, tmp)
+            folder.set_run_info(seed=args.seed)
+    except OSError as exc:
+        raise UserError(f"--out {out}: cannot write the outputs: {exc.strerror or exc}") from None
     print(f"{res.imu}: {res.duration_s / 3600:g} h static at {res.rate_hz:g} Hz, profile "
           f"{res.profile.name}, seed {res.seed} ({res.wall_time_s:.1f} s)")
     for st, r in res.stage.items():
@@ -67,7 +124,6 @@ def cmd_imu_test(args) -> int:
               f" deg/sqrt(h), bias instability "
               f"{', '.join(f'{v:.3f}' for v in a.bias_instability_deg_per_h)} deg/h")
     print(f"  outputs in {out}: {', '.join(summary['outputs'])}")
-    folder.commit()
     return 0
 
 
@@ -77,15 +133,17 @@ def register(sub) -> None:
                                         "compensation (temperature, run-to-run, slow drift)")
     p.add_argument("--imu", default="STIM210", help="MEMS gyro preset or YAML file "
                                                     "(default STIM210)")
-    p.add_argument("--duration-h", type=float, default=2.0, help="test length, h (default 2)")
+    p.add_argument("--duration-h", type=float, default=2.0,
+                   help="test length, h (default 2; at least 60 s, at most what half the "
+                        "available memory holds: about 240 B per sample)")
     p.add_argument("--temperature-profile", default="warmup",
                    help="warmup (switch-on self-heating, default), ramp (thermal cycle over the "
                         "operating range), constant, or a CSV file with t_s,temperature_degC")
     p.add_argument("--stages", default=DEFAULT_STAGES,
                    help=f"compensation stages to apply and report, comma-separated "
                         f"(default {DEFAULT_STAGES})")
-    p.add_argument("--seed", type=int, default=0, help="seed of the calibration and test runs "
-                                                       "(default 0)")
+    p.add_argument("--seed", type=SEED, default=0, help="seed of the calibration and test runs "
+                                                        "(default 0)")
     p.add_argument("--allan", action="store_true",
                    help="fit ARW and bias instability from the overlapping Allan deviation")
     p.add_argument("--out", help="output folder (default results/imu-test-<imu>)")

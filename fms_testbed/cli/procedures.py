@@ -133,6 +133,8 @@ def cmd_check(args) -> int:
           f"{summary['max_rf_radius_err_nm']:.4f} NM, turn mismatches "
           f"{summary['turn_mismatches']}")
     print(f"  corrections by branch: {summary['branches']}; flags: {summary['flags']}")
+    print(f"  class 3 (database coding) found: {summary['class3_transitions']} transitions; "
+          f"coded numbers against the fixes by kind: {summary['class3_by_kind'] or 'none'}")
     print(f"  wrote {out / 'procedures_check.parquet'}, .csv and summary.json")
     folder.commit()
     return 0 if not math.isnan(summary["ok_or_corrected_pct"]) else 1

@@ -28,7 +28,11 @@ import os
 import sys
 from pathlib import Path
 
-from fms_testbed.cli.common import WIND_HELP, parse_isa_dev, parse_wind
+from fms_testbed.cli.common import (SEED, WIND_HELP, bounded_float, bounded_int, out_path,
+                                    parse_isa_dev, parse_wind)
+
+MAX_CASES = 10_000_000
+"""Largest ``--limit``, cases."""
 from fms_testbed.core.errors import UserError
 
 
@@ -81,14 +85,18 @@ def config_from_args(args):
                             "set)")
         sets = read_conditions(args.conditions)
     else:
-        sets = command_line_sets(_winds(args.wind), _navs(args.nav, args.imu),
+        navs = _navs(args.nav, args.imu)
+        if getattr(args, "truth_model", None):
+            navs = [n if n["source"] == "truth" else {**n, "truth_model": args.truth_model}
+                    for n in navs]
+        sets = command_line_sets(_winds(args.wind), navs,
                                  [parse_isa_dev(v) for v in args.isa_dev_c or []] or None,
                                  missed=args.missed)
     if args.sample_airports is None and (args.sample_seed is not None
                                          or args.sample_min_transitions is not None):
         raise UserError("--sample-seed/--sample-min-transitions need --sample-airports N")
     return RunConfig(
-        out=Path(args.out), conditions=sets, db=args.db, airports=args.airports,
+        out=out_path(args.out), conditions=sets, db=args.db, airports=args.airports,
         sample_airports=args.sample_airports, sample_seed=args.sample_seed or 0,
         sample_min_transitions=args.sample_min_transitions or 1,
         types=parse_types(args.types), aircraft=_split(args.aircraft) or ["737"],
@@ -96,7 +104,7 @@ def config_from_args(args):
         workers=args.workers or os.cpu_count() or 1, scheduler=args.scheduler,
         case_timeout_s=args.case_timeout, keep=tuple(_split([args.keep] if args.keep else [])),
         progress=False if args.no_progress else None, command=list(sys.argv), phase=args.phase,
-        batch_rows=args.batch_rows)
+        batch_rows=args.batch_rows, overwrite=args.overwrite)
 
 
 def cmd_run(args) -> int:
@@ -114,31 +122,72 @@ def cmd_run(args) -> int:
     if s["sum_loop_wall_s"]:
         over = 100.0 * (s["sum_wall_s"] - s["sum_loop_wall_s"]) / s["sum_loop_wall_s"]
         print(f"  per-case overhead (wall_s - loop_wall_s) / loop_wall_s: {over:.1f} %")
+    if s.get("quarantined"):
+        print(f"  {len(s['quarantined'])} damaged part file(s) moved to {args.out}/quarantine, "
+              "their cases flown again")
     if info["status"] != "complete":
         print("  not every case is written: run the same command again to resume")
     return 0
+
+
+def markdown_target(path: str, runs: list[str]) -> Path:
+    """The ``--markdown`` file, checked before the diff: not a folder, its folder exists and is
+    writable, and not inside either run folder compared (an input is never written).
+
+    Parameters
+    ----------
+    path : the ``--markdown`` value; runs : the run folders compared
+    """
+    out = Path(path)
+    if not path.strip():
+        raise UserError("--markdown '': give a file name")
+    if out.is_dir():
+        raise UserError(f"--markdown {path}: is a folder; give the Markdown file to write")
+    if out.is_symlink():
+        raise UserError(f"--markdown {path}: is a symbolic link; give the real file")
+    target = out.absolute().resolve()
+    for r in runs:
+        if target.is_relative_to(Path(r).absolute().resolve()):
+            raise UserError(f"--markdown {path}: lies inside the run folder {r} that is "
+                            "compared; write it elsewhere (an input is never written)")
+    parent = target.parent
+    if not parent.is_dir():
+        raise UserError(f"--markdown {path}: folder {parent} does not exist")
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise UserError(f"--markdown {path}: cannot write in {parent} (permission denied)")
+    return out
 
 
 def cmd_diff(args) -> int:
     """Compare two runs; exit 1 when something changed beyond tolerance."""
     from fms_testbed.campaign.diff import diff_runs, read_tolerances
 
+    md = markdown_target(args.markdown, [args.run_a, args.run_b]) if args.markdown is not None \
+        else None
     tol = read_tolerances(args.tolerance) if args.tolerance else None
     res = diff_runs(args.run_a, args.run_b, tol, args.across_conditions)
     print(res.text())
-    if args.markdown:
-        Path(args.markdown).write_text(res.markdown())
+    if md is not None:
+        tmp = md.with_name(f".{md.name}.tmp")
+        try:
+            tmp.write_text(res.markdown())
+            tmp.replace(md)
+        except OSError as exc:
+            tmp.unlink(missing_ok=True)
+            raise UserError(f"--markdown {md}: cannot write: {exc.strerror or exc}") from None
         print(f"  Markdown summary: {args.markdown}")
     return 0 if res.clean else 1
 
 
 def cmd_report(args) -> int:
-    """Write DIR/report.html."""
+    """Write DIR/report.html; print its status counted from the data."""
     from fms_testbed.campaign.report import write_report
 
-    path = write_report(args.dir, worst=args.worst, others=args.others or [],
-                        refly=not args.no_refly)
-    print(f"wrote {path}")
+    if args.worst < 0:
+        raise UserError(f"--worst {args.worst}: must be >= 0")
+    path, line = write_report(args.dir, worst=args.worst, others=args.others or [],
+                              refly=not args.no_refly)
+    print(f"wrote {path}\n  {line}")
     return 0
 
 
@@ -161,18 +210,15 @@ def cmd_testdb(args) -> int:
     return 0
 
 
-def register(sub) -> None:
-    """Add ``regress run|diff|report``."""
-    p = sub.add_parser("regress", help="procedure-database regression runs: run, diff, report")
-    rs = p.add_subparsers(dest="regress_command", metavar="SUBCOMMAND")
-
+def _add_run(rs) -> None:
+    """``regress run``'s options."""
     r = rs.add_parser("run", help="fly every procedure of a database (resumable)")
     r.add_argument("--db", help="ARINC-424 file (default: the embedded excerpt)")
     r.add_argument("--airports", nargs="+", metavar="ICAO", help="airports (default: all)")
-    r.add_argument("--sample-airports", type=int, metavar="N",
+    r.add_argument("--sample-airports", type=bounded_int(1, 100_000), metavar="N",
                    help="fly a seeded sample of N airports (of --airports, or of all)")
-    r.add_argument("--sample-seed", type=int, metavar="S", help="seed of the sample (default 0)")
-    r.add_argument("--sample-min-transitions", type=int, metavar="K",
+    r.add_argument("--sample-seed", type=SEED, metavar="S", help="seed of the sample (default 0)")
+    r.add_argument("--sample-min-transitions", type=bounded_int(1, 10_000), metavar="K",
                    help="sample only airports with ≥ K transitions of the --types (default 1)")
     r.add_argument("--types", help="SID,STAR,APPROACH (default all three)")
     r.add_argument("--aircraft", nargs="+", help="aircraft names or files, e.g. 737,global5000 "
@@ -186,6 +232,8 @@ def register(sub) -> None:
                    help="navigation sources: truth or SOURCE[:PRESET], e.g. sins:HG1700, "
                         "ins_gnss:STIM300 (default truth)")
     r.add_argument("--imu", help="IMU preset for --nav sins")
+    from fms_testbed.cli.run import add_truth_model_option
+    add_truth_model_option(r)
     r.add_argument("--conditions", metavar="FILE.yaml",
                    help="condition sets from a YAML file (instead of --wind/--isa-dev-c/--nav)")
     r.add_argument("--missed", action="store_true",
@@ -194,25 +242,35 @@ def register(sub) -> None:
     r.add_argument("--combinations", choices=("each", "all"), default="each",
                    help="each: fewest sequences flying every transition once (default); all: "
                         "every runway × en-route/approach transition")
-    r.add_argument("--limit", type=int, metavar="N", help="fly only the first N cases")
-    r.add_argument("--seed", type=int, default=0, help="campaign seed (default 0)")
+    r.add_argument("--limit", type=bounded_int(1, MAX_CASES), metavar="N", help="fly only the first N cases")
+    r.add_argument("--seed", type=SEED, default=0, help="campaign seed (default 0)")
     ex = r.add_mutually_exclusive_group()
-    ex.add_argument("--workers", type=int, metavar="N",
+    ex.add_argument("--workers", type=bounded_int(1, 1024), metavar="N",
                     help="local worker processes (default: the number of CPUs)")
     ex.add_argument("--scheduler", metavar="tcp://HOST:PORT",
                     help="an existing dask.distributed scheduler (workers with --nthreads 1)")
-    r.add_argument("--case-timeout", type=float, metavar="S",
+    r.add_argument("--case-timeout", type=bounded_float(0.0, 7 * 86400.0, "s", lo_open=True), metavar="S",
                    help="wall-time limit of one case, s")
     r.add_argument("--keep", help="per-case artefacts to keep: timeseries,plots (in DIR/cases)")
     r.add_argument("--phase", choices=("test-db", "integration"),
                    help="Danilin phase of the run for the report (default: test-db when the "
                         "database has a test-database manifest, else inferred from the size)")
-    r.add_argument("--batch-rows", type=int, default=64, metavar="N",
+    r.add_argument("--batch-rows", type=bounded_int(1, 100_000), default=64, metavar="N",
                    help="rows per Parquet part file at most (default 64; a part is also "
                         "written every 15 s)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.add_argument("--out", required=True, help="campaign folder (resumed when it holds one)")
+    r.add_argument("--overwrite", action="store_true",
+                   help="replace an --out folder holding another kind of run, other files or a "
+                        "run of other cases (never an input)")
     r.set_defaults(func=cmd_run)
+
+
+def register(sub) -> None:
+    """Add ``regress run|diff|report|testdb``."""
+    p = sub.add_parser("regress", help="procedure-database regression runs: run, diff, report")
+    rs = p.add_subparsers(dest="regress_command", metavar="SUBCOMMAND")
+    _add_run(rs)
 
     d = rs.add_parser("diff", help="compare two runs (exit 1 when something changed)")
     d.add_argument("run_a", help="campaign folder A (the reference)")
@@ -225,7 +283,7 @@ def register(sub) -> None:
 
     q = rs.add_parser("report", help="write DIR/report.html (self-contained)")
     q.add_argument("dir", help="campaign folder")
-    q.add_argument("--worst", type=int, default=6, help="worst cases drawn (default 6)")
+    q.add_argument("--worst", type=bounded_int(0, 1000), default=6, help="worst cases drawn (default 6)")
     q.add_argument("--with", dest="others", nargs="+", metavar="DIR",
                    help="other runs for the phase table (e.g. the test-database phase)")
     q.add_argument("--no-refly", action="store_true",

@@ -14,14 +14,32 @@ from fms_testbed.data import results_dir, scenarios_dir
 DEMO_SCENARIO = "demo-sid.yaml"
 
 
+TRUTH_MODELS = ("strapdown", "linear")
+
+
+def add_truth_model_option(p) -> None:
+    """Add ``--truth-model strapdown|linear`` (the INS units' truth side) to a parser."""
+    p.add_argument("--truth-model", choices=TRUTH_MODELS,
+                   help="truth side of the INS units: strapdown mechanisation of a simulated "
+                        "IMU, or truth + the linear 33-state error model (default: the "
+                        "source's, strapdown for ins_gnss, linear for sins)")
+
+
+def with_truth_model(overrides: dict, args) -> dict:
+    """``overrides`` with the ``--truth-model`` of ``args`` (when given)."""
+    if getattr(args, "truth_model", None):
+        overrides["navigation_truth_model"] = args.truth_model
+    return overrides
+
+
 def _fly(scenario, out: Path, args) -> int:
     """Fly a scenario (file or mapping) with the command's overrides; exit code from the status."""
     check_out_dir(out, getattr(args, "overwrite", False))      # before any work
     from fms_testbed.evaluation.outcome import EXIT_CODES
     from fms_testbed.run.api import run_scenario
 
-    res = run_scenario(scenario, seed=args.seed, overrides=overrides_from_args(args),
-                       progress=None)
+    res = run_scenario(scenario, seed=args.seed,
+                       overrides=with_truth_model(overrides_from_args(args), args), progress=None)
     res.save(out, csv=args.csv, plots=not getattr(args, "no_plots", False),
              overwrite=getattr(args, "overwrite", False))
     print_results(res)
@@ -48,6 +66,7 @@ def register(sub) -> None:
     p.add_argument("scenario", help="scenario YAML file")
     p.add_argument("--out", help="output folder (default results/<scenario name>)")
     add_override_options(p)
+    add_truth_model_option(p)
     p.add_argument("--csv", action="store_true", help="also write timeseries.csv")
     p.add_argument("--no-plots", action="store_true", help="skip the PNG plots")
     add_overwrite_option(p)

@@ -142,6 +142,26 @@ class CoupledLawGains(_Frozen):
     dH_limit_m: Pos = Field(100.0, description="altitude-error limit (level-change mode), m")
 
 
+class SchedulePoint(_Frozen):
+    """One row of the coupled law's gain schedule: the scheduling variables and the tuning."""
+
+    qbar_pa: Pos = Field(description="dynamic pressure, Pa")
+    mass_kg: Pos = Field(description="mass, kg")
+    T_V_s: Pos = Field(description="speed-channel time constant, s")
+    xi_V: Pos = Field(description="speed-channel damping ratio")
+    T_H_s: Pos = Field(description="altitude-channel time constant, s")
+    xi_H: Pos = Field(description="altitude-channel damping ratio")
+    ny_trim_tau_s: Pos = Field(description="n_y tracking-error integrator time constant, s")
+
+
+class CoupledLawSchedule(_Frozen):
+    """Gain schedule of the coupled law in dynamic pressure and mass (``fms-testbed tune
+    --envelope``): a table, piecewise linear in ln q̄ per mass level and linear in mass
+    (:mod:`fms_testbed.control.schedule`)."""
+
+    points: list[SchedulePoint] = Field(min_length=1)
+
+
 class FlapDetent(_Frozen):
     """One flap detent the approach schedule uses: its name (as the crew calls it), the
     normalised JSBSim command ``fcs/flap-cmd-norm`` that selects it (the model's own traverse
@@ -285,6 +305,9 @@ class AircraftConfig(_Frozen):
     inner_loops: InnerLoopGains
     inner_spec: InnerLoopSpec = Field(default_factory=InnerLoopSpec)
     coupled_law: CoupledLawGains | None = None
+    coupled_law_schedule: CoupledLawSchedule | None = Field(
+        None, description="gains of the coupled law scheduled in dynamic pressure and mass "
+                          "(replace T_V_s, xi_V, T_H_s, xi_H of coupled_law in flight)")
     approach: ApproachSettings | None = Field(
         None, description="approach speeds and configuration (None: flown clean at the "
                           "planned approach speed)")

@@ -45,7 +45,10 @@ class SinsBlock(BaseModel):
         60.0, description="baro loop time constant, s")
     tol: Annotated[float, Field(gt=0, lt=1e-3)] = Field(
         1e-12, description="adaptive Picard tolerance (relative)")
-    alignment: Literal["stationary", "none"] = Field(
+    truth_model: Literal["linear", "strapdown"] = Field(
+        "linear", description="truth ⊕ the 33-state model, or a strapdown mechanisation of a "
+                              "simulated IMU (vertical baro-aided or free)")
+    alignment: Literal["stationary", "none", "gnss_heading"] = Field(
         "stationary", description="initial attitude errors from a stationary self-alignment, "
                                   "or independent")
     matrices_dt_s: Annotated[float, Field(ge=0, le=60)] = Field(
@@ -108,6 +111,13 @@ class GnssBlock(BaseModel):
     outages: list[IntervalBlock] = Field(default_factory=list, description="no fix inside these")
     outliers: list[OutlierBlock] = Field(default_factory=list, description="outlier bursts")
     ramps: list[RampBlock] = Field(default_factory=list, description="slow ramp faults")
+    antenna_lever_arm_m: Annotated[list[Annotated[float, Field(ge=-100, le=100)]],
+                                   Field(min_length=3, max_length=3)] = Field(
+        [0.0, 0.0, 0.0], description="antenna position from the CG, body x fwd/y right/z down, m")
+    time_tag_error_s: Annotated[float, Field(ge=-1, le=1)] = Field(
+        0.0, description="truth side: fixes are valid this long before their time stamp, s")
+    time_tag_sigma_s: Annotated[float, Field(ge=0, le=1)] = Field(
+        0.0, description="declared 1σ of the time-tag error (the filter's R allows for it), s")
 
     @model_validator(mode="after")
     def _latency(self):
@@ -144,6 +154,9 @@ class FilterBlock(BaseModel):
         1.0, description="longest interval the covariance is propagated over at once (F "
                          "averaged over it), s; a measurement or a GNSS epoch ends one too; "
                          "0: every navigation step")
+    reset_after: Annotated[int, Field(ge=0, le=1000)] = Field(
+        10, description="consecutive gate rejections of a measurement after which the "
+                        "covariance of the states it observes is reset (0: never)")
     predict_rotation_deg: Annotated[float, Field(gt=0, le=90)] = Field(
         1.0, description="an interval also ends once the body has turned this much in it, deg")
 
@@ -164,6 +177,15 @@ class InsGnssBlock(BaseModel):
     baro: BaroBlock | None = Field(default_factory=BaroBlock,
                                    description="baro altimeter (null: none)")
     filter: FilterBlock = Field(default_factory=FilterBlock, description="filter settings")
+    truth_model: Literal["strapdown", "linear"] = Field(
+        "strapdown", description="truth side of the INS units: strapdown mechanisation of a "
+                                 "simulated IMU, or truth ⊕ the linear 33-state error model")
+    alignment: Literal["stationary", "gnss_heading"] = Field(
+        "stationary", description="strapdown units' initial alignment (levelling + "
+                                  "gyrocompassing at rest, or in-air levelling + GNSS heading)")
+    record_sensors: bool = Field(
+        False, description="write the flight's IMU/GNSS/init files (the nav-replay format) "
+                           "into the run folder's sensors/")
     matrices_dt_s: Annotated[float, Field(ge=0, le=10)] = Field(
         1.0, description="the INS units' error model (truth side) reuses its Φ_k, S_k this long, "
                          "s (0: every step) ...")

@@ -11,7 +11,8 @@ from typing import Protocol
 
 from fms_testbed.core.state import AircraftState
 from fms_testbed.control.baselines import SeparateChannelsLaw, TecsLaw
-from fms_testbed.control.coupled_law import CoupledLaw, CoupledLawParams, params_from_config
+from fms_testbed.control.coupled_law import (CoupledLaw, CoupledLawParams, params_from_config,
+                                             schedule_from_config)
 
 
 class VerticalLaw(Protocol):
@@ -44,9 +45,10 @@ def procedure_law(cfg):
     g = cfg.coupled_law
     dh = max(g.dH_limit_m, LAW_CLIMB_FRACTION * cfg.limits.climb_rate_max_mps
              * 2.0 * g.xi_H * g.T_H_s)
-    return CoupledLaw(params=params_from_config(cfg, dH_limit_m=dh))
+    return CoupledLaw(params=params_from_config(cfg, dH_limit_m=dh),
+                      schedule=schedule_from_config(cfg))
 
 
 
 __all__ = ["procedure_law", "LAW_CLIMB_FRACTION", "VERTICAL_LAWS", "VerticalLaw", "CoupledLaw", "CoupledLawParams", "SeparateChannelsLaw",
-           "TecsLaw", "params_from_config"]
+           "TecsLaw", "params_from_config", "schedule_from_config"]

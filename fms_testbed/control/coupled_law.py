@@ -49,6 +49,9 @@ from fms_testbed.core.earth import A_M, OMEGA_IE_RPS, normal_gravity_mps2
 from fms_testbed.core.state import AircraftState
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.atmosphere import isa
+from fms_testbed.control.schedule import (REFRESH_REL, GainSchedule, qbar_from_state,
+                                          schedule_from_points)
 
 _SAT_EPS = 0.005
 """Throttle within this of a limit counts as saturated (normalised throttle)."""
@@ -112,6 +115,15 @@ class CoupledLawParams:
     def vy_limit_mps(self) -> float:
         """Steady climb/descent rate of the level-change mode, ``dH_limit / (2 ξ_H T_H)``, m/s."""
         return self.dH_limit_m / (2.0 * self.xi_H * self.T_H_s)
+
+
+def schedule_from_config(cfg: AircraftConfig) -> GainSchedule | None:
+    """The aircraft configuration ``cfg``'s ``coupled_law_schedule`` as a :class:`GainSchedule`
+    (None when absent)."""
+    sc = cfg.coupled_law_schedule
+    if sc is None:
+        return None
+    return schedule_from_points([p.model_dump() for p in sc.points])
 
 
 def params_from_config(cfg: AircraftConfig, **overrides) -> CoupledLawParams:
@@ -288,13 +300,27 @@ class CoupledLaw:
     name = "coupled"
 
     def __init__(self, aircraft_cfg: AircraftConfig | None = None,
-                 params: CoupledLawParams | None = None):
+                 params: CoupledLawParams | None = None, schedule: GainSchedule | None = None):
         if params is None:
             if aircraft_cfg is None:
                 raise ValueError("CoupledLaw needs an aircraft config or params")
             params = params_from_config(aircraft_cfg)
+            schedule = schedule or schedule_from_config(aircraft_cfg)
         self.params = params
+        self.schedule = schedule
         self.state = CoupledLawState()
+
+    def _follow_schedule(self, state: AircraftState) -> None:
+        """Take the scheduled (T_V, ξ_V, T_H, ξ_H, τ_ny-trim) at the measured q̄ and mass when one of
+        them moved by more than ``REFRESH_REL`` (:mod:`fms_testbed.control.schedule`)."""
+        ps, ts = float(state.p_static_pa), float(state.t_static_k)
+        if not (math.isfinite(ps) and math.isfinite(ts)):
+            ts, ps, _ = isa(float(state.alt_m))
+        want = self.schedule.values(qbar_from_state(float(state.tas_mps), ps, ts),
+                                    float(state.mass_kg))
+        p = self.params
+        if any(abs(v - getattr(p, k)) > REFRESH_REL * abs(getattr(p, k)) for k, v in want.items()):
+            self.params = replace(p, **want)
 
     def reset(self) -> None:
         """Forget the run-time state (the next update re-engages)."""
@@ -325,6 +351,8 @@ class CoupledLaw:
             for the n_y trim: the law uses the vertical-plane component n_y cos φ)
         alt_cmd_m : altitude target, m;  tas_cmd_mps : true-airspeed target, m/s
         """
+        if self.schedule is not None:
+            self._follow_schedule(state)
         p, st = self.params, self.state
         if not st.engaged:
             self.engage(state, alt_cmd_m, tas_cmd_mps)
@@ -345,15 +373,7 @@ class CoupledLaw:
         ny = min(max(ny, p.ny_min), p.ny_max)
 
         if p.ny_trim_tau_s > 0:
-            ny_law = ny
-            ny = min(max(ny + st.ny_trim, p.ny_min), p.ny_max)
-            a = min(dt_s / p.ny_model_tau_s, 1.0) if p.ny_model_tau_s > 0 else 1.0
-            st.ny_model += a * (ny_law - st.ny_model)
-            if p.ny_min < ny < p.ny_max:
-                # measured n_y, vertical-plane component (the law works in the vertical plane)
-                ny_meas = float(state.ny) * math.cos(state.roll_rad)
-                st.ny_trim += (st.ny_model - ny_meas) * dt_s / p.ny_trim_tau_s
-                st.ny_trim = min(max(st.ny_trim, -0.1), 0.1)
+            ny = self._ny_trim(ny, dt_s, state)
 
         if st.protect_mode:
             # flight path holds the speed; keep the throttle at its limit
@@ -371,6 +391,20 @@ class CoupledLaw:
             st.nxa_cmd += rate * dt_s
         st.dny = ny - 1.0
         return st.nxa_cmd, ny
+
+    def _ny_trim(self, ny_law: float, dt_s: float, state: AircraftState) -> float:
+        """n_y tracking-error integrator (``ny_trim_tau_s``): the command plus the trim, the
+        model of the inner loop advanced, the trim integrated unless the command is clipped."""
+        p, st = self.params, self.state
+        ny = min(max(ny_law + st.ny_trim, p.ny_min), p.ny_max)
+        a = min(dt_s / p.ny_model_tau_s, 1.0) if p.ny_model_tau_s > 0 else 1.0
+        st.ny_model += a * (ny_law - st.ny_model)
+        if p.ny_min < ny < p.ny_max:
+            # measured n_y, vertical-plane component (the law works in the vertical plane)
+            ny_meas = float(state.ny) * math.cos(state.roll_rad)
+            st.ny_trim += (st.ny_model - ny_meas) * dt_s / p.ny_trim_tau_s
+            st.ny_trim = min(max(st.ny_trim, -0.1), 0.1)
+        return ny
 
     def _protect(self, ny: float, dV: float, V: float, gam: float, nx_meas: float,
                  gr: float) -> float:

@@ -109,12 +109,7 @@ def step_metrics(df: pd.DataFrame, channel: str, band_frac: float = 0.02,
         raise ValueError(f"no {channel} command change in the run")
     i0 = min(steps)
     t = df["t_s"].to_numpy()
-    end = len(df)
-    later = [i for i in find_steps(df, ccol) if i > i0]
-    if later:
-        end = min(later)
-    if t_end_s is not None:
-        end = min(end, int(np.searchsorted(t, t_end_s)))
+    end = _segment_end(df, ccol, i0, t, t_end_s)
     seg = slice(i0, end)
     ts, y = t[seg], df[ycol].to_numpy()[seg]
     prev = float(df[ccol].iloc[i0 - 1])
@@ -139,6 +134,17 @@ def step_metrics(df: pd.DataFrame, channel: str, band_frac: float = 0.02,
     return StepMetrics(channel, float(t[i0]), step, settling_time(ts, y, target, band),
                        rise_time(ts, y, y0, target), over, float(np.nanmax(cross)), act, sat,
                        float(ny.min()), float(ny.max()))
+
+
+def _segment_end(df: pd.DataFrame, ccol: str, i0: int, t: np.ndarray,
+                 t_end_s: float | None) -> int:
+    """End index of the step starting at ``i0``: the channel's next command change or
+    ``t_end_s`` (s), whichever is first."""
+    later = [i for i in find_steps(df, ccol) if i > i0]
+    end = min(later) if later else len(df)
+    if t_end_s is not None:
+        end = min(end, int(np.searchsorted(t, t_end_s)))
+    return end
 
 
 def _appearing(df: pd.DataFrame, ccol: str, ycol: str, tol: float = 0.5) -> list[int]:

@@ -17,11 +17,12 @@ from dataclasses import dataclass
 from fms_testbed.core.processes import die_with_parent
 from fms_testbed.core.geodesy import gravity_mps2, inverse
 from fms_testbed.core.segments import Arc
-from fms_testbed.core.units import NM_M
-from fms_testbed.procedures.database import Database, load_database
+from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.procedures.database import Database
 from fms_testbed.procedures.legrecord import PATH_TERMINATORS, PROC_TYPES
 from fms_testbed.legs.model import BuildParams, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
+from fms_testbed.path.coding import coding_kind
 from fms_testbed.path.monitor import check_path, leg_end_checks
 from fms_testbed.path.segmentation import build_sequence
 
@@ -136,7 +137,8 @@ def check_transition(db: Database, seq, perf: Performance, params: BuildParams):
 ROW_COLUMNS = ("airport", "order", "procedure", "transition", "type", "route_type", "legs",
                "n_legs", "status", "findings", "branches", "flags", "n_segments", "length_nm",
                "max_gap_m", "fix_excess_m", "rf_radius_err_nm", "turn_mismatch", "built_legs",
-               "monitor_status", "defects", "lines")
+               "monitor_status", "defects", "lines", "max_plan_alt_ft", "max_plan_tas_kt",
+               "coding")
 """Columns of a check row (:func:`check_airport`), in order."""
 
 
@@ -187,8 +189,19 @@ def check_airport(db: Database, airport: str, perf: Performance,
             "turn_mismatch": -1 if inv is None else inv.turn_mismatch,
             "built_legs": "" if path is None else " ".join(lg.path_term for lg in path.legs),
             "monitor_status": monitor, "defects": ",".join(kinds), "lines": _lines(seq),
+            "max_plan_alt_ft": math.nan if path is None else path.max_plan_alt_m() / FT_M,
+            "max_plan_tas_kt": math.nan if path is None else path.max_plan_tas_mps() / KT_MPS,
+            "coding": "" if path is None else ",".join(
+                sorted({coding_kind(f) for f in path.findings if f.category == "coding"})),
         })
     return rows
+
+
+def _load(db_path) -> Database:
+    """The database through its index (:func:`~fms_testbed.procedures.index.load_index`: the
+    file parsed once, then unpickled in a fraction of a second by every worker)."""
+    from fms_testbed.procedures.index import load_index
+    return load_index(db_path).db
 
 
 _WORKER: dict = {}
@@ -196,7 +209,7 @@ _WORKER: dict = {}
 
 def _init_worker(db_path: str, perf: Performance, params: BuildParams) -> None:
     die_with_parent()                       # no orphan worker after a SIGKILL of the parent
-    _WORKER["db"] = load_database(db_path)
+    _WORKER["db"] = _load(db_path)
     _WORKER["perf"] = perf
     _WORKER["params"] = params
 
@@ -233,7 +246,7 @@ def run_check(db_path: str | None, perf: Performance, airports: list[str] | None
     """Check a database (every airport, or ``airports``, repeats merged case-insensitively)."""
     t0 = time.perf_counter()
     params = params or BuildParams()
-    db = load_database(db_path)
+    db = _load(db_path)
     known = set(db.airport_idents())
     todo = merge_airports(airports) or sorted(known)
     missing = [a for a in todo if a not in known]
@@ -311,5 +324,7 @@ def summarise(rows: list[dict], db: Database, elapsed_s: float, workers: int) ->
         "turn_mismatches": sum(max(r["turn_mismatch"], 0) for r in sound),
         "branches": dict(Counter(b for r in rows for b in r["branches"].split("|") if b)),
         "flags": dict(Counter(f for r in rows for f in r["flags"].split(",") if f)),
+        "class3_transitions": sum(bool(r["coding"]) or "loop" in r["flags"] for r in rows),
+        "class3_by_kind": dict(Counter(k for r in rows for k in r["coding"].split(",") if k)),
         "elapsed_s": elapsed_s, "workers": workers,
     }

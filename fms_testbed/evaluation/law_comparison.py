@@ -166,7 +166,7 @@ def comparison_rows(cmp: ScenarioComparison, cfg: AircraftConfig) -> list[dict]:
 
 @dataclass(frozen=True, slots=True)
 class Goal:
-    """One goal of issue 3 with its measured value."""
+    """One goal of the coupled-law comparison (docs/coupled-law.md) with its measured value."""
 
     name: str
     value: float

@@ -14,9 +14,12 @@ status                 meaning                                                  
 ``envelope_exceeded``  above the ceiling, above VMO or MMO, or outside the        1
                        limit load factors of the aircraft file
 ``not_contained``      RNP containment lost: on some leg TSE95 > RNP or max       1
-                       TSE > 2 × RNP (procedure flights); NSE95 > RNP or max
-                       NSE > 2 × RNP (other flights with a navigation source);
-                       or the on-board RNP alert was raised (ANP > RNP)
+                       TSE > 2 × RNP (procedure flights); the navigation error
+                       seen from truth NSE95 > RNP or max NSE > 2 × RNP (every
+                       flight with a navigation source other than truth); the
+                       on-board RNP alert was raised (ANP > RNP). A NSE past
+                       the RNP with the alert silent is recorded as a missed
+                       alert (``outcome.checks.missed_alert``, an event)
 ``constraints_missed`` a coded altitude/speed constraint was missed               1
 ``timeout``            stopped from outside before its end (a regression run's    1
                        ``--case-timeout``); the checks of what was flown are kept
@@ -41,10 +44,12 @@ import pandas as pd
 
 from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.core.contracts import RecordView
-from fms_testbed.core.earth import MEAN_RADIUS_M
-from fms_testbed.core.units import FT_M, KT_MPS, NM_M
+from fms_testbed.core.units import FT_M, KT_MPS
+from fms_testbed.evaluation.navigation_truth import (has_solution, horizontal_distance_m,
+                                                     missed_alert, navigation_containment)
 from fms_testbed.evaluation.records import (AlertCheck, Checks, ConstraintsCheck, EnvelopeCheck,
-                                            NavigationCheck, Outcome, RecordsCheck, RnpCheck)
+                                            MissedAlert, NavigationCheck, Outcome, RecordsCheck,
+                                            RnpCheck)
 
 ORDER = ("diverged", "incomplete", "degraded", "envelope_exceeded", "not_contained",
          "constraints_missed")
@@ -95,40 +100,6 @@ def envelope_violations(df: pd.DataFrame, cfg: AircraftConfig) -> list[str]:
     first(ny < lim.ny_limit_min, f"load factor {ny.min():.2f} g below the limit "
                                  f"{lim.ny_limit_min:.2f} g")
     return out
-
-
-def horizontal_distance_m(lat1_deg, lon1_deg, lat2_deg, lon2_deg) -> np.ndarray:
-    """Great-circle (haversine) distance between two tracks, vectorised, m — good to 0.5 % of the
-    WGS-84 geodesic at any distance (enough for a containment verdict, unlike a flat-Earth
-    approximation at the 1,000 km errors of a free-running MEMS INS).
-
-    Parameters
-    ----------
-    lat1_deg, lon1_deg, lat2_deg, lon2_deg : positions, deg (arrays of one shape)
-    """
-    p1, p2 = np.radians(lat1_deg), np.radians(lat2_deg)
-    dl = np.radians(np.asarray(lon2_deg) - np.asarray(lon1_deg))
-    h = np.sin(0.5 * (p2 - p1)) ** 2 + np.cos(p1) * np.cos(p2) * np.sin(0.5 * dl) ** 2
-    return 2.0 * MEAN_RADIUS_M * np.arcsin(np.sqrt(np.clip(h, 0.0, 1.0)))
-
-
-def navigation_containment(df: pd.DataFrame, rnp_nm: float) -> dict:
-    """NSE containment of a flight without a defined path: NSE95 ≤ RNP and max NSE ≤ 2 × RNP.
-
-    Parameters
-    ----------
-    df : timeseries with ``lat_deg``/``lon_deg`` (truth) and ``nav_lat_deg``/``nav_lon_deg``
-    rnp_nm : the RNP, NM
-    """
-    nse = horizontal_distance_m(df["lat_deg"].to_numpy(), df["lon_deg"].to_numpy(),
-                                df["nav_lat_deg"].to_numpy(), df["nav_lon_deg"].to_numpy())
-    nse = nse[np.isfinite(nse)]
-    if not nse.size:
-        return {"rnp_nm": rnp_nm, "nse95_m": None, "nse_max_m": None, "contained": None}
-    p95, mx = float(np.percentile(nse, 95)), float(nse.max())
-    rnp = rnp_nm * NM_M
-    return {"rnp_nm": rnp_nm, "nse95_m": round(p95, 2), "nse_max_m": round(mx, 2),
-            "contained": bool(p95 <= rnp and mx <= 2.0 * rnp)}
 
 
 @dataclass(frozen=True)
@@ -192,20 +163,31 @@ def decide(flight: Mapping, df: pd.DataFrame, cfg: AircraftConfig,
 
 def _containment(flight: Mapping, df: pd.DataFrame, rnp_nm: float | None, checks: dict,
                  found: list[str]) -> None:
-    """RNP containment (a procedure flight's ``rnp``, else the navigation error against
-    ``rnp_nm`` NM) and the on-board RNP alert: their checks into ``checks``, their failures
-    into ``found``."""
+    """RNP containment (a procedure flight's ``rnp``), the navigation error seen from truth
+    against the RNP in force (:mod:`.navigation_truth`: a procedure flight on a navigation
+    source other than truth, or another flight with ``rnp_nm``), the on-board RNP alert and a
+    missed alert: their checks into ``checks``, their failures into ``found``."""
     if flight.get("rnp") is not None:
         r = flight["rnp"]
         checks["rnp"] = RnpCheck(bool(r["contained"]), list(r["legs_not_contained"]))
         if not r["contained"]:
             found.append(f"RNP containment lost on legs {r['legs_not_contained']}")
-    elif rnp_nm is not None:
+    nav_source = (flight.get("procedure") or {}).get("navigation")
+    truth_check = has_solution(df) and (
+        (flight.get("rnp") is not None and nav_source not in (None, "truth"))
+        or (flight.get("rnp") is None and rnp_nm is not None))
+    if truth_check:
         nc = navigation_containment(df, rnp_nm)
         checks["navigation"] = NavigationCheck(**nc)
+        miss = missed_alert(df, rnp_nm)
+        if miss is not None:
+            checks["missed_alert"] = MissedAlert(**miss)      # an event, not a status
         if nc["contained"] is False:
             found.append(f"navigation error NSE95 {nc['nse95_m']:.0f} m / max "
-                         f"{nc['nse_max_m']:.0f} m outside RNP {rnp_nm:g} NM")
+                         f"{nc['nse_max_m']:.0f} m outside RNP {nc['rnp_nm']:g} NM (seen from "
+                         "truth)" + ("" if miss is None else
+                                     f"; missed alert: NSE {miss['nse_m']:.0f} m past the RNP "
+                                     f"at t={miss['t_s']:.1f} s with the RNP alert silent"))
     if "rnp_alert" in df and (df["rnp_alert"].to_numpy() > 0).any():
         t_alert = float(df["t_s"].to_numpy()[np.argmax(df["rnp_alert"].to_numpy() > 0)])
         checks["rnp_alert"] = AlertCheck(False, round(t_alert, 2))
@@ -213,4 +195,4 @@ def _containment(flight: Mapping, df: pd.DataFrame, rnp_nm: float | None, checks
 
 
 __all__ = ["ORDER", "EXIT_CODES", "DEFAULT_ENROUTE_RNP_NM", "STOPPED", "Decision", "decide",
-           "envelope_violations", "navigation_containment"]
+           "envelope_violations", "horizontal_distance_m", "navigation_containment"]

@@ -203,14 +203,27 @@ class RnpCheck(RecordView):
 
 @dataclass(frozen=True)
 class NavigationCheck(RecordView):
-    """NSE containment of a flight without a path: RNP (NM), NSE95 and max NSE (m), contained
-    (None: no samples)."""
+    """NSE containment seen from truth (:mod:`.navigation_truth`): the smallest RNP in force
+    (NM), NSE95 and max NSE (m), contained (None: no samples)."""
 
     __pydantic_config__ = STRICT
     rnp_nm: float
     nse95_m: float | None
     nse_max_m: float | None
     contained: bool | None
+
+
+@dataclass(frozen=True)
+class MissedAlert(RecordView):
+    """The navigation error went past the RNP in force at ``t_s`` (s; ``nse_m`` m against
+    ``rnp_nm`` NM) with the on-board RNP alert silent; ``alert_t_s``: when it was raised later
+    (None: never)."""
+
+    __pydantic_config__ = STRICT
+    t_s: float
+    nse_m: float
+    rnp_nm: float
+    alert_t_s: float | None
 
 
 @dataclass(frozen=True)
@@ -242,6 +255,7 @@ class Checks(RecordView):
     rnp: RnpCheck | None = _opt()
     navigation: NavigationCheck | None = _opt()
     rnp_alert: AlertCheck | None = _opt()
+    missed_alert: MissedAlert | None = _opt()
     constraints: ConstraintsCheck | None = _opt()
 
 
@@ -257,6 +271,7 @@ class Outcome(RecordView):
 
 
 __all__ = ["AlertCheck", "Checks", "ConstraintCheck", "ConstraintsCheck", "EnvelopeCheck",
-           "ErrorParts", "ErrorStat", "FlightErrors", "LegErrors", "NavigationCheck", "Outcome",
+           "ErrorParts", "ErrorStat", "FlightErrors", "LegErrors", "MissedAlert", "NavigationCheck",
+           "Outcome",
            "RecordsCheck", "RnpCheck", "RnpContainment", "STRICT", "Sequencing",
            "ThresholdChecks", "ThresholdCrossing"]

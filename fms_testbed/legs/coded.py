@@ -16,7 +16,7 @@ resolved and the course turned true. Three shapes cover every leg type that has 
   (:func:`racetrack`).
 
 Every shape answers ``distance_m(lat_deg, lon_deg)``: the unsigned distance of a point from it,
-m. Course lines are extended beyond their ends (the distance is the cross-track of the
+m; a course line also scores a piece flown backwards along it (:meth:`CourseLine.pde_m`). Course lines are extended beyond their ends (the distance is the cross-track of the
 geodesic) and a circle is the whole circle — a built point is compared with where the record
 puts the path, not with where the leg starts or ends; a racetrack is a closed curve.
 """
@@ -43,6 +43,14 @@ class CourseLine:
     def distance_m(self, lat_deg: float, lon_deg: float) -> float:
         """Unsigned cross-track distance of a point (deg) from the geodesic, m."""
         return abs(project(self.line, lat_deg, lon_deg)[1])
+
+    def pde_m(self, points: list[tuple[float, float]]) -> float:
+        """PDE of a built piece through ``points`` (deg, in flying order), signed along the
+        course: the larger of the largest cross-track distance and the distance flown back
+        along the course (the along-track drop from the first point to the last), m — a
+        piece flown backwards along the line scores its length, not zero."""
+        along, xtk = zip(*(project(self.line, lat, lon)[:2] for lat, lon in points))
+        return max(max(abs(x) for x in xtk), along[0] - along[-1], 0.0)
 
 
 @dataclass(frozen=True, slots=True)
@@ -121,6 +129,9 @@ def course_from(lat_deg: float, lon_deg: float, course_deg: float) -> CourseLine
 
 
 def path_definition_error_m(coded: CodedPath, points: list[tuple[float, float]]) -> float:
-    """PDE of a built piece of path: the largest distance of its points (deg) from the coded
-    path, m."""
+    """PDE of a built piece of path: the largest distance of its points (deg, in flying order)
+    from the coded path, m; along a coded course line signed along the course
+    (:meth:`CourseLine.pde_m`)."""
+    if isinstance(coded, CourseLine):
+        return coded.pde_m(points)
     return max(coded.distance_m(lat, lon) for lat, lon in points)

@@ -24,11 +24,13 @@ from fms_testbed.legs.coded import course_from
 from fms_testbed.legs.construct import ray_circle_distance, ray_geodesic_intersection
 from fms_testbed.core.segments import Line
 from fms_testbed.legs.model import FlightState, Termination, drift_track_deg
+from fms_testbed.legs.moves import (altitude_distance_m, direct_to, fix_state, join_from_fix,
+                                    start_course, turn_dir)
 
 
 def _climb_to(b: LegBuilder, s: FlightState, course: float) -> tuple[FlightState, Termination]:
     alt = altitude_of(b)
-    dist = b.altitude_distance_m(s, alt)
+    dist = altitude_distance_m(b, s, alt)
     s = b.straight(s, course, dist)
     s = replace(s, alt_m=max(s.alt_m, alt), flyby=False, fix_ident="")
     return s, Termination("altitude", s.lat_deg, s.lon_deg, alt_m=alt)
@@ -105,16 +107,16 @@ def from_fix(b: LegBuilder, s: FlightState, direction: str | None = "coded"
     a transition onto the leg's coded path (role 'turn', no PDE); a turn flown over the fix
     rejoins the coded course line (:meth:`~.builder.LegBuilder.join_from_fix`)."""
     f, c = fix_of(b), course_of(b)
-    d = b.turn_dir() if direction == "coded" else direction
+    d = turn_dir(b) if direction == "coded" else direction
     if s.track_deg is None:
-        s = replace(b.fix_state(s, f), track_deg=c)
+        s = replace(fix_state(b, s, f), track_deg=c)
     elif inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[0] > 1.0:
         n0 = len(b.segments)
-        s = b.direct_to(s, f, d, not b.leg.rec.fly_over)
+        s = direct_to(b, s, f, d, not b.leg.rec.fly_over)
         b.as_transition(n0)
-        s = b.fix_state(s, f)
+        s = fix_state(b, s, f)
         d = None
-    return b.join_from_fix(s, f, c, d), c
+    return join_from_fix(b, s, f, c, d), c
 
 
 # --------------------------------------------------------------------------- C*, V*
@@ -131,11 +133,11 @@ class _CourseLeg(Leg):
     def build(cls, b, s):
         c = course_of(b)
         if not cls.heading_leg:
-            s = b.start_course(s, c, b.turn_dir())
+            s = start_course(b, s, c, turn_dir(b))
             return cls.end(b, s, c)
         trk = drift_track_deg(c, b.speed_mps, b.params.wind_speed_mps, b.params.wind_from_deg)
         n0 = len(b.segments)
-        s = b.start_course(s, trk, b.turn_dir())
+        s = start_course(b, s, trk, turn_dir(b))
         s, term = cls.end(b, s, trk)
         for k in range(n0, len(b.segments)):
             sg = b.segments[k]

@@ -21,6 +21,8 @@ from fms_testbed.legs.coded import CodedCircle, course_into, track_between
 from fms_testbed.legs.construct import centre_through
 from fms_testbed.legs.model import FlightState
 from fms_testbed.procedures.records import Fix
+from fms_testbed.legs.moves import (can_cut, commit, connect, direct_to, fix_state, join_course,
+                                    join_from_fix, trial, turn_dir)
 
 
 class IF(Leg):
@@ -39,10 +41,10 @@ class IF(Leg):
                 and nxt.course_true_deg is not None and s.track_deg is not None:
             # the final's IF after a procedure turn lies on the inbound course the turn
             # intercepts: join that course through the IF (no direct-to onto it)
-            s = b.join_course(s, f, nxt.course_true_deg, None, not b.leg.rec.fly_over)
+            s = join_course(b, s, f, nxt.course_true_deg, None, not b.leg.rec.fly_over)
         elif s.track_deg is not None or b.segments:
-            s = b.connect(s, f.lat_deg, f.lon_deg, f"IF {f.ident} away from the previous leg")
-        return b.fix_state(s, f), fix_termination(f)
+            s = connect(b, s, f.lat_deg, f.lon_deg, f"IF {f.ident} away from the previous leg")
+        return fix_state(b, s, f), fix_termination(f)
 
 
 class TF(Leg):
@@ -60,22 +62,22 @@ class TF(Leg):
         if prev is None or s.fix_ident != prev.ident:
             if prev is not None and s.track_deg is not None:
                 _, az1, az2 = inverse(prev.lat_deg, prev.lon_deg, f.lat_deg, f.lon_deg)
-                s = b.join_course(s, f, az2, b.turn_dir(), not b.leg.rec.fly_over)
-                return b.fix_state(s, f), fix_termination(f)
-            s = b.direct_to(s, f, b.turn_dir(), not b.leg.rec.fly_over)
-            return b.fix_state(s, f), fix_termination(f)
-        if b.can_cut(s, inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[1], b.turn_dir()):
-            s = b.direct_to(s, f, b.turn_dir(), not b.leg.rec.fly_over)   # fly-by corner
+                s = join_course(b, s, f, az2, turn_dir(b), not b.leg.rec.fly_over)
+                return fix_state(b, s, f), fix_termination(f)
+            s = direct_to(b, s, f, turn_dir(b), not b.leg.rec.fly_over)
+            return fix_state(b, s, f), fix_termination(f)
+        if can_cut(b, s, inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[1], turn_dir(b)):
+            s = direct_to(b, s, f, turn_dir(b), not b.leg.rec.fly_over)   # fly-by corner
         else:  # over the previous fix: turn there and rejoin the TF track out of it
             length, az1, az2 = inverse(prev.lat_deg, prev.lon_deg, f.lat_deg, f.lon_deg)
             n0 = len(b.segments)
-            s1 = b.join_from_fix(s, prev, az1, b.turn_dir(), max_along_m=length)
-            if b.joined:
+            s1 = join_from_fix(b, s, prev, az1, turn_dir(b), max_along_m=length)
+            if s1 is not None:
                 b.as_transition(n0)
                 s = b.line_to(s1, f.lat_deg, f.lon_deg, f.ident, not b.leg.rec.fly_over)
             else:   # the track is too short to rejoin after the turn: join it upstream of f
-                s = b.join_course(s, f, az2, b.turn_dir(), not b.leg.rec.fly_over)
-        return b.fix_state(s, f), fix_termination(f)
+                s = join_course(b, s, f, az2, turn_dir(b), not b.leg.rec.fly_over)
+        return fix_state(b, s, f), fix_termination(f)
 
     @classmethod
     def coded_path(cls, b, term):
@@ -98,8 +100,8 @@ class CF(Leg):
         f, c = fix_of(b), course_of(b)
         if s.track_deg is None:
             s = replace(s, track_deg=c)
-        s = b.join_course(s, f, c, b.turn_dir(), not b.leg.rec.fly_over)
-        return b.fix_state(s, f), fix_termination(f)
+        s = join_course(b, s, f, c, turn_dir(b), not b.leg.rec.fly_over)
+        return fix_state(b, s, f), fix_termination(f)
 
     @classmethod
     def target(cls, leg):
@@ -127,15 +129,15 @@ class DF(Leg):
     @classmethod
     def build(cls, b, s):
         f = fix_of(b)
-        s = b.direct_to(s, f, b.turn_dir(), not b.leg.rec.fly_over)
-        return b.fix_state(s, f), fix_termination(f)
+        s = direct_to(b, s, f, turn_dir(b), not b.leg.rec.fly_over)
+        return fix_state(b, s, f), fix_termination(f)
 
 
 def _corner_onto(b: LegBuilder, s: FlightState, arc: Arc) -> None:
     """Mark a non-tangent entry onto a coded arc as a fly-by corner when the state allows it
     (the segmentation then fits a line-to-arc fillet)."""
     if b.segments and isinstance(b.segments[-1].geom, Line) and \
-            b.can_cut(s, arc.start_course_deg, None) and \
+            can_cut(b, s, arc.start_course_deg, None) and \
             abs(wrap180(arc.start_course_deg - s.track_deg)) >= 0.5:
         b._corner_pending = True
 
@@ -154,7 +156,7 @@ def _arc_to_fix(b: LegBuilder, s: FlightState, clat: float, clon: float, f, why:
     where the aircraft is, ends at the fix and is never flown as a direct-to. A larger gap is
     a discontinuity, bridged by :meth:`~.builder.LegBuilder.connect` to the arc at the fix's
     range on the present radial."""
-    d = b.turn_dir()
+    d = turn_dir(b)
     if d is None:
         raise LegError(f"{b.leg.pt} leg without a turn direction (column 44)")
     r_end, rad_end, _ = inverse(clat, clon, f.lat_deg, f.lon_deg)
@@ -166,7 +168,7 @@ def _arc_to_fix(b: LegBuilder, s: FlightState, clat: float, clon: float, f, why:
         _, rad_start, _ = inverse(clat, clon, s.lat_deg, s.lon_deg)
     else:
         start_pt = direct(clat, clon, rad_start, r_end)
-        s = b.connect(s, start_pt[0], start_pt[1], why)
+        s = connect(b, s, start_pt[0], start_pt[1], why)
     sweep = wrap360(rad_end - rad_start) if d == "R" else -wrap360(rad_start - rad_end)
     if abs(sweep) > 0.01:
         arc = Arc(clat, clon, r_end, rad_start, sweep)
@@ -174,7 +176,7 @@ def _arc_to_fix(b: LegBuilder, s: FlightState, clat: float, clon: float, f, why:
             return _join_arc_ahead(b, s, arc, f)
         _corner_onto(b, s, arc)
         s = b.arc(s, arc, role="leg")
-    return b.fix_state(replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
+    return fix_state(b, replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
 
 
 ARC_JOIN_DEG = 60.0
@@ -191,7 +193,7 @@ def _too_sharp(b: LegBuilder, s: FlightState, arc: Arc) -> bool:
     if delta <= 20.0:
         return False
     last = b.segments[-1].geom if b.segments else None
-    room = last.length_m() if isinstance(last, Line) and b.can_cut(s, arc.start_course_deg,
+    room = last.length_m() if isinstance(last, Line) and can_cut(b, s, arc.start_course_deg,
                                                                       None) else 0.0
     return b.radius_m * math.tan(math.radians(min(delta, 179.0)) / 2.0) > 0.9 * room
 
@@ -203,19 +205,19 @@ def _join_arc_ahead(b: LegBuilder, s: FlightState, arc: Arc, f) -> FlightState:
     :data:`ARC_JOIN_DEG`, then 30° steps further round (at most 80 % of the sweep), until the
     corner at Q, as the direct-to arrives there, fits its fly-by. A finding says so."""
     n0 = len(b.segments)
-    theta, st, rest = 0.0, s, arc
     for theta in (ARC_JOIN_DEG, 90.0, 120.0, 150.0):
         theta = min(theta, 0.8 * abs(arc.sweep_deg))
-        del b.segments[n0:]
+        t = trial(b)      # a candidate join point Q: kept when its corner fits
         rad_q = arc.start_radial_deg + math.copysign(theta, arc.sweep_deg)
         qlat, qlon, _ = direct(arc.centre_lat_deg, arc.centre_lon_deg, rad_q, arc.radius_m)
         target = Fix(ident="", region="", section="", lat_deg=qlat, lon_deg=qlon)
-        st = b.direct_to(replace(s, flyby=False), target, None, True)
+        st = direct_to(t, replace(s, flyby=False), target, None, True)
         rest = Arc(arc.centre_lat_deg, arc.centre_lon_deg, arc.radius_m, rad_q,
                    arc.sweep_deg - math.copysign(theta, arc.sweep_deg))
-        if not _too_sharp(b, replace(st, flyby=True), rest) or \
+        if not _too_sharp(t, replace(st, flyby=True), rest) or \
                 theta >= 0.8 * abs(arc.sweep_deg):
             break
+    commit(b, t)
     b.finding("info", f"{b.leg.pt} entered {abs(wrap180(arc.start_course_deg - s.track_deg)):.0f}"
               f"° off its tangent: too sharp for a fly-by at {b.radius_m:.0f} m; the arc is "
               f"joined {theta:.0f}° round it")
@@ -223,7 +225,7 @@ def _join_arc_ahead(b: LegBuilder, s: FlightState, arc: Arc, f) -> FlightState:
     st = replace(st, flyby=True)
     _corner_onto(b, st, rest)
     st = b.arc(st, rest, role="leg")
-    return b.fix_state(replace(st, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
+    return fix_state(b, replace(st, lat_deg=f.lat_deg, lon_deg=f.lon_deg), f)
 
 
 class RF(Leg):
@@ -241,7 +243,7 @@ class RF(Leg):
         f, c = fix_of(b), b.leg.centre
         if c is None:
             raise LegError("RF leg without a centre fix (column 107)")
-        if b.turn_dir() is None:
+        if turn_dir(b) is None:
             raise LegError("RF leg without a turn direction (column 44)")
         return _arc_to_fix(b, s, c.lat_deg, c.lon_deg, f, "RF start not on the arc"), \
             fix_termination(f)

@@ -23,6 +23,8 @@ from fms_testbed.legs.coded import racetrack
 from fms_testbed.legs.construct import _foot, turn_to_course
 from fms_testbed.legs.course_legs import from_fix
 from fms_testbed.legs.model import FlightState, Termination, turn_radius_m
+from fms_testbed.legs.moves import (commit, direct_to, fix_state, join_course, join_from_fix,
+                                    trial, turn_dir)
 
 
 def timed_speed_mps(b: LegBuilder) -> float:
@@ -52,7 +54,7 @@ def _circuit(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: fl
     arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, inbound, d, b.radius_m)
     if arc is not None:
         s = b.arc(s, arc, role="hold")
-    return b.direct_to(s, f, None, False)
+    return direct_to(b, s, f, None, False)
 
 
 ALIGNED_DEG = 1.0
@@ -82,6 +84,29 @@ def _hold_frame(f, inbound: float, lat: float, lon: float) -> tuple[float, float
     return x * math.cos(a) - y * math.sin(a), x * math.sin(a) + y * math.cos(a)
 
 
+def _entry_theta_deg(r_m: float, x0_m: float, leg_m: float) -> float:
+    """The outbound heading offset θ (deg, bisection in −60°..90°) for which the final turn
+    of radius R ends on the inbound line: R (1 + cos θ) − x₀ = L sin θ (``x0_m`` the lateral
+    offset toward the σ side where the outbound leg starts, L = ``leg_m``); the nearer bound
+    when there is no root there."""
+    def miss(t: float) -> float:
+        rt = math.radians(t)
+        return r_m * (1.0 + math.cos(rt)) - x0_m - leg_m * math.sin(rt)
+
+    lo, hi = -60.0, 90.0
+    if miss(lo) * miss(hi) > 0:
+        return lo if abs(miss(lo)) < abs(miss(hi)) else hi
+    m_lo = miss(lo)
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        m_mid = miss(mid)
+        if m_lo * m_mid > 0:
+            lo, m_lo = mid, m_mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
 def _entry(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: float
            ) -> tuple[FlightState, bool]:
     """Hold entry from over the fix, ending over the fix on the inbound course.
@@ -103,35 +128,23 @@ def _entry(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: floa
     first = d if kind == "direct" else None
     final = "R" if sigma > 0 else "L"
     outbound = wrap360(inbound + 180.0)
-    n0 = len(b.segments)
     r = b.radius_m
 
     def head(theta: float) -> float:   # outbound heading turned θ toward the σ side
         return wrap360(outbound - sigma * theta)
 
-    def first_turn(theta: float) -> tuple[FlightState, float]:
-        del b.segments[n0:]
+    def first_turn(theta: float):   # a candidate first turn: (trial builder, state, x₀ m)
+        t = trial(b)
         arc = turn_to_course(s.lat_deg, s.lon_deg, s.track_deg, head(theta), first, r)
-        st = b.arc(s, arc, role="turn") if arc is not None else replace(s, track_deg=head(theta))
-        return st, _hold_frame(f, inbound, st.lat_deg, st.lon_deg)[0]
+        st = t.arc(s, arc, role="turn") if arc is not None else replace(s, track_deg=head(theta))
+        return t, st, _hold_frame(f, inbound, st.lat_deg, st.lon_deg)[0]
 
     theta = 0.0
     for _ in range(3):
-        st, x0 = first_turn(theta)
-
-        def miss(t: float) -> float:
-            rt = math.radians(t)
-            return r * (1.0 + math.cos(rt)) - sigma * x0 - leg_m * math.sin(rt)
-
-        lo, hi = -60.0, 90.0
-        if miss(lo) * miss(hi) > 0:
-            theta = lo if abs(miss(lo)) < abs(miss(hi)) else hi
-        else:
-            for _ in range(40):
-                mid = 0.5 * (lo + hi)
-                lo, hi = (mid, hi) if miss(lo) * miss(mid) > 0 else (lo, mid)
-            theta = 0.5 * (lo + hi)
-    st, x0 = first_turn(theta)
+        x0 = first_turn(theta)[2]
+        theta = _entry_theta_deg(r, sigma * x0, leg_m)
+    t, st, x0 = first_turn(theta)
+    commit(b, t)
     # the straight that puts the final turn's end on the inbound line (planar, exact heading)
     psi = math.radians(wrap360(st.track_deg - inbound))
     xs, _ = _hold_frame(f, inbound, st.lat_deg, st.lon_deg)
@@ -144,7 +157,7 @@ def _entry(b: LegBuilder, s: FlightState, f, inbound: float, d: str, leg_m: floa
     arc = turn_to_course(st.lat_deg, st.lon_deg, st.track_deg, inbound, final, r)
     if arc is not None:
         st = b.arc(st, arc, role="turn")
-    st = b.join_course(st, f, inbound, None, False)
+    st = join_course(b, st, f, inbound, None, False)
     return replace(st, lat_deg=f.lat_deg, lon_deg=f.lon_deg, track_deg=inbound), True
 
 
@@ -165,11 +178,11 @@ class _Hold(Leg):
         f, c = fix_of(b), course_of(b)
         n0 = len(b.segments)
         if s.track_deg is None:
-            s = replace(b.fix_state(s, f), track_deg=c)
+            s = replace(fix_state(b, s, f), track_deg=c)
         elif inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[0] > 1.0:
-            s = b.direct_to(s, f, None, False)
+            s = direct_to(b, s, f, None, False)
         s = replace(s, lat_deg=f.lat_deg, lon_deg=f.lon_deg)
-        d = b.turn_dir() or "R"
+        d = turn_dir(b) or "R"
         s, flown = _entry(b, s, f, c, d, hold_leg_m(b, s.alt_m))
         b.as_transition(n0)
         return s, f, c, d, hold_leg_m(b, s.alt_m), flown
@@ -179,7 +192,7 @@ class _Hold(Leg):
         fc = fix_course(b.leg)
         if fc is None or not term.distance_m:
             return None
-        return racetrack(*fc, b.turn_dir() or "R", term.distance_m, b.radius_m)
+        return racetrack(*fc, turn_dir(b) or "R", term.distance_m, b.radius_m)
 
 
 class HM(_Hold):
@@ -191,7 +204,7 @@ class HM(_Hold):
     def build(cls, b, s):
         s, f, c, d, leg_m, _ = cls._enter(b, s)
         s = _circuit(b, s, f, c, d, leg_m)
-        return b.fix_state(s, f), Termination("manual", f.lat_deg, f.lon_deg, fix_ident=f.ident,
+        return fix_state(b, s, f), Termination("manual", f.lat_deg, f.lon_deg, fix_ident=f.ident,
                                               distance_m=leg_m)
 
 
@@ -206,7 +219,7 @@ class HF(_Hold):
         s, f, c, d, leg_m, flown = cls._enter(b, s)
         if not flown:
             s = _circuit(b, s, f, c, d, leg_m)
-        return replace(b.fix_state(s, f), flyby=False), Termination(
+        return replace(fix_state(b, s, f), flyby=False), Termination(
             "circuit", f.lat_deg, f.lon_deg, fix_ident=f.ident, distance_m=leg_m)
 
 
@@ -231,7 +244,7 @@ class HA(_Hold):
             s = _circuit(b, s, f, c, d, leg_m)
             n += 1
         s = replace(s, alt_m=max(s.alt_m, alt))
-        return replace(b.fix_state(s, f), flyby=False), Termination(
+        return replace(fix_state(b, s, f), flyby=False), Termination(
             "altitude", f.lat_deg, f.lon_deg, fix_ident=f.ident, alt_m=alt, distance_m=leg_m)
 
 
@@ -288,21 +301,11 @@ class PI(Leg):
         return wrap360(c + (45.0 if d == "R" else -45.0)), None
 
     @classmethod
-    def build(cls, b, s):
-        f, c = fix_of(b), course_of(b)
-        d = b.turn_dir() or "L"
-        out, x_next = cls._outbound_deg(b, c, d)
-        n0 = len(b.segments)
-        s = replace(s, flyby=False)   # a course reversal starts over its fix
-        if s.track_deg is None:
-            s = replace(b.fix_state(s, f), track_deg=out, flyby=False)
-        elif inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[0] > 1.0:
-            s = b.direct_to(s, f, None, False)
-            b.as_transition(n0)
-        s = replace(b.fix_state(s, f), flyby=False)
-        limit = b.leg.rec.distance_m or 10 * NM_M
-        timed = 60.0 * timed_speed_mps(b)
-        gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
+    def _size(cls, b: LegBuilder, x_next: float | None, limit: float, timed: float,
+              gmax: float) -> tuple:
+        """The manoeuvre's sizes at the planned bank, else at ``gmax`` (class docstring):
+        (bank deg or None for the planned one, R m, the 45° leg m, d₁ least m, d₁ most m, and
+        the far point's offsets a, b m)."""
         for bank in (None, gmax):
             if bank is not None:
                 b.radius_m = turn_radius_m(b.speed_mps + b.wind_mps, bank, b.g)
@@ -317,6 +320,25 @@ class PI(Leg):
             d_max = math.sqrt(reach) - a_m if reach > 0 else -math.inf
             if d_min <= d_max:
                 break
+        return bank, r, leg45, d_min, d_max, a_m, b_m
+
+    @classmethod
+    def build(cls, b, s):
+        f, c = fix_of(b), course_of(b)
+        d = turn_dir(b) or "L"
+        out, x_next = cls._outbound_deg(b, c, d)
+        n0 = len(b.segments)
+        s = replace(s, flyby=False)   # a course reversal starts over its fix
+        if s.track_deg is None:
+            s = replace(fix_state(b, s, f), track_deg=out, flyby=False)
+        elif inverse(s.lat_deg, s.lon_deg, f.lat_deg, f.lon_deg)[0] > 1.0:
+            s = direct_to(b, s, f, None, False)
+            b.as_transition(n0)
+        s = replace(fix_state(b, s, f), flyby=False)
+        limit = b.leg.rec.distance_m or 10 * NM_M
+        timed = 60.0 * timed_speed_mps(b)
+        gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
+        bank, r, leg45, d_min, d_max, a_m, b_m = cls._size(b, x_next, limit, timed, gmax)
         fits = d_min <= d_max
         if bank is not None and fits:
             b.finding("correction", f"procedure turn at {f.ident} kept within "
@@ -327,7 +349,7 @@ class PI(Leg):
                       f"the bank limit, beyond the coded {limit / NM_M:.1f} NM")
         d1 = max(d_min, min(d_max, timed)) if fits else d_min
         n1 = len(b.segments)
-        s = b.join_from_fix(s, f, out, None)
+        s = join_from_fix(b, s, f, out, None)
         b.as_transition(n1)
         # the outbound straight is measured from the fix: a turn onto the outbound course
         # from over the fix already flew part of it

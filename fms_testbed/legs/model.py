@@ -93,7 +93,9 @@ class Performance:
 
     tas_plan_mps: planned TAS; tas_min_mps: lowest acceptable TAS for a correction;
     climb_gradient_max: rise over run at ``tas_plan_mps``; climb_rate_max_mps;
-    descent_rate_max_mps; bank_max_deg; alt_max_m: the service ceiling, m (inf: none given).
+    descent_rate_max_mps; bank_max_deg; alt_max_m: the service ceiling, m (inf: none given);
+    cas_max_mps: VMO as a CAS, m/s, and mach_max: MMO (inf: none given) — the speed envelope
+    every planned TAS stays inside (:meth:`tas_max_mps`).
     """
 
     tas_plan_mps: float
@@ -103,6 +105,22 @@ class Performance:
     descent_rate_max_mps: float
     bank_max_deg: float
     alt_max_m: float = math.inf
+    cas_max_mps: float = math.inf
+    mach_max: float = math.inf
+
+    def tas_max_mps(self, alt_m: float, isa_dev_c: float = 0.0) -> float:
+        """Largest TAS inside the speed envelope at ``alt_m`` (m) on a day ``isa_dev_c`` (K)
+        off the ISA, m/s: min(TAS(VMO), MMO · a), a = √(γ R T) the speed of sound there
+        (T of :func:`~fms_testbed.core.atmosphere.isa`, the troposphere's lapse to 11 km)."""
+        from fms_testbed.core.atmosphere import GAMMA, H_TROP_M, LAPSE_KPM, R_JPKGK, T0_K
+        h = max(alt_m, 0.0)
+        v = math.inf
+        if math.isfinite(self.cas_max_mps):
+            v = cas_to_tas_scalar(self.cas_max_mps, h, isa_dev_c)
+        if math.isfinite(self.mach_max):
+            t_k = T0_K + isa_dev_c - LAPSE_KPM * min(h, H_TROP_M)
+            v = min(v, self.mach_max * math.sqrt(GAMMA * R_JPKGK * t_k))
+        return v
 
     @property
     def alt_plan_max_m(self) -> float:
@@ -118,7 +136,8 @@ class Performance:
                    climb_gradient_max=lim.climb_gradient_max,
                    climb_rate_max_mps=lim.climb_rate_max_mps,
                    descent_rate_max_mps=lim.descent_rate_max_mps, bank_max_deg=lim.bank_max_deg,
-                   alt_max_m=lim.alt_max_m)
+                   alt_max_m=lim.alt_max_m, cas_max_mps=lim.cas_max_mps,
+                   mach_max=lim.mach_max)
 
     def climb_gradient_at(self, tas_mps: float) -> float:
         """Climb gradient capability at a TAS, rise over run: the climb rate is taken as
@@ -218,7 +237,7 @@ class Finding:
         upstream); 3 — the coding itself (a path flown twice, a fix missing, a coded radius
         the fixes contradict) — not correctable by the monitor, for the crew to judge."""
         m = self.message
-        if self.category == "loop" or "not in the database" in m or "coded" in m and \
+        if self.category in ("loop", "coding") or "not in the database" in m or "coded" in m and \
                 "fixes give" in m or "arc angle built" in m:
             return 3
         if self.category in ("discontinuity", "no-intercept") or "joined" in m and \
@@ -243,6 +262,13 @@ class BuiltLeg:
     seg_first: int = 0
     seg_count: int = 0
     coded: CodedPath | None = None
+    resolved: object = None
+    """The :class:`~fms_testbed.legs.builder.ResolvedLeg` it was built from (fixes looked up,
+    course turned true, the variation used): the coded-numbers check reads the record's
+    fields against its fixes from it."""
+    from_fix: object = None
+    """The :class:`~fms_testbed.procedures.records.Fix` the leg starts from (the previous
+    leg's fix when that leg ends there), or None."""
 
 
 @dataclass(frozen=True)
@@ -269,6 +295,20 @@ class ProcedurePath:
     def leg_types(self) -> list[str]:
         """Path terminators in order."""
         return [lg.path_term for lg in self.legs]
+
+    def max_plan_alt_m(self) -> float:
+        """Highest planned altitude, m: of the builder's leg starts and ends and of the
+        vertical profile (NaN when nothing was built)."""
+        alts = [a for lg in self.legs for a in (lg.start.alt_m, lg.end.alt_m)]
+        if self.profile is not None:
+            alts += [float(max(self.profile.alt_m, default=-math.inf))]
+        return max(alts, default=math.nan)
+
+    def max_plan_tas_mps(self) -> float:
+        """Highest planned TAS, m/s: of the legs and of the segments (fly-by corrections
+        included; NaN when nothing was built)."""
+        v = [lg.speed_mps for lg in self.legs] + [s.speed_mps for s in self.segments]
+        return max(v, default=math.nan)
 
 
 def isa_tas_mps(cas_mps: float, alt_m: float, isa_dev_c: float = 0.0) -> float:

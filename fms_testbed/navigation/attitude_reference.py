@@ -61,7 +61,7 @@ from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import DEG_RAD, DPH_RPS
 from fms_testbed.navigation.ins_bank import derive_seeds
-from fms_testbed.navigation.ins_filter import enu_difference_m
+from fms_testbed.navigation.measurements import enu_difference_m
 from fms_testbed.navigation.ins_gnss import gnss_spec
 from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed, innovation,
                                           predict)

@@ -9,19 +9,25 @@ State (SI, errors are *indicated minus true*, the SINS model's convention)::
 
 The INS block of F is the first 15×15 of the project's 33-state model
 (:func:`fms_testbed.sensors.sins.model.build_F`, free vertical channel), built at the INS's
-*indicated* position, velocity and attitude with the IMU's rates and specific force; the GNSS and
-baro states are first-order Gauss-Markov. Φ_k, Q_k come from the Picard series
+*indicated* position, velocity and attitude with the INS's *compensated measured* specific force
+and angular rate (:meth:`~fms_testbed.navigation.bank.InsBankLike.measured`, the step means
+ΣΔv_c/T, ΣΔθ_c/T); the GNSS and baro states are first-order Gauss-Markov. Nothing in the filter
+reads the true state. Φ_k, Q_k come from the Picard series
 (:func:`fms_testbed.sensors.sins.discretize.discretize_sins`, Babich 2017 eq. 2.5-2.9/4.3-4.5) or
-Van Loan. Measurements (ENU, m and m/s)::
+Van Loan. Measurements are plug-ins (:mod:`.measurements`: GNSS position and velocity of the
+antenna with its lever arm and the receiver-reported σ, baro altitude, airspeed), each giving
+(z, H, R) from the INS output at its time of validity, e.g.::
 
-    z_p = p_INS - p_GNSS = δp - m_p - w_p           H_p = [I 0 0 0 0 -I 0]
-    z_v = V_INS - V_GNSS = δV - m_v - w_v           H_v = [0 I 0 0 0 0 -I]
+    z_p = p_INS + C l - p_GNSS = δp + [(C l)×] ε - m_p - w_p
     z_h = h_INS - h_baro = δp_U - b_h - w_h
 
 A fix valid at t_m and used at t (latency) is compared with the INS output of t_m against the
 estimate carried back, x̂(t_m) = Φ(t, t_m)⁻¹ x̂(t) (the process noise over the lag is neglected in
 the cross-covariance). Each group passes an innovation gate (|ν_i| ≤ gate·√S_ii) before the
-Joseph-form correction (:mod:`.kalman`). Feedback: at every GNSS update the INS block of x̂ is
+Joseph-form correction (:mod:`.kalman`). A measurement rejected ``reset_after`` times in a row
+(a jump the filter's σ cannot follow: a GNSS re-acquisition after a long outage) resets the
+covariance of the INS states it observes (rows and columns zeroed, variance ν² + R) and is used:
+the estimate follows the sensor again instead of coasting on a confident, wrong P. Feedback: at every GNSS update the INS block of x̂ is
 handed back (the INS subtracts it from its position, velocity, attitude and sensor-bias
 compensation) and zeroed; the GNSS/baro states stay in the filter.
 
@@ -41,13 +47,16 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 
-from fms_testbed.core.earth import OMEGA_IE_RPS, radii_m
+from fms_testbed.core.earth import OMEGA_IE_RPS
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.navigation.fdi import unmodelled_variances
 from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed,
                                           predict)
+from fms_testbed.navigation.measurements import (ATT, BA, BARO, BG, MP, MV, N_INS, POS, VEL,
+                                                 BaroAltitude, Measurement, enu_difference_m,
+                                                 gnss_measurements)
 from fms_testbed.navigation.sins import _c_bn
 from fms_testbed.sensors.baro import BaroReading, BaroSpec
 from fms_testbed.sensors.gnss import GnssFix, GnssSpec
@@ -58,10 +67,6 @@ from fms_testbed.sensors.sins.discretize import (PICARD_MAX_ORDER, PICARD_MAX_RA
 from fms_testbed.sensors.sins.model import build_F
 from fms_testbed.sensors.sins.presets import ImuModel
 
-N_INS = 15
-POS, VEL, ATT, BA, BG = (slice(0, 3), slice(3, 6), slice(6, 9), slice(9, 12), slice(12, 15))
-MP, MV = slice(15, 18), slice(18, 21)
-BARO = 21
 STATE_NAMES = (
     [f"dp_{c}_m" for c in "enu"] + [f"dv_{c}_mps" for c in "enu"]
     + [f"eps_{c}_rad" for c in "enu"] + [f"ba_{c}_mps2" for c in "xyz"]
@@ -84,6 +89,8 @@ class FilterTuning:
     predict_rotation_deg : an interval also ends once the body has turned this much in it
         (∫|ω| dt, deg): F follows the attitude, and a held F̄ misses the commutator terms of a
         rotating F (2 % of the gyro-bias → velocity block of Φ over 0.9 s of a 3 °/s turn)
+    reset_after : consecutive gate rejections of one measurement group after which the
+        covariance of the INS states it observes is reset and the measurement used (0: never)
     """
 
     gate_sigma: float = 5.0
@@ -91,6 +98,7 @@ class FilterTuning:
     method: str = "picard"
     predict_interval_s: float = 1.0
     predict_rotation_deg: float = 1.0
+    reset_after: int = 10
 
     def __post_init__(self):
         if not self.gate_sigma > 0:
@@ -103,34 +111,31 @@ class FilterTuning:
             raise ConfigError("navigation.filter.predict_interval_s: must be in [0, 10] s")
         if not self.predict_rotation_deg > 0:
             raise ConfigError("navigation.filter.predict_rotation_deg: must be > 0 deg")
+        if not self.reset_after >= 0:
+            raise ConfigError("navigation.filter.reset_after: must be >= 0")
 
 
 @dataclass(frozen=True)
 class GroupResult:
-    """One measurement group at one update: name (``gnss_pos``, ``gnss_vel``, ``baro``), its
-    innovation (units of the group), S, NIS, and whether it passed the gate and was used."""
+    """One measurement group at one update: name (``gnss_pos``, ``gnss_vel``, ``baro``, ...), its
+    innovation (units of the group), S, NIS, whether it passed the gate and was used, and
+    whether it was used after a covariance reset (sustained rejection)."""
 
     name: str
     innovation: np.ndarray
     S: np.ndarray
     nis: float
     used: bool
-
-
-def enu_difference_m(a_lat_rad, a_lon_rad, a_alt_m, b_lat_rad, b_lon_rad, b_alt_m) -> np.ndarray:
-    """Position a - b in local ENU at a, m (small differences: radii of curvature at a)."""
-    rm, rn = radii_m(a_lat_rad)
-    return np.array([(a_lon_rad - b_lon_rad) * (rn + a_alt_m) * math.cos(a_lat_rad),
-                     (a_lat_rad - b_lat_rad) * (rm + a_alt_m), a_alt_m - b_alt_m])
+    reset: bool = False
 
 
 @njit(cache=True)
-def _predict_step(x, P, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol):
-    """Fused prediction: F at the INS output (33-state model's INS block, free vertical; the
-    GNSS/baro states' decay) → Picard (Φ, Q_k) → (Φ x, Φ P Φᵀ + Q_k, Φ, status); status 0 ok,
+def _predict_step(x, P, lat, alt, v, rpy, w_ib, f_b, decay24, decay, q, dt, tol):
+    """Fused prediction: F at the INS output with the measured ω_ib, f
+    (:func:`filter_F_measured`) → Picard (Φ, Q_k) → (Φ x, Φ P Φᵀ + Q_k, Φ, status); status 0 ok,
     1 Δt/τ beyond the Picard range, 2 no convergence. Returns (x, P, Φ, Q_k, status)."""
-    phi, qk, status = _filter_phi_q(x.size, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt,
-                                    tol)
+    phi, qk, status = _phi_q_of(filter_F_measured(x.size, lat, alt, v, rpy, w_ib, f_b, decay24,
+                                                  decay), q, dt, tol)
     if status:
         return x, P, phi, qk, status
     xn, Pn = predict(x, P, phi, qk)
@@ -139,11 +144,20 @@ def _predict_step(x, P, lat, alt, v, rpy, w_eb, f_b, decay24, decay, q, dt, tol)
 
 @njit(cache=True)
 def _filter_F(n, lat, alt, v, rpy, w_eb, f_b, decay24, decay):
-    """F (n×n) of the filter's model at one state: the 33-state model's INS block (free
-    vertical) and the GNSS/baro states' decay."""
+    """F (n×n) of the filter's model at one state with the body rate over the Earth ``w_eb``
+    (:func:`filter_F_measured` with ω_ib = ω_eb + C_n^b ω_ie)."""
     c = _c_bn(rpy[0], rpy[1], rpy[2])
     w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(lat), OMEGA_IE_RPS * math.sin(lat)])
-    w_ib = w_eb + c.T @ w_ie
+    return filter_F_measured(n, lat, alt, v, rpy, w_eb + c.T @ w_ie, f_b, decay24, decay)
+
+
+@njit(cache=True)
+def filter_F_measured(n, lat, alt, v, rpy, w_ib, f_b, decay24, decay):
+    """F (n×n) of the filter's model at an INS output (lat rad, alt m, V ENU m/s, roll, pitch,
+    heading rad) with the INS's measured angular rate ``w_ib`` (3,) rad/s and specific force
+    ``f_b`` (3,) m/s², body axes: the 33-state model's INS block (free vertical; Babich 2017
+    eq. 6.7) and the GNSS/baro states' decay ``decay`` (n,) 1/s."""
+    c = _c_bn(rpy[0], rpy[1], rpy[2])
     F33 = build_F(lat, alt, v, f_b, w_ib, c, decay24, 0.0, 0.0)
     F = np.zeros((n, n))
     F[:15, :15] = F33[:15, :15]
@@ -188,6 +202,13 @@ def _predict_trapezoid(X, P, F0, F1, q_bar, dt, tol):
         x, Pi = predict(X[i], P[i], phi, qk)
         Xn[i], Pn[i] = x, Pi
     return Xn, Pn, phi, qk, 0
+
+
+def _w_eb(ins: NavSolution, w_ib) -> np.ndarray:
+    """ω_eb = ω_ib - C_n^b ω_ie (3,) rad/s at the INS's indicated latitude and attitude."""
+    c = _c_bn(ins.roll_rad, ins.pitch_rad, ins.heading_rad)
+    w_ie = np.array([0.0, OMEGA_IE_RPS * math.cos(ins.lat_rad), OMEGA_IE_RPS * math.sin(ins.lat_rad)])
+    return np.asarray(w_ib, float) - c.T @ w_ie
 
 
 def mean_state(ins: list[NavSolution]) -> tuple[float, float, np.ndarray, np.ndarray]:
@@ -282,24 +303,25 @@ class PredictionInterval:
         self._F0: np.ndarray | None = None
         self._w2dt = self._df2dt = 0.0   # ∫|ω|² dt, ∫max(|f|² - 2 g |f_z| + g², 0) dt
 
-    def _F_q(self, ins: list[NavSolution], truth: AircraftState) -> tuple[np.ndarray, np.ndarray]:
+    def _F_q(self, ins: list[NavSolution], f_b: np.ndarray, w_ib: np.ndarray) -> np.ndarray:
         f0 = self.filters[0]
         lat, alt, v, rpy = mean_state(ins)
-        F = _filter_F(f0.n, lat, alt, v, rpy, np.array([truth.p_rps, truth.q_rps, truth.r_rps]),
-                      np.asarray(truth.f_body_mps2, float), f0._decay24, f0.decay)
-        return F
+        return filter_F_measured(f0.n, lat, alt, v, rpy, np.asarray(w_ib, float),
+                                 np.asarray(f_b, float), f0._decay24, f0.decay)
 
-    def start(self, ins: list[NavSolution], truth: AircraftState) -> None:
-        """Open the first interval at the INS outputs ``ins`` and the truth of its start."""
-        self._F0 = self._F_q(ins, truth)
-        self.t0_s, self.dt_s = truth.t_s, 0.0
+    def start(self, ins: list[NavSolution], t_s: float, f_b, w_ib) -> None:
+        """Open the first interval at the INS outputs ``ins`` of time ``t_s`` (s) with the
+        units' mean measured specific force ``f_b`` (3,) m/s² and rate ``w_ib`` (3,) rad/s."""
+        self._F0 = self._F_q(ins, f_b, w_ib)
+        self.t0_s, self.dt_s = t_s, 0.0
 
-    def add(self, prev: AircraftState, dt_s: float) -> bool:
-        """One more navigation step of ``dt_s`` (s) starting at ``prev`` (its body rate and
-        specific force) in the interval; True when the interval is full (``max_s`` or the
-        rotation limit)."""
-        w2 = prev.p_rps ** 2 + prev.q_rps ** 2 + prev.r_rps ** 2
-        f = prev.f_body_mps2
+    def add(self, f_b, w_ib, dt_s: float) -> bool:
+        """One more navigation step of ``dt_s`` (s) with the measured specific force ``f_b``
+        (3,) m/s² and rate ``w_ib`` (3,) rad/s (its means) in the interval; True when the
+        interval is full (``max_s`` or the rotation limit)."""
+        w = np.asarray(w_ib, float)
+        f = np.asarray(f_b, float)
+        w2 = float(w @ w)
         df2 = float(f @ f) - 2.0 * G0_MPS2 * abs(float(f[2])) + G0_MPS2 ** 2
         self.dt_s += float(dt_s)
         self.rotation_rad += math.sqrt(w2) * dt_s
@@ -316,9 +338,10 @@ class PredictionInterval:
         A = self._F0[:N_INS, :N_INS] * self.dt_s
         return np.eye(N_INS) + A + 0.5 * (A @ A)
 
-    def flush(self, ins: list[NavSolution], truth: AircraftState) -> None:
-        """Close the interval at the INS outputs ``ins`` and the truth of its end: predict
-        every filter over it and open the next (nothing when it is empty).
+    def flush(self, ins: list[NavSolution], t_s: float, f_b, w_ib) -> None:
+        """Close the interval at the INS outputs ``ins`` of time ``t_s`` (s) with the measured
+        ``f_b`` (3,) m/s², ``w_ib`` (3,) rad/s of the last step: predict every filter over it
+        and open the next (nothing when it is empty).
 
         Raises
         ------
@@ -326,7 +349,7 @@ class PredictionInterval:
         """
         if self.dt_s <= 0.0:
             return
-        F1 = self._F_q(ins, truth)
+        F1 = self._F_q(ins, f_b, w_ib)
         dt = self.dt_s
         X = np.array([f.x for f in self.filters])
         P = np.array([f.P for f in self.filters])
@@ -341,7 +364,7 @@ class PredictionInterval:
             f.x, f.P = X[i], P[i]
             f._record_step(self.t0_s, phi, qk, dt)
         self._F0 = F1
-        self.t0_s, self.dt_s, self.rotation_rad = truth.t_s, 0.0, 0.0
+        self.t0_s, self.dt_s, self.rotation_rad = t_s, 0.0, 0.0
         self._w2dt = self._df2dt = 0.0
 
 
@@ -389,6 +412,7 @@ class InsGnssFilter:
         self.frozen = self._no_freeze
         self.r_scale = {"gnss_pos": np.ones(3), "gnss_vel": np.ones(3), "baro": np.ones(1)}
         self._lag = PredictionLag()   # (t_start_s, Φ, Q_k) of the recent steps
+        self._rejected: dict[str, int] = {}   # consecutive gate rejections per group
         self.t_s: float | None = None
         R = np.zeros(n)
         R[:6] = gnss.white_sigma ** 2
@@ -405,16 +429,22 @@ class InsGnssFilter:
             self._r_baro = np.array([[baro.white_sigma_m ** 2]])
 
     # -- initialisation and prediction ----------------------------------------------------
-    def initialise(self, ins: NavSolution) -> None:
+    def initialise(self, ins: NavSolution, alignment_s: float | None = None) -> None:
         """P0 at the first INS output: the INS block from the alignment (A diag(p0) Aᵀ of the
         33-state model, :func:`~fms_testbed.sensors.sins.analysis.initial_map`, at the indicated
         attitude, widened by the spread of A over the heading error σ_ψ) plus the
         equivalent-bias variance of the unmodelled accelerometer errors at 1 g; the GNSS and baro
-        states at their stationary variance."""
+        states at their stationary variance. ``alignment_s`` (s): the duration T of a
+        stationary alignment on a noisy IMU, whose white-noise means (VRW²/T, ARW²/T) level and
+        gyrocompass like a bias that the sensor's own bias state does not share: they add
+        A_b diag(q/T) A_bᵀ to the navigation block only (None: no such term)."""
         imu = self.imu
         rpy = (ins.roll_rad, ins.pitch_rad, ins.heading_rad)
         A = initial_map(ins.lat_rad, rpy, imu, SinsOptions())
         P33 = (A * imu.p0_var) @ A.T
+        if alignment_s:
+            Ab = A[:9, 9:15]
+            P33[:9, :9] += (Ab * (imu.q_psd[3:9] / float(alignment_s))) @ Ab.T
         # the map is built at the indicated heading, off by the alignment's own heading error:
         # add the first-order spread of A over that error, σ_ψ² (∂A/∂ψ) diag(p0) (∂A/∂ψ)ᵀ —
         # without it the nearly singular (ε_U, b_g) block of P0 is confidently wrong
@@ -435,23 +465,30 @@ class InsGnssFilter:
         self.x[:] = 0.0
         self.t_s = ins.t_s
 
-    def system_matrix(self, ins: NavSolution, truth: AircraftState) -> np.ndarray:
-        """F (n×n) at the INS's indicated state; IMU rates and specific force from ``truth``
-        (the IMU's errors change them by < 1e-3 relative, far below what F is sensitive to)."""
+    def system_matrix(self, ins: NavSolution, f_b, w_ib) -> np.ndarray:
+        """F (n×n) at the INS's indicated state ``ins`` with its compensated measured specific
+        force ``f_b`` (3,) m/s² and rate ``w_ib`` (3,) rad/s (body axes)."""
         F33 = system_matrix(ins.lat_rad, ins.alt_m, ins.v_enu_mps,
                             (ins.roll_rad, ins.pitch_rad, ins.heading_rad),
-                            (truth.p_rps, truth.q_rps, truth.r_rps), truth.f_body_mps2,
-                            self.imu, _FREE)
+                            _w_eb(ins, w_ib), np.asarray(f_b, float), self.imu, _FREE)
         F = np.zeros((self.n, self.n))
         F[:15, :15] = F33[:15, :15]
         F[np.arange(15, self.n), np.arange(15, self.n)] = -self.decay[15:]
         return F
 
-    def _process_noise(self, truth: AircraftState) -> np.ndarray:
-        f = np.asarray(truth.f_body_mps2, float)
+    def _process_noise(self, state) -> np.ndarray:
+        """:meth:`process_noise_at` the specific force and body rate of ``state`` (an object
+        with ``f_body_mps2``, ``p_rps``, ``q_rps``, ``r_rps``: the Monte-Carlo engine's twin
+        passes the sampled trajectory)."""
+        return self.process_noise_at(state.f_body_mps2, (state.p_rps, state.q_rps, state.r_rps))
+
+    def process_noise_at(self, f_b, w_b) -> np.ndarray:
+        """Process-noise density (n,) at the specific force ``f_b`` (3,) m/s² and body rate
+        ``w_b`` (3,) rad/s (:meth:`process_noise_mean` of their squares)."""
+        f = np.asarray(f_b, float)
+        w = np.asarray(w_b, float)
         df2 = float(f @ f) - 2.0 * G0_MPS2 * abs(float(f[2])) + G0_MPS2 ** 2
-        w2 = truth.p_rps ** 2 + truth.q_rps ** 2 + truth.r_rps ** 2
-        return self.process_noise_mean(max(df2, 0.0), w2)
+        return self.process_noise_mean(max(df2, 0.0), float(w @ w))
 
     def process_noise_mean(self, df2_mps4: float, w2_rps2: float) -> np.ndarray:
         """Process-noise density (n,) for a specific-force departure from 1 g of mean square
@@ -465,28 +502,28 @@ class InsGnssFilter:
             q[ATT] += 2.0 * self._var_gyro * w2_rps2 * tau
         return q
 
-    def predict(self, ins: NavSolution, truth: AircraftState, dt_s: float) -> None:
-        """Propagate x, P over ``dt_s`` (s) with F at the INS output ``ins`` of the step start.
+    def predict(self, ins: NavSolution, f_b, w_ib, dt_s: float) -> None:
+        """Propagate x, P over ``dt_s`` (s) with F at the INS output ``ins`` of the step start
+        and the INS's compensated measured ``f_b`` (3,) m/s², ``w_ib`` (3,) rad/s of the step.
 
         Raises
         ------
         DiscretisationError : Picard asked for Δt/τ > 0.1 or did not converge (use vanloan)
         """
-        q = self._process_noise(truth)
+        q = self.process_noise_at(f_b, w_ib)
         if self.tuning.method == "picard":
             x, P, phi, qk, status = _predict_step(
                 self.x, self.P, ins.lat_rad, ins.alt_m, np.asarray(ins.v_enu_mps, float),
                 np.array([ins.roll_rad, ins.pitch_rad, ins.heading_rad]),
-                np.array([truth.p_rps, truth.q_rps, truth.r_rps]),
-                np.asarray(truth.f_body_mps2, float), self._decay24, self.decay, q, float(dt_s),
-                1e-12)
+                np.asarray(w_ib, float), np.asarray(f_b, float), self._decay24, self.decay, q,
+                float(dt_s), 1e-12)
             if status:
                 raise DiscretisationError(
                     f"navigation.filter: Picard series unsuitable at dt = {dt_s:g} s (Δt/τ > "
                     f"{PICARD_MAX_RATE_DT} or no convergence); set navigation.filter.method: "
                     "vanloan")
         else:
-            F = self.system_matrix(ins, truth)
+            F = self.system_matrix(ins, f_b, w_ib)
             with single_thread_blas():
                 phi, qk = discretize(F, np.diag(q), dt_s, method="vanloan")
             x, P = predict(self.x, self.P, phi, qk)
@@ -508,35 +545,66 @@ class InsGnssFilter:
         return {"gnss_pos": self._r_pos, "gnss_vel": self._r_vel}.get(name) if name != "baro" \
             else self._r_baro
 
-    def _group(self, name, z, H, R, lag) -> GroupResult:
-        # one correction, kept when the innovation passes the gate (the same numbers as
-        # testing the innovation first and correcting after)
+    def use(self, meas: Measurement, sol: NavSolution, w_eb_rps=(0.0, 0.0, 0.0)
+            ) -> GroupResult | None:
+        """Use one measurement (:mod:`.measurements`) against the INS output ``sol`` at its time
+        of validity (``w_eb_rps`` (3,) rad/s: the INS's measured body rate, for lever arms):
+        delayed correction when the filter has predicted past it, the innovation gate, and the
+        covariance reset after ``tuning.reset_after`` consecutive rejections. None when the
+        measurement cannot be formed."""
+        m = meas.matrices(sol, self.n, np.asarray(w_eb_rps, float))
+        if m is None:
+            return None
+        z, H, R = m
+        name = meas.name
+        sc = self.r_scale.setdefault(name, np.ones(z.size))
+        lag = self._lag_since(meas.t_s)
+        n_rej = self._rejected.get(name, 0)
+        reset = 0 < self.tuning.reset_after <= n_rej
+        gate = math.inf if reset else self.tuning.gate_sigma
+        P_in = self.P
+        if reset:
+            self.P = self._reset_covariance(meas, z, H, R, lag)
         if lag is None:
-            x, P, nu, S, nis, used = _gated_correct(self.x, self.P, z, H, R, self.r_scale[name],
-                                                    self._no_freeze, self.tuning.gate_sigma)
+            x, P, nu, S, nis, used = _gated_correct(self.x, self.P, z, H, R, sc,
+                                                    self._no_freeze, gate)
         else:
             x, P, nu, S, nis, used = _gated_correct_delayed(
-                self.x, self.P, z, H, R, self.r_scale[name], lag[0], lag[1], self._no_freeze,
-                self.tuning.gate_sigma)
+                self.x, self.P, z, H, R, sc, lag[0], lag[1], self._no_freeze, gate)
         if used:
             self.x, self.P = x, P
-        return GroupResult(name, nu, S, nis, bool(used))
+            self._rejected[name] = 0
+        else:
+            self.P = P_in
+            self._rejected[name] = n_rej + 1
+        return GroupResult(name, nu, S, nis, bool(used), reset)
 
-    def gnss_update(self, fix: GnssFix, ins_at_fix: NavSolution) -> list[GroupResult]:
-        """Use a fix (position, then velocity) against the INS output at its time of validity."""
-        lag = self._lag_since(fix.t_s)
-        zp = enu_difference_m(ins_at_fix.lat_rad, ins_at_fix.lon_rad, ins_at_fix.alt_m,
-                              fix.lat_rad, fix.lon_rad, fix.alt_m)
-        zv = np.asarray(ins_at_fix.v_enu_mps, float) - fix.v_enu_mps
-        return [self._group("gnss_pos", zp, self._H_pos, self._r_pos, lag),
-                self._group("gnss_vel", zv, self._H_vel, self._r_vel, lag)]
+    def _reset_covariance(self, meas: Measurement, z, H, R, lag) -> np.ndarray:
+        """P with the rows and columns of ``meas.reset_states`` zeroed and their variance set
+        to the largest ν² + R_ii of the measurement (same units as those states)."""
+        Hm = H if lag is None else np.linalg.solve(lag[0].T, H.T).T
+        nu = z - Hm @ self.x
+        var = float(np.max(nu ** 2 + np.diag(R)))
+        P = self.P.copy()
+        idx = np.arange(self.n)[meas.reset_states]
+        P[idx, :] = 0.0
+        P[:, idx] = 0.0
+        P[idx, idx] = var
+        return P
+
+    def gnss_update(self, fix: GnssFix, ins_at_fix: NavSolution,
+                    w_eb_rps=(0.0, 0.0, 0.0)) -> list[GroupResult]:
+        """Use a fix (position, then velocity of the antenna; the receiver's σ, or the declared
+        white σ when it reports none) against the INS output at its time of validity."""
+        ms = gnss_measurements(fix, self.gnss.antenna_lever_arm_m, self.gnss.time_tag_sigma_s,
+                               self.gnss.white_sigma)
+        return [g for g in (self.use(m, ins_at_fix, w_eb_rps) for m in ms) if g is not None]
 
     def baro_update(self, reading: BaroReading, ins: NavSolution) -> GroupResult:
         """Use a baro reading taken at the time of the INS output ``ins``."""
         if self.baro is None:
             raise ConfigError("navigation.baro: this filter has no baro state")
-        z = np.array([ins.alt_m - reading.alt_m])
-        return self._group("baro", z, self._H_baro, self._r_baro, None)
+        return self.use(BaroAltitude(ins.t_s, reading.alt_m, self.baro.white_sigma_m), ins)
 
     def take_feedback(self) -> np.ndarray:
         """The INS block of x̂ (15,), handed to the INS; the filter's INS block is zeroed."""
@@ -546,4 +614,4 @@ class InsGnssFilter:
 
 
 __all__ = ["FilterTuning", "GroupResult", "InsGnssFilter", "PredictionInterval", "STATE_NAMES",
-           "can_share_prediction", "enu_difference_m"]
+           "can_share_prediction", "enu_difference_m", "filter_F_measured"]

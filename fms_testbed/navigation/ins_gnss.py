@@ -47,15 +47,16 @@ from fms_testbed.core.earth import radii_and_derivatives, radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import G0_MPS2
+from fms_testbed.navigation.inertial.bank import StrapdownBank
 from fms_testbed.navigation.ins_bank import InsBank, derive_seeds
 from fms_testbed.navigation.faults import check_fault, inject
 from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
                                         TwoStageFdi,
                                         channel_sigmas, declared_sensor_noise)
 from fms_testbed.navigation.ins_filter import (FilterTuning, GroupResult, InsGnssFilter,
-                                               PredictionInterval, can_share_prediction,
-                                               enu_difference_m)
+                                               PredictionInterval, _w_eb, can_share_prediction)
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
+from fms_testbed.navigation.recording import SensorRecorder
 from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor
 from fms_testbed.sensors.baro import BaroAltimeter, BaroSpec
 from fms_testbed.sensors.gnss import GnssReceiver, GnssSpec, Interval, OutlierBurst, Ramp
@@ -78,7 +79,8 @@ def gnss_spec(block) -> GnssSpec:
         tuple(block.vel_white_sigma_mps), block.rate_hz, block.latency_s,
         tuple(_interval(o) for o in block.outages),
         tuple(OutlierBurst(_interval(o), o.sigma_m) for o in block.outliers),
-        tuple(Ramp(_interval(r), tuple(r.rate_mps)) for r in block.ramps))
+        tuple(Ramp(_interval(r), tuple(r.rate_mps)) for r in block.ramps),
+        tuple(block.antenna_lever_arm_m), block.time_tag_error_s, block.time_tag_sigma_s)
 
 
 def baro_spec(block) -> BaroSpec | None:
@@ -179,6 +181,8 @@ class InsGnssNavigation(NavigationSourceBase):
                  filters: list[InsGnssFilter], alert_delay_s: float = DEFAULT_ALERT_DELAY_S,
                  fdi: TwoStageFdi | None = None):
         self.bank, self.receiver, self.baro, self.filters = bank, receiver, baro, filters
+        self.frame_properties = tuple(bank.frame_properties)
+        self.truth_model = "strapdown" if isinstance(bank, StrapdownBank) else "linear"
         self.alert_delay_s = float(alert_delay_s)
         self.fdi = fdi
         # seed 001's fault-tolerant estimator (channel tests, baro exclusion, vertical freezing)
@@ -203,6 +207,7 @@ class InsGnssNavigation(NavigationSourceBase):
         self._mean_P_cache: dict[tuple, tuple] = {}
         self._anp = math.nan
         self._interval: PredictionInterval | None = None      # built at the first step
+        self.recorder: SensorRecorder | None = None   # navigation.record_sensors
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "InsGnssNavigation":
@@ -222,16 +227,23 @@ class InsGnssNavigation(NavigationSourceBase):
         seeds = derive_seeds(sd, b.n_ins + 2)        # [GNSS, baro, INS 1, INS 2, ...]
         g, br = gnss_spec(b.gnss), baro_spec(b.baro)
         tuning = FilterTuning(b.filter.gate_sigma, b.filter.unmodelled_tau_s, b.filter.method,
-                              b.filter.predict_interval_s, b.filter.predict_rotation_deg)
-        bank = InsBank([imu] * b.n_ins, seeds[2:], method=b.filter.method,
-                       matrices_dt_s=b.matrices_dt_s,
-                       matrices_rotation_deg=b.matrices_rotation_deg)
+                              b.filter.predict_interval_s, b.filter.predict_rotation_deg,
+                              b.filter.reset_after)
+        if b.truth_model == "strapdown":
+            bank = StrapdownBank([imu] * b.n_ins, seeds[2:], alignment=b.alignment)
+        else:
+            bank = InsBank([imu] * b.n_ins, seeds[2:], method=b.filter.method,
+                           matrices_dt_s=b.matrices_dt_s,
+                           matrices_rotation_deg=b.matrices_rotation_deg)
         filters = [InsGnssFilter(imu, g, br, tuning) for _ in range(b.n_ins)]
         baro = BaroAltimeter(br, seeds[1]) if br is not None else None
         fdi = TwoStageFdi(b.n_ins) if b.n_ins > 1 else None
         src = cls(bank, GnssReceiver(g, seeds[0]), baro, filters,
                   DEFAULT_ALERT_DELAY_S if b.alert_delay_s is None else b.alert_delay_s, fdi)
         src.seed = sd
+        src.truth_model = b.truth_model
+        if b.record_sensors:
+            src.recorder = SensorRecorder(b.imu, dict(spec.get("gnss") or {}))
         if b.n_ins == 3:
             src.refdesc = ReferenceDescriptionMonitor([f.imu for f in filters])
         return src
@@ -278,29 +290,36 @@ class InsGnssNavigation(NavigationSourceBase):
         ``filter.predict_interval_s``; every step and one filter at a time (F at the step's
         start) when they cannot share the call or ``fused`` is off (the reference path)."""
         dt_s = truth.t_s - prev.t_s
+        meas = [self.bank.measured(i) for i in range(len(self.filters))]
         if not self.fused or not can_share_prediction(self.filters):
             for i, f in enumerate(self.filters):
-                f.predict(self._prev_ins[i], prev, dt_s)
+                f.predict(self._prev_ins[i], meas[i][0], meas[i][1], dt_s)
             return
+        f_b = sum(m[0] for m in meas) / len(meas)
+        w_ib = sum(m[1] for m in meas) / len(meas)
         iv = self._interval
         if iv is None or iv.filters is not self.filters:
             iv = self._interval = PredictionInterval(self.filters)
-            iv.start(self._prev_ins, prev)
-        full = iv.add(prev, dt_s)
+            iv.start(self._prev_ins, prev.t_s, f_b, w_ib)
+        full = iv.add(f_b, w_ib, dt_s)
         if boundary or full:
-            iv.flush(ins, truth)
+            iv.flush(ins, truth.t_s, f_b, w_ib)
 
     def update(self, truth: AircraftState, frames=None) -> NavSolution:
         """Advance to ``truth.t_s``: INS, prediction, GNSS (feedback), baro, identification;
         return the output."""
-        ins = self.bank.update(truth)
+        ins = self.bank.update(truth, frames)
         t = truth.t_s
         prev = self._prev_truth
         fixes = self.receiver.update(truth)
         reading = self.baro.update(truth) if self.baro is not None else None
+        if self.recorder is not None:
+            self._record(truth, prev, fixes)
         if prev is None:
             for i, f in enumerate(self.filters):
-                f.initialise(ins[i])
+                f.initialise(ins[i], self._alignment_s())
+            if self.recorder is not None:
+                self.recorder.start(ins[0], self.filters[0].P, self._alignment_s())
         elif t > prev.t_s:
             # an interval ends where a measurement is valid: at a GNSS epoch (the fix, delivered
             # later, is then used at the filters' time, its time of validity) and at a baro
@@ -318,7 +337,7 @@ class InsGnssNavigation(NavigationSourceBase):
                 if at is None:
                     continue
                 self.events += self.ft.set_vertical(i, t, True)      # altitude measured
-                groups = f.gnss_update(fix, at)
+                groups = f.gnss_update(fix, at, _w_eb(at, self.bank.measured(i)[1]))
                 self.events += self.ft.check(i, t, groups)
                 for r in groups:
                     if i == 0:
@@ -345,6 +364,31 @@ class InsGnssNavigation(NavigationSourceBase):
         self._prev_truth, self._prev_ins = truth, ins
         return self.solution(truth, ins)
 
+    def _record(self, truth: AircraftState, prev: AircraftState | None, fixes) -> None:
+        """Record unit 0's raw step increments, the delivered fixes and the truth."""
+        rec = self.recorder
+        rec.true_state(truth)
+        for fix in fixes:
+            rec.fix(fix)
+        if prev is not None and truth.t_s > prev.t_s:
+            f, w = self.bank.measured(0)
+            comp = self.bank.comp[0] if isinstance(self.bank, StrapdownBank) else \
+                self.bank.compensation[0]
+            rec.step(truth.t_s, np.concatenate([f, w]) + comp, truth.t_s - prev.t_s)
+
+    def recorded_sensors(self) -> dict | None:
+        """The recorded sensors (:meth:`~.recording.SensorRecorder.tables`; None: not
+        recording)."""
+        return None if self.recorder is None else self.recorder.tables()
+
+    def _alignment_s(self) -> float | None:
+        """The stationary alignment's duration of a strapdown bank (its white-noise means are
+        in the initial errors), else None."""
+        b = self.bank
+        if isinstance(b, StrapdownBank) and b.alignment == "stationary":
+            return b.alignment_s
+        return None
+
     def _sensor_pairs(self, truth: AircraftState) -> tuple:
         """Sensor-level stage 1 on the units' raw IMU outputs over the last step."""
         prev = self._prev_sensor_t
@@ -355,8 +399,15 @@ class InsGnssNavigation(NavigationSourceBase):
         if self.comparator is None:
             q, sf = declared_sensor_noise([f.imu for f in self.filters], dt)
             self.comparator = SensorComparator(len(self.bank), q, dt, sf, self.fdi.tuning)
-        return self.comparator.update(truth.t_s, self.bank.sensor_errors(truth, dt),
-                                      truth.f_body_mps2, (truth.p_rps, truth.q_rps, truth.r_rps))
+        if isinstance(self.bank, StrapdownBank):
+            # the units' raw measured outputs: their pair differences are those of the errors
+            raw = self.bank.mean + self.bank.comp
+            f, w = raw[0, :3], raw[0, 3:]
+        else:
+            # the linear twin: its units' outputs are truth ⊕ errors, the errors are what it has
+            f, w = self.bank.measured(0)
+            raw = self.bank.sensor_errors(truth, dt)
+        return self.comparator.update(truth.t_s, raw, f, w)
 
     def _mean_P(self, units: list[int]) -> np.ndarray:
         """(9, 9): the mean over ``units`` of the filters' covariances of the navigation states

@@ -129,10 +129,11 @@ def monitor_flight(df: pd.DataFrame, source, rnp_m: float | None
     -------
     (df with an ``rnp_alert`` column 0/1 when ANP was logged, the ``navigation`` block: ``events``
     sorted by time and ``rnp_alert`` {raised, first_t_s, time_to_alert_s, delay_s}; None when the
-    source logs neither ANP nor events)
+    source logs neither ANP nor events nor has a ``truth_model``; ``truth_model`` the source's)
     """
     events = [dict(e) for e in getattr(source, "events", None) or []]
-    if "anp_m" not in df and not events:
+    truth_model = getattr(source, "truth_model", None)
+    if "anp_m" not in df and not events and truth_model is None:
         return df, None
     block: dict = {}
     if "anp_m" in df:
@@ -154,6 +155,8 @@ def monitor_flight(df: pd.DataFrame, source, rnp_m: float | None
     if nse95:
         block["nse95_m"] = nse95
     block["events"] = sorted(events, key=lambda e: e["t_s"])
+    if truth_model is not None:
+        block["truth_model"] = truth_model
     return df, block
 
 

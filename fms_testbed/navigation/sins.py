@@ -3,6 +3,7 @@
 Scenario block (``navigation:``)::
 
     source: sins
+    truth_model: linear     # linear (this class) | strapdown (.strapdown_sins)
     imu: STIM300            # preset name (imu/*.yaml), a .yaml path, or an inline mapping
     seed: 7                 # optional; otherwise the run seed
     method: picard          # picard | vanloan | trapezoid
@@ -56,7 +57,7 @@ from fms_testbed.sensors.sins._blas import single_thread_blas
 from fms_testbed.sensors.sins.analysis import system_matrix, initial_map
 
 SPEC_KEYS = {"source", "imu", "seed", "method", "dt_s", "vertical", "baro_tau_s", "tol",
-             "matrices_dt_s", "matrices_rotation_deg", "alignment"}
+             "matrices_dt_s", "matrices_rotation_deg", "alignment", "truth_model"}
 NOISE_BLOCK = 256   # navigation steps of process noise drawn at once
 
 
@@ -144,6 +145,8 @@ class SinsNavigation(NavigationSourceBase):
 
     #: per-frame JSBSim samples the truth side needs (none: it reads the outer-step state)
     frame_properties: tuple[tuple[str, float], ...] = ()
+    #: the truth side: truth ⊕ the linear error model
+    truth_model = "linear"
 
     def __init__(self, imu: ImuModel, seed: int = 0, opts: SinsOptions = SinsOptions(),
                  dt_s: float = 0.1, matrices_dt_s: float = 0.0,
@@ -181,6 +184,12 @@ class SinsNavigation(NavigationSourceBase):
         if unknown:
             raise ConfigError(f"navigation.{unknown[0]}: unknown key; allowed: "
                               f"{', '.join(sorted(SPEC_KEYS))}")
+        truth_model = spec.get("truth_model", "linear")
+        if truth_model not in ("linear", "strapdown"):
+            raise ConfigError(f"navigation.truth_model: strapdown or linear, got {truth_model!r}")
+        if truth_model == "strapdown":
+            from fms_testbed.navigation.strapdown_sins import StrapdownSinsNavigation
+            return StrapdownSinsNavigation.from_spec(spec, seed)
         if "imu" not in spec:
             raise ConfigError("navigation.imu: missing (a preset name, a .yaml path or a mapping)")
         imu = load_imu(spec["imu"])

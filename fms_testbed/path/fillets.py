@@ -74,6 +74,34 @@ def _geo_radial(fr: LocalFrame, arc: Arc, planar_radial_deg: float) -> float:
     return inverse(arc.centre_lat_deg, arc.centre_lon_deg, lat, lon)[1]
 
 
+def _planar_lead(fr: LocalFrame, line: Line, arc: Arc, omega: float, r_m: float
+                 ) -> tuple[float, float, float, float, float] | None:
+    """The lead L of a fillet of radius ``r_m`` from ``line`` onto ``arc`` in the plane of
+    ``fr`` (origin at the corner): the fillet's centre F = −L u + r n (u the line's direction,
+    n its normal toward the turn) lies at |F − C| = R ∓ r from the arc's centre C — a
+    quadratic in L, its least root ≥ 0. Returns (L m, F x, F y, C x, C y) or None."""
+    sgn = 1.0 if omega > 0 else -1.0
+    same = (arc.sweep_deg > 0) == (omega > 0)
+    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
+    u = math.radians(line.end_course_deg)
+    ux, uy = math.sin(u), math.cos(u)
+    nx, ny = sgn * uy, -sgn * ux          # unit normal toward the turn side
+    d = arc.radius_m - r_m if same else arc.radius_m + r_m
+    if d <= 0:
+        return None
+    px, py = r_m * nx - cx, r_m * ny - cy
+    bq = -(px * ux + py * uy)
+    cq = px * px + py * py - d * d
+    disc = bq * bq - cq
+    if disc < 0:
+        return None
+    roots = sorted(x for x in (-bq - math.sqrt(disc), -bq + math.sqrt(disc)) if x >= 0)
+    if not roots:
+        return None
+    lead = roots[0]
+    return lead, -lead * ux + r_m * nx, -lead * uy + r_m * ny, cx, cy
+
+
 def line_arc_fillet(line: Line, arc: Arc, r_m: float, avail_m: float | None = None
                     ) -> Fillet | None:
     """Round the corner from ``line`` (ending where ``arc`` starts) onto ``arc``.
@@ -93,28 +121,11 @@ def line_arc_fillet(line: Line, arc: Arc, r_m: float, avail_m: float | None = No
     if abs(omega) < 0.5:
         return None
     avail_m = line.length_m() if avail_m is None else avail_m
-    sgn = 1.0 if omega > 0 else -1.0
-    same = (arc.sweep_deg > 0) == (omega > 0)
     fr = LocalFrame(*arc.start)
-    cx, cy = fr.to_xy(arc.centre_lat_deg, arc.centre_lon_deg)
-    u = math.radians(line.end_course_deg)
-    ux, uy = math.sin(u), math.cos(u)
-    nx, ny = sgn * uy, -sgn * ux          # unit normal toward the turn side
-    d = arc.radius_m - r_m if same else arc.radius_m + r_m
-    if d <= 0:
+    got = _planar_lead(fr, line, arc, omega, r_m)
+    if got is None or got[0] > avail_m:
         return None
-    # F = -L u + r n, |F - C| = d: a quadratic in the lead L
-    px, py = r_m * nx - cx, r_m * ny - cy
-    bq = -(px * ux + py * uy)
-    cq = px * px + py * py - d * d
-    disc = bq * bq - cq
-    if disc < 0:
-        return None
-    roots = sorted(x for x in (-bq - math.sqrt(disc), -bq + math.sqrt(disc)) if x >= 0)
-    if not roots or roots[0] > avail_m:
-        return None
-    lead = roots[0]
-    fx, fy = -lead * ux + r_m * nx, -lead * uy + r_m * ny
+    lead, fx, fy, cx, cy = got
     # the contact point lies on the ray from C through F (planar radial from C) ...
     radial_t2 = math.degrees(math.atan2(fx - cx, fy - cy))
     # ... and from here on the geometry is exact: the contact point on the coded arc and a

@@ -20,7 +20,8 @@ from fms_testbed.core.segments import Arc, project
 from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
 from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
-from fms_testbed.path.profile import plan_profile, sid_join_required_alt_m
+from fms_testbed.path.coding import hold_checks, record_checks
+from fms_testbed.path.profile import path_climb_top_m, plan_profile, sid_join_required_alt_m
 from fms_testbed.path.segmentation import planned_conditions
 
 #: Tolerances: fly-over pass, gaps (the coded-arc radius tolerances are the leg classes'
@@ -106,8 +107,6 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                 g: float) -> list[Finding]:
     """(R, Ω, γ) checks of the coded arcs (RF, AF) with the γ and V,γ corrections."""
     out = []
-    gplan = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
-    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
     for lg in path.legs:
         kind = LEG_TYPES[lg.path_term]
         if kind.arc_centre is None:
@@ -141,31 +140,37 @@ def _arc_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
                                    f"{lg.path_term} radius coded {coded_r / NM_M:.3f} NM, fixes "
                                    f"give {arc.radius_m / NM_M:.3f} NM: path follows the fixes",
                                    "R"))
-        v = lg.speed_mps
-        # the ground speed on an arc reaches TAS + wind (class 1): the wind at the leg's
-        # planned altitude
-        w = params.wind_at(lg.start.alt_m)[0]
-        why = arc_conditions_text(v, w, params.isa_dev_c, lg.start.alt_m, arc.radius_m, gplan, g)
-        for _ in range(params.max_iterations):
-            g_req = math.degrees(math.atan((v + w) ** 2 / (arc.radius_m * g)))
-            if g_req <= gplan + 1e-9:
-                break
-            if g_req <= gmax:
-                out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
-                                   f"{arc.radius_m / NM_M:.2f} NM at {v / KT_MPS:.0f} kt: bank "
-                                   f"{gplan:.0f} -> {g_req:.1f}°{why}", "γ"))
-                break
-            v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax))) - w
-            if v_reg >= perf.tas_min_mps:
-                out.append(Finding(lg.index, "correction", f"{lg.path_term} radius "
-                                   f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT_MPS:.0f} -> "
-                                   f"{v_reg / KT_MPS:.0f} kt at bank {gmax:.0f}°{why}", "V,γ"))
-                break
-            out.append(Finding(lg.index, "impossible", f"{lg.path_term} radius "
-                               f"{arc.radius_m / NM_M:.2f} NM needs bank {g_req:.0f}° > "
-                               f"{gmax:.0f}° even at the minimum speed {v_reg / KT_MPS:.0f} kt"))
-            break
+        out += _arc_bank_findings(lg, arc, perf, params, g)
     return out
+
+
+def _arc_bank_findings(lg, arc, perf: Performance, params: BuildParams, g: float
+                       ) -> list[Finding]:
+    """(γ; V,γ) of one coded arc: the bank its radius needs at the planned speed and the
+    wind at the leg's planned altitude, γ = atan((V + W)² / (R g)); raised up to the limit,
+    else the speed lowered to V = √(R g tan γ_max) − W, else impossible."""
+    gplan = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
+    gmax = min(params.bank_limit_deg, perf.bank_max_deg)
+    v = lg.speed_mps
+    # the ground speed on an arc reaches TAS + wind (class 1): the wind at the leg's
+    # planned altitude
+    w = params.wind_at(lg.start.alt_m)[0]
+    why = arc_conditions_text(v, w, params.isa_dev_c, lg.start.alt_m, arc.radius_m, gplan, g)
+    g_req = math.degrees(math.atan((v + w) ** 2 / (arc.radius_m * g)))
+    if g_req <= gplan + 1e-9:
+        return []
+    if g_req <= gmax:
+        return [Finding(lg.index, "correction", f"{lg.path_term} radius "
+                        f"{arc.radius_m / NM_M:.2f} NM at {v / KT_MPS:.0f} kt: bank "
+                        f"{gplan:.0f} -> {g_req:.1f}°{why}", "γ")]
+    v_reg = math.sqrt(arc.radius_m * g * math.tan(math.radians(gmax))) - w
+    if v_reg >= perf.tas_min_mps:
+        return [Finding(lg.index, "correction", f"{lg.path_term} radius "
+                        f"{arc.radius_m / NM_M:.2f} NM: speed {v / KT_MPS:.0f} -> "
+                        f"{v_reg / KT_MPS:.0f} kt at bank {gmax:.0f}°{why}", "V,γ")]
+    return [Finding(lg.index, "impossible", f"{lg.path_term} radius "
+                    f"{arc.radius_m / NM_M:.2f} NM needs bank {g_req:.0f}° > "
+                    f"{gmax:.0f}° even at the minimum speed {v_reg / KT_MPS:.0f} kt")]
 
 
 def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams,
@@ -186,8 +191,11 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
             out.append(Finding(-1, "impossible", f"aircraft climb gradient "
                                f"{100 * theta_perf:.1f}% below the 3.3% minimum"))
     g_desc = perf.descent_rate_max_mps / perf.tas_plan_mps
+    top = path_climb_top_m(path.proc_type, params.climb_top_m)
     prof = plan_profile(path, theta_perf, start_alt_m, params.descent_angle_deg,
-                        descent_gradient_max=g_desc, descent_rate_mps=perf.descent_rate_max_mps)
+                        climb_top_m=top, descent_gradient_max=g_desc,
+                        descent_rate_mps=perf.descent_rate_max_mps,
+                        alt_max_m=perf.alt_plan_max_m)
     if path.proc_type == "D" and path.start_kind != "runway" and prof.windows:
         # joined at a fix away from the runway: the planned start must make every climb
         # constraint ahead at the aircraft's gradient; a start below that is flagged and the
@@ -200,8 +208,20 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                                f"at {100 * theta_perf:.1f}%: joined at {a0 / FT_M:.0f} ft",
                                "V,Θ"))
             prof = plan_profile(path, theta_perf, a0, params.descent_angle_deg,
-                                descent_gradient_max=g_desc,
-                                descent_rate_mps=perf.descent_rate_max_mps)
+                                climb_top_m=top, descent_gradient_max=g_desc,
+                                descent_rate_mps=perf.descent_rate_max_mps,
+                                alt_max_m=perf.alt_plan_max_m)
+    out += _climb_window_findings(path, perf, params, prof, v, theta_perf)
+    out += _descent_findings(path, perf, prof, v)
+    return out, prof
+
+
+def _climb_window_findings(path: ProcedurePath, perf: Performance, params: BuildParams,
+                           prof, v: float, theta_perf: float) -> list[Finding]:
+    """(V,Θ) of every 'at or above' window of a climb the profile misses at the gradient
+    ``theta_perf``: the speed lowered (bounded iterations) until the aircraft's gradient
+    there makes it, else impossible. ``v``: the planned TAS, m/s."""
+    out = []
     for w in prof.windows:
         k = w.leg_index + 1
         if not prof.climb[k] or w.lo_m is None or prof.alt_m[k] >= w.lo_m - 1.0:
@@ -239,6 +259,14 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
                                f"{w.lo_m / FT_M:.0f} ft needs {100 * need:.2f}% climb, aircraft "
                                f"max {100 * perf.climb_gradient_at(perf.tas_min_mps):.2f}% at "
                                "minimum speed"))
+    return out
+
+
+def _descent_findings(path: ProcedurePath, perf: Performance, prof, v: float
+                      ) -> list[Finding]:
+    """(V,Θ) of every descent piece steeper than the descent rate allows at ``v`` (m/s):
+    V = w_d / gradient when that is above the minimum speed, else impossible."""
+    out = []
     grads = prof.gradients()
     for k in range(1, len(prof.alt_m)):
         if prof.climb[k] or not grads[k - 1] < 0:
@@ -258,7 +286,7 @@ def _gradient_checks(path: ProcedurePath, perf: Performance, params: BuildParams
             out.append(Finding(k - 1, "impossible", f"descent to {ident} needs "
                                f"{100 * need:.1f}% (> {100 * perf.descent_rate_max_mps / perf.tas_min_mps:.1f}% "
                                "at minimum speed)"))
-    return out, prof
+    return out
 
 
 LONG_WAY_TURN_DEG = 270.0
@@ -339,14 +367,83 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
     return out
 
 
+CF_OFF_COURSE_DEG = 20.0
+"""A CF's own straight (role 'leg') more than this off its coded course is not the coded leg,
+deg."""
+CF_AGAINST_COURSE_DEG = 90.0
+"""A CF's own straight more than this off its coded course is flown against it, deg."""
+
+
+def cf_course_checks(path: ProcedurePath) -> list[Finding]:
+    """Every straight a CF leg flies as its own path (role 'leg') against its coded course
+    (from the record, turned true with the leg's variation).
+
+    More than :data:`CF_AGAINST_COURSE_DEG` off (the course flown backwards): the transition
+    is impossible, with the reason. More than :data:`CF_OFF_COURSE_DEG` off (the fix reached
+    direct where the course cannot be joined at the planned radius, the corner flown over
+    and the fix rejoined): a correction of branch V,γ,φ,λ (the position changed, class 1)
+    that says the coded course is not flown. The turns and intercepts onto the course (roles
+    'turn', 'flyby') are transitions and not checked."""
+    out = []
+    for lg in path.legs:
+        if lg.path_term != "CF" or lg.resolved is None or lg.resolved.course_true_deg is None:
+            continue
+        crs = lg.resolved.course_true_deg
+        offs = [max(abs(wrap180(s.geom.start_course_deg - crs)),
+                    abs(wrap180(s.geom.end_course_deg - crs))) for s in path.segments
+                if s.leg_index == lg.index and s.role == "leg" and s.geom.kind == "line"
+                and s.geom.length_m() >= 1.0]
+        off = max(offs, default=0.0)
+        if off <= CF_OFF_COURSE_DEG:
+            continue
+        ident = lg.record.fix.ident if lg.record.fix else ""
+        what = (f"CF {ident} built {off:.0f}° off its coded course {crs:.1f}° "
+                f"(line {lg.record.line})")
+        if off > CF_AGAINST_COURSE_DEG:
+            out.append(Finding(lg.index, "impossible", f"{what}: flown against the course"))
+        else:
+            out.append(Finding(lg.index, "correction", f"{what}: the fix is reached without "
+                               "flying the coded course", "V,γ,φ,λ"))
+    return out
+
+
+STATUSES = ("ok", "corrected", "coding_suspect", "impossible")
+"""The monitor's outcomes of a transition, from best to worst (:func:`outcome`)."""
+
+
 def outcome(findings) -> str:
-    """'impossible' if any finding says so, 'corrected' if the plan was changed, else 'ok'."""
+    """The monitor's outcome (:data:`STATUSES`) from its findings.
+
+    'impossible' if a finding says so or the built path is not continuous (a
+    ``discontinuity``: a gap bridged or a track jump, the path is not the coded one);
+    'coding_suspect' if a record's coded numbers disagree with its fixes (category
+    ``coding``, :mod:`.coding`) or the path loops or is flown twice (``loop``, Danilin's
+    Fig. 4): class 3, the database's coding; 'corrected' if the plan was changed to fly it
+    (``correction``, ``no-intercept``); else 'ok'.
+    """
     cats = {f.category for f in findings}
-    if "impossible" in cats:
+    if cats & {"impossible", "discontinuity"}:
         return "impossible"
-    if cats & {"correction", "no-intercept", "discontinuity"}:
+    if cats & {"coding", "loop"}:
+        return "coding_suspect"
+    if cats & {"correction", "no-intercept"}:
         return "corrected"
     return "ok"
+
+
+def coding_findings(path: ProcedurePath, params: BuildParams) -> list[Finding]:
+    """Class-3 findings of the coded numbers (:mod:`.coding`) of the legs built from
+    resolved records, and of the holds' built leg lengths.
+
+    Parameters
+    ----------
+    path : the built transition; params : build settings (the timed-leg speed, m/s)
+    """
+    legs = [lg for lg in path.legs if lg.resolved is not None]
+    if len(legs) != len(path.legs):
+        return []
+    out = record_checks([lg.resolved for lg in legs], [lg.from_fix for lg in legs])
+    return out + hold_checks(path, params.timed_speed_mps)
 
 
 def check_path(path: ProcedurePath, perf: Performance, params: BuildParams | None = None,
@@ -370,4 +467,6 @@ def check_path(path: ProcedurePath, perf: Performance, params: BuildParams | Non
     grad, prof = _gradient_checks(path, perf, params, path.legs[0].start.alt_m)
     findings += grad
     findings += _topology_checks(path)
+    findings += coding_findings(path, params)
+    findings += cf_course_checks(path)
     return replace(path, findings=tuple(findings), profile=prof, status=outcome(findings))

@@ -212,7 +212,7 @@ def _finish(path, seq, spec, cfg, perf, params, offset: int,
                             descent_rate_mps=PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
                             wind=(params.wind_speed_mps, params.wind_from_deg),
                             start_in_climb=in_missed, cas_plan_mps=cfg.limits.climb_cas_mps,
-                            isa_dev_c=params.isa_dev_c)
+                            isa_dev_c=params.isa_dev_c, alt_max_m=perf.alt_plan_max_m)
         if checked.proc_type == "F" and cfg.approach is not None:
             prof = replace(prof, speed=approach_speed_profile(checked, prof, cfg))
         checked = replace(checked, profile=prof)

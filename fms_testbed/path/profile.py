@@ -201,13 +201,70 @@ def descent_leg_tas_mps(path: ProcedurePath, leg_alt_m: np.ndarray, cas_plan_mps
     return out
 
 
+def climb_phases(records, proc_type: str, start_in_climb: bool = False) -> np.ndarray:
+    """Per node (the start and every leg end), True where the leg ending there is climbed: a
+    SID, or from the first missed-approach leg on (or all of it with ``start_in_climb``)."""
+    climb = np.zeros(len(records) + 1, dtype=bool)
+    climbing = proc_type == "D" or start_in_climb
+    for k, r in enumerate(records):
+        climbing = climbing or r.missed_approach_start
+        climb[k + 1] = climbing
+    return climb
+
+
+def path_climb_top_m(proc_type: str, climb_top_m: float | None) -> float | None:
+    """The climb top a path of type ``proc_type`` is planned to, m: the flight's
+    ``climb_top_m`` for a SID; None for an approach (its missed approach climbs to its own
+    coded altitudes, the highest of them, not to the SID climb top)."""
+    return None if proc_type == "F" else climb_top_m
+
+
+def climb_caps_m(records, climb: np.ndarray, climb_top_m: float | None = None,
+                 alt_max_m: float = math.inf) -> np.ndarray:
+    """The altitude a climb may reach at each node (the start and every leg end), m.
+
+    A climb is capped by every 'at or below' ahead of the node and levels at the highest
+    climb constraint still ahead, raised to ``climb_top_m`` when given (else, with none
+    coded, the coded transition altitude, else 18,000 ft); never above ``alt_max_m`` (the
+    aircraft's ceiling less its margin). The one climb planner: the leg builder (planned
+    altitudes, speeds and turn radii) and :func:`plan_profile` both use it.
+
+    Parameters
+    ----------
+    records : the legs' :class:`~fms_testbed.procedures.legrecord.LegRecord` in order
+    climb : per node, whether it is climbed (:func:`climb_phases`)
+    climb_top_m : the flight's climb top, m (None: from the records, above)
+    alt_max_m : the highest altitude the plan may reach, m
+    """
+    n = len(records)
+    cap = np.full(n + 1, np.inf)
+    run = np.inf
+    top = -np.inf
+    trans = next((r.trans_alt_m for r in records if r.trans_alt_m), None)
+    wins = [(None, None)] + [window(r.alt_desc, r.alt1_m, r.alt2_m) for r in records]
+    for k in range(n, -1, -1):
+        lo, hi = wins[k]
+        if climb[k]:
+            if hi is not None:
+                run = min(run, hi)
+                top = max(top, hi)
+            elif lo is not None:
+                top = max(top, lo)
+        if climb_top_m is not None:
+            level = max(top, climb_top_m)
+        else:
+            level = top if np.isfinite(top) else (trans if trans else 18000 * FT_M)
+        cap[k] = min(run, level, alt_max_m)
+    return cap
+
+
 def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
                  descent_angle_deg: float = 3.0, climb_top_m: float | None = None,
                  descent_gradient_max: float | None = None,
                  descent_rate_mps: float | None = None,
                  wind: tuple[float, float] | None = None,
                  start_in_climb: bool = False, cas_plan_mps: float | None = None,
-                 isa_dev_c: float = 0.0) -> VerticalProfile:
+                 isa_dev_c: float = 0.0, alt_max_m: float = math.inf) -> VerticalProfile:
     """Plan the vertical profile of a built path.
 
     Parameters
@@ -216,10 +273,7 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     climb_gradient : planned climb gradient (rise over run) for climb phases
     start_alt_m : altitude at the path start, m
     descent_angle_deg : default descent path angle where no vertical angle is coded, deg
-    climb_top_m : where a climb levels off, m (raised to the highest climb constraint ahead);
-        None: the highest climb constraint ahead, else the coded transition altitude, else
-        18,000 ft (the database check). A flight passes its own climb top so that the planned
-        profile and the flown climb level at the same altitude.
+    climb_top_m : where a climb levels off, m (:func:`climb_caps_m`; None: from the records)
     descent_gradient_max : steepest descent the aircraft can fly (drop over run; its descent
         rate over its planned speed); None: 2.5 × tan(descent_angle_deg)
     descent_rate_mps : when given, the steepest descent of each leg is this rate over the
@@ -231,155 +285,155 @@ def plan_profile(path: ProcedurePath, climb_gradient: float, start_alt_m: float,
     cas_plan_mps, isa_dev_c : with ``descent_rate_mps``, the aircraft's planned CAS (m/s) and
         the day's ISA deviation (K): descents are planned within the energy the aircraft can
         shed (below)
+    alt_max_m : the highest altitude the plan may reach (the aircraft's ceiling less its
+        margin, :attr:`~fms_testbed.legs.model.Performance.alt_plan_max_m`), m: climbs level
+        at :func:`climb_caps_m`, descents start no higher
 
     Notes
     -----
-    Descent: planned backwards from the last constrained node at the coded vertical angle
-    (else ``descent_angle_deg``), clamped into every window and under the start and highest
-    coded altitude — so the final approach lies on its coded path angle to the runway. Where
-    the path starts above that geometric path, the aircraft descends from its start at up to
-    ``descent_gradient_max`` until it meets it (it does not stay high and dive at the end).
-
-    Energy (Danilin: the path from the aircraft's performance, speeds included): with
-    ``cas_plan_mps`` a leg without a coded angle drops no more than the aircraft can at its
-    descent rate while it also changes speed (:func:`descent_leg_tas_mps`)::
+    Descent: backwards from the last constrained node at the coded angle (else
+    ``descent_angle_deg``), clamped into every window, under the start and highest coded
+    altitude; from a start above that path, down at up to ``descent_gradient_max`` until it
+    is met. With ``cas_plan_mps`` a leg without a coded angle drops no more than the energy
+    the aircraft can shed (Danilin: speeds from its performance, :func:`energy_drop_max_m`)::
 
         Δh_k ≤ (w_d / V_g,k) Δs_k + (V_k² − V_k-1²) / (2 g)
-
-    (w_d = ``descent_rate_mps``, V_g the ground speed, V TAS; a deceleration uses up part of
-    the drop). A 737 slowing from 280 to 230 kt CAS near FL180 sheds the energy of ~1,600 ft:
-    planned at 3° regardless, the aircraft levelled to slow down and crossed the 'at or below'
-    fix after it 551 ft high (KTMB BNFSH2). The fix before such a leg is planned lower instead.
     """
-    g_desc = descent_gradient_max if descent_gradient_max is not None else \
-        2.5 * math.tan(math.radians(descent_angle_deg))
+    plan = _Plan(path, start_alt_m, descent_angle_deg, descent_rate_mps, wind,
+                 climb_phases([lg.record for lg in path.legs], path.proc_type, start_in_climb))
+    plan.ceiling = max(min(max(plan.coded(), default=-math.inf), alt_max_m), start_alt_m)
+    if plan.desc_idx:
+        plan.backward(None)
+        if cas_plan_mps is not None and descent_rate_mps is not None:
+            # the speeds at the altitudes of the geometric plan, then the plan within the
+            # energy budget (one refinement: TAS changes ~2 %/1,000 ft)
+            plan.backward(descent_leg_tas_mps(path, plan.alt[1:], cas_plan_mps, isa_dev_c))
+        plan.forward(descent_gradient_max if descent_gradient_max is not None else
+                     2.5 * math.tan(math.radians(descent_angle_deg)))
+        plan.never_climb_in_descent()
+    plan.climb_up(climb_caps_m([lg.record for lg in path.legs], plan.climb, climb_top_m,
+                               alt_max_m), climb_gradient)
+    return VerticalProfile(plan.along, plan.alt, plan.climb, tuple(plan.windows))
 
-    n = len(path.legs)
-    ends = leg_end_distances(path)
-    windows = []
-    climb = np.zeros(n + 1, dtype=bool)
-    climbing = path.proc_type == "D" or start_in_climb
-    for k, lg in enumerate(path.legs):
-        r = lg.record
-        if r.missed_approach_start:
-            climbing = True
-        climb[k + 1] = climbing
-        lo, hi = window(r.alt_desc, r.alt1_m, r.alt2_m)
-        if lo is not None or hi is not None:
-            windows.append(AltitudeWindow(k, r.fix.ident if r.fix else "", ends[k], r.alt_desc,
-                                          lo, hi))
-    along = np.concatenate(([0.0], ends))
-    alt = np.full(n + 1, start_alt_m)
-    lo_at = [None] * (n + 1)
-    hi_at = [None] * (n + 1)
-    for w in windows:
-        lo_at[w.leg_index + 1], hi_at[w.leg_index + 1] = w.lo_m, w.hi_m
-    # descent: backward pass from the last descent node, then clamp into windows
-    desc_idx = [k for k in range(1, n + 1) if not climb[k]]
-    coded = [v for w in windows for v in (w.lo_m, w.hi_m) if v is not None]
-    ceiling = max([start_alt_m] + coded)   # never plan above the start or any coded altitude
-    def ground_speed(k: int, v: float) -> float:
+
+class _Plan:
+    """The working state of :func:`plan_profile`: node distances, altitudes and windows, and
+    the passes over them (each a named step)."""
+
+    def __init__(self, path: ProcedurePath, start_alt_m: float, descent_angle_deg: float,
+                 descent_rate_mps: float | None, wind, climb: np.ndarray):
+        self.path, self.n = path, len(path.legs)
+        self.start_alt_m, self.angle_deg = start_alt_m, descent_angle_deg
+        self.rate_mps, self.wind, self.climb = descent_rate_mps, wind, climb
+        ends = leg_end_distances(path)
+        self.windows = []
+        for k, lg in enumerate(path.legs):
+            r = lg.record
+            lo, hi = window(r.alt_desc, r.alt1_m, r.alt2_m)
+            if lo is not None or hi is not None:
+                self.windows.append(AltitudeWindow(k, r.fix.ident if r.fix else "", ends[k],
+                                                   r.alt_desc, lo, hi))
+        self.along = np.concatenate(([0.0], ends))
+        self.alt = np.full(self.n + 1, start_alt_m)
+        self.lo_at = [None] * (self.n + 1)
+        self.hi_at = [None] * (self.n + 1)
+        for w in self.windows:
+            self.lo_at[w.leg_index + 1], self.hi_at[w.leg_index + 1] = w.lo_m, w.hi_m
+        self.desc_idx = [k for k in range(1, self.n + 1) if not climb[k]]
+        self.last = self.desc_idx[-1] if self.desc_idx else 0
+        self.ceiling = math.inf
+        self.v_leg = None
+
+    def coded(self) -> list[float]:
+        """Every coded altitude of the windows, m."""
+        return [v for w in self.windows for v in (w.lo_m, w.hi_m) if v is not None]
+
+    def ground_speed(self, k: int, v: float) -> float:
         """Planned ground speed on leg k at TAS v (a tailwind: the same descent rate is a
         shallower path; class 1: wind), m/s."""
-        lg = path.legs[k]
-        if v and wind is not None and lg.end.track_deg is not None:
-            v = max(v + wind[0] * math.cos(math.radians(wind[1] + 180.0 - lg.end.track_deg)),
+        lg = self.path.legs[k]
+        if v and self.wind is not None and lg.end.track_deg is not None:
+            w = self.wind
+            v = max(v + w[0] * math.cos(math.radians(w[1] + 180.0 - lg.end.track_deg)),
                     0.3 * v)
         return v
 
-    energy = cas_plan_mps is not None and descent_rate_mps is not None
-
-    def max_drop(k: int, v_leg: np.ndarray | None) -> float:
+    def max_drop(self, k: int) -> float:
         """Largest drop over leg k within the energy budget, m (inf without one)."""
-        if v_leg is None:
+        if self.v_leg is None:
             return math.inf
-        v_prev = v_leg[k - 1] if k > 0 else v_leg[0]
-        return energy_drop_max_m(along[k + 1] - along[k], ground_speed(k, v_leg[k]), v_leg[k],
-                                 v_prev, descent_rate_mps)
+        v = self.v_leg
+        v_prev = v[k - 1] if k > 0 else v[0]
+        return energy_drop_max_m(self.along[k + 1] - self.along[k],
+                                 self.ground_speed(k, v[k]), v[k], v_prev, self.rate_mps)
 
-    def backward(v_leg: np.ndarray | None) -> None:
-        h = next((lo_at[k] if lo_at[k] is not None else hi_at[k]
-                  for k in reversed(desc_idx) if lo_at[k] is not None or hi_at[k] is not None),
-                 start_alt_m)
-        alt[last] = h
-        for k in range(last - 1, -1, -1):
-            ang = descent_angle_deg
-            vpa = path.legs[k].record.vpa_deg if k < n else None
-            if vpa:
-                ang = abs(vpa)
+    def backward(self, v_leg: np.ndarray | None) -> None:
+        """Backward pass from the last descent node at the coded angles (else the default),
+        within the energy budget of ``v_leg`` (the legs' TAS, m/s; None: none), clamped into
+        every window and under the ceiling."""
+        self.v_leg = v_leg
+        lo_at, hi_at, alt, along = self.lo_at, self.hi_at, self.alt, self.along
+        alt[self.last] = next((lo_at[k] if lo_at[k] is not None else hi_at[k]
+                               for k in reversed(self.desc_idx)
+                               if lo_at[k] is not None or hi_at[k] is not None),
+                              self.start_alt_m)
+        for k in range(self.last - 1, -1, -1):
+            vpa = self.path.legs[k].record.vpa_deg if k < self.n else None
+            ang = abs(vpa) if vpa else self.angle_deg
             drop = math.tan(math.radians(ang)) * (along[k + 1] - along[k])
-            if not vpa and not climb[k + 1]:
-                drop = min(drop, max_drop(k, v_leg))
-            h = min(alt[k + 1] + drop, ceiling)
+            if not vpa and not self.climb[k + 1]:
+                drop = min(drop, self.max_drop(k))
+            h = min(alt[k + 1] + drop, self.ceiling)
             if hi_at[k] is not None:
                 # a descent capped by a window's top aims a margin inside it: the aircraft
                 # tracks a descending path a little high (:func:`descent_cap_margin_m`)
                 h = min(h, hi_at[k] - descent_cap_margin_m(lo_at[k], hi_at[k]))
             if lo_at[k] is not None:
                 h = max(h, lo_at[k])
-            alt[k] = h if k > 0 else start_alt_m
-        # two constraints at one point (a transition ending at the fix a final segment's IF
-        # codes again, e.g. KRST I31-Z MINGO: 'at or above' 2,900 then 2,800 ft): the later
-        # node keeps the earlier one's altitude where its own window allows — no step down
-        # at the fix that the blend would fly below the first window
-        for k in range(1, last):
-            if along[k + 1] - along[k] < 1.0:
-                a = alt[k]
-                if hi_at[k + 1] is not None:
-                    a = min(a, hi_at[k + 1])
-                if lo_at[k + 1] is not None:
-                    a = max(a, lo_at[k + 1])
-                alt[k + 1] = a
+            alt[k] = h if k > 0 else self.start_alt_m
+        self.share_coincident_windows()
 
-    v_leg = None
-    if desc_idx:
-        last = desc_idx[-1]
-        backward(None)
-        if energy:
-            # the speeds at the altitudes of the geometric plan, then the plan within the
-            # energy budget (one refinement: TAS changes ~2 %/1,000 ft)
-            v_leg = descent_leg_tas_mps(path, alt[1:], cas_plan_mps, isa_dev_c)
-            backward(v_leg)
-        # forward pass: from a start above the geometric path, descend no steeper than the
-        # aircraft can until the path is met
-        for k in range(1, last + 1):
-            lg = path.legs[k - 1]
-            v = ground_speed(k - 1, lg.speed_mps)
-            # the descent rate over the leg's planned ground speed (fast and high in a STAR,
-            # the same rate is a shallower path), else the given gradient; within the energy
-            # budget when there is one
-            g_k = descent_rate_mps / v if descent_rate_mps and v else g_desc
-            drop = g_k * (along[k] - along[k - 1])
-            if v_leg is not None and not climb[k]:
-                drop = min(drop, max_drop(k - 1, v_leg))
+    def share_coincident_windows(self) -> None:
+        """Two constraints at one point (a transition ending at the fix a final segment's IF
+        codes again): the later node keeps the earlier one's altitude where its own window
+        allows — no step down at the fix that the blend would fly below the first window."""
+        for k in range(1, self.last):
+            if self.along[k + 1] - self.along[k] < 1.0:
+                a = self.alt[k]
+                if self.hi_at[k + 1] is not None:
+                    a = min(a, self.hi_at[k + 1])
+                if self.lo_at[k + 1] is not None:
+                    a = max(a, self.lo_at[k + 1])
+                self.alt[k + 1] = a
+
+    def forward(self, g_desc: float) -> None:
+        """From a start above the geometric path, descend no steeper than the aircraft can
+        (its descent rate over each leg's ground speed, else ``g_desc``; within the energy
+        budget) until the path is met."""
+        alt, hi_at = self.alt, self.hi_at
+        for k in range(1, self.last + 1):
+            lg = self.path.legs[k - 1]
+            v = self.ground_speed(k - 1, lg.speed_mps)
+            g_k = self.rate_mps / v if self.rate_mps and v else g_desc
+            drop = g_k * (self.along[k] - self.along[k - 1])
+            if self.v_leg is not None and not self.climb[k]:
+                drop = min(drop, self.max_drop(k - 1))
             floor = alt[k - 1] - drop
             if floor > alt[k]:
                 alt[k] = floor if hi_at[k] is None else min(floor, max(hi_at[k], alt[k]))
-        # a descent phase never climbs: after the last constraint (e.g. a STAR ending in vectors)
-        # the backward pass from the final node can plan above an earlier 'at' fix
-        for k in range(1, n + 1):
-            if not climb[k] and not climb[k - 1] and alt[k] > alt[k - 1]:
-                alt[k] = max(alt[k - 1], lo_at[k] if lo_at[k] is not None else -np.inf)
-    # climb: forward pass, capped by every 'at or below' ahead and levelling off at the
-    # highest climb constraint still ahead (else the coded transition altitude, else 18,000 ft)
-    cap = np.full(n + 1, np.inf)
-    run = np.inf
-    top = -np.inf
-    trans = next((lg.record.trans_alt_m for lg in path.legs if lg.record.trans_alt_m), None)
-    for k in range(n, -1, -1):
-        if climb[k]:
-            if hi_at[k] is not None:
-                run = min(run, hi_at[k])
-                top = max(top, hi_at[k])
-            elif lo_at[k] is not None:
-                top = max(top, lo_at[k])
-        if climb_top_m is not None:
-            level = max(top, climb_top_m)
-        else:
-            level = top if np.isfinite(top) else (trans if trans else 18000 * FT_M)
-        cap[k] = min(run, level)
-    for k in range(1, n + 1):
-        if climb[k]:
-            base = alt[k - 1]
-            alt[k] = min(base + climb_gradient * (along[k] - along[k - 1]), max(cap[k], base))
-    return VerticalProfile(along, alt, climb, tuple(windows))
+
+    def never_climb_in_descent(self) -> None:
+        """A descent phase never climbs: after the last constraint (a STAR ending in vectors)
+        the backward pass from the final node can plan above an earlier 'at' fix."""
+        for k in range(1, self.n + 1):
+            if not self.climb[k] and not self.climb[k - 1] and self.alt[k] > self.alt[k - 1]:
+                lo = self.lo_at[k]
+                self.alt[k] = max(self.alt[k - 1], lo if lo is not None else -np.inf)
+
+    def climb_up(self, cap: np.ndarray, climb_gradient: float) -> None:
+        """Climb nodes: at ``climb_gradient`` from the node before, up to ``cap`` (m)."""
+        for k in range(1, self.n + 1):
+            if self.climb[k]:
+                base = self.alt[k - 1]
+                self.alt[k] = min(base + climb_gradient * (self.along[k] - self.along[k - 1]),
+                                  max(cap[k], base))

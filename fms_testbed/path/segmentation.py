@@ -25,13 +25,15 @@ from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
-from fms_testbed.path.profile import PLAN_CLIMB_FRACTION, arrival_join_alt_m, window
+from fms_testbed.path.profile import (PLAN_CLIMB_FRACTION, arrival_join_alt_m, climb_caps_m,
+                                     climb_phases, path_climb_top_m, window)
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
 from fms_testbed.legs.model import (BuildParams, BuiltLeg, Finding, FlightState, Performance, PathSegment,
                     approach_cas_caps, max_tailwind_mps,
                     ProcedurePath, isa_tas_mps, turn_radius_m)
+from fms_testbed.legs.moves import join_course
 
 
 
@@ -134,8 +136,8 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
         alt = next((_descent_target(lg) for lg in legs if lg.rec.alt1_m is not None), None)
         if alt is None:
             alt = elev + (10000 if seq.proc_type == "E" else 3000) * FT_M
-            if perf is not None:            # never above the aircraft's ceiling (less margin)
-                alt = min(alt, perf.alt_plan_max_m)
+        if perf is not None:            # never above the aircraft's ceiling (less margin)
+            alt = min(alt, perf.alt_plan_max_m)
     if first.fix is not None:
         return FlightState(first.fix.lat_deg, first.fix.lon_deg, None, alt,
                            fix_ident=first.fix.ident)
@@ -151,18 +153,21 @@ def planned_speed_mps(perf: Performance, leg: ResolvedLeg, alt_m: float,
     approach_cas_caps`) capped by an 'at or below' speed limit, raised to
     an 'at or above' one, and equal to an 'at' one — the speed guidance will fly there, so turn
     radii are planned for it (limits are IAS, turned to TAS on a day ``isa_dev_c`` K off the
-    ISA: a warm day flies a higher TAS for the same CAS, so a larger radius), m/s."""
+    ISA: a warm day flies a higher TAS for the same CAS, so a larger radius) — never above
+    the aircraft's VMO / MMO there (:meth:`~fms_testbed.legs.model.Performance.tas_max_mps`),
+    m/s."""
     v = isa_tas_mps(perf.tas_plan_mps if cas_cap_mps is None else
                     min(perf.tas_plan_mps, cas_cap_mps), alt_m, isa_dev_c)  # flown as a CAS
     lim = leg.rec.speed_limit_mps
-    if lim is None:
-        return v
-    lim_tas = isa_tas_mps(lim, alt_m, isa_dev_c)
-    if leg.rec.speed_desc == "-":
-        return min(v, lim_tas)
-    if leg.rec.speed_desc == "+":
-        return max(v, lim_tas)
-    return lim_tas  # blank or '@': at
+    if lim is not None:
+        lim_tas = isa_tas_mps(lim, alt_m, isa_dev_c)
+        if leg.rec.speed_desc == "-":
+            v = min(v, lim_tas)
+        elif leg.rec.speed_desc == "+":
+            v = max(v, lim_tas)
+        else:
+            v = lim_tas  # blank or '@': at
+    return min(v, perf.tas_max_mps(alt_m, isa_dev_c))   # inside VMO / MMO
 
 
 def leg_cls_hold(leg: ResolvedLeg) -> bool:
@@ -211,30 +216,33 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     b = LegBuilder(legs, perf, params, g, prev_fixes)
     b.climbing = seq.proc_type == "D"
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
+    built = _build_legs(b, seq.proc_type, state, bank)
+    segs = round_corners(b, perf, params, bank)
+    built = _attach_segments(built, segs)
+    status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
+    out = replace(path, legs=tuple(built), segments=tuple(segs),
+                  findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
+    if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
+        alt = _arrival_start_m(out, perf, params, state0.alt_m)
+        if alt is not None:
+            again = build_sequence(db, seq, perf, params, start=replace(state0, alt_m=alt))
+            return replace(again, start_kind=kind)
+    return out
+
+
+def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: float
+                ) -> list[BuiltLeg]:
+    """Run every leg's class from ``state`` (each planned by :func:`_plan_leg`: its climb
+    cap from :func:`~fms_testbed.path.profile.climb_caps_m`, its approach CAS cap); stop at
+    the first leg that cannot be built (an 'impossible' finding). Returns the built legs."""
+    legs, perf, params = b.legs, b.perf, b.params0
+    recs = [lg.rec for lg in legs]
+    caps = approach_cas_caps(recs, proc_type, perf.tas_min_mps)
+    alt_caps = climb_caps_m(recs, climb_phases(recs, proc_type),
+                            path_climb_top_m(proc_type, params.climb_top_m), perf.alt_plan_max_m)
     built: list[BuiltLeg] = []
-    caps = approach_cas_caps([lg.rec for lg in legs], seq.proc_type, perf.tas_min_mps)
     for i, leg in enumerate(legs):
-        b.i = i
-        if leg.rec.missed_approach_start:
-            b.climbing = True
-        speed_in = b.speed_mps if i else None
-        # the conditions at the leg's planned altitude (a wind profile: its wind there)
-        alt_plan = state.alt_m   # the builder's planned altitude at the leg's start
-        b.params = params.for_altitude(alt_plan)
-        if b.climbing and leg_cls_hold(leg) and params.climb_top_m is not None:
-            # a hold in a climb is flown from here up to the climb top (guidance climbs on to
-            # it; an HA is left only at the end of a circuit): its turns are planned for the
-            # TAS at the top (constant CAS: the largest) and the strongest wind on the way
-            top = max(alt_plan, params.climb_top_m)
-            b.params = params.for_band(alt_plan, top)
-            alt_plan = top
-        b.leg_params[i] = b.params
-        b.leg_alt_m[i] = alt_plan
-        b.speed_mps = planned_speed_mps(perf, leg, alt_plan, caps[i], params.isa_dev_c)
-        b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
-        # a turn at the start of the leg is entered at the previous leg's speed: plan its radius
-        # for the faster of the two
-        b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank, g)
+        _plan_leg(b, i, state.alt_m, float(alt_caps[i + 1]), caps[i], bank_deg)
         start_st = state
         leg_cls = LEG_TYPES[leg.pt]
         try:
@@ -246,22 +254,47 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
             state = replace(state, alt_m=_descent_target(leg))
         built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps,
-                              coded=leg_cls.coded_path(b, term)))
-    segs = round_corners(b, perf, params, bank)
-    built = _attach_segments(built, segs)
-    status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
-    out = replace(path, legs=tuple(built), segments=tuple(segs),
-                  findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
-    if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
-        # an arrival starts on the descent path planned back from its last constraint, not
-        # above it at its first coded altitude (an 'at or below' far above the next fixes)
-        alt = arrival_join_alt_m(out, params.descent_angle_deg, perf.tas_plan_mps,
-                                 PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps,
-                                 params.isa_dev_c)
-        if alt is not None and alt < state0.alt_m - 30.0:
-            again = build_sequence(db, seq, perf, params, start=replace(state0, alt_m=alt))
-            return replace(again, start_kind=kind)
-    return out
+                              coded=leg_cls.coded_path(b, term), resolved=leg,
+                              from_fix=b.prev_fixes[i]))
+    return built
+
+
+def _arrival_start_m(path: ProcedurePath, perf: Performance, params: BuildParams,
+                     alt0_m: float) -> float | None:
+    """The altitude an arrival built from ``alt0_m`` (m) is built again from, m, or None: it
+    starts on the descent path planned back from its last constraint
+    (:func:`~fms_testbed.path.profile.arrival_join_alt_m`), not above it at its first coded
+    altitude (an 'at or below' far above the next fixes)."""
+    alt = arrival_join_alt_m(path, params.descent_angle_deg, perf.tas_plan_mps,
+                             PLAN_CLIMB_FRACTION * perf.descent_rate_max_mps, params.isa_dev_c)
+    return alt if alt is not None and alt < alt0_m - 30.0 else None
+
+
+def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
+              cas_cap_mps: float | None, bank_deg: float) -> None:
+    """Set the builder up for leg ``i`` planned from ``alt_m`` (m): its climb cap (m), its
+    settings (the wind at its planned altitude; a hold in a climb: the strongest up to the
+    climb top, planned at the top), its planned speed (m/s, under ``cas_cap_mps``), climb
+    gradient and turn radius R = V²/(g tan γ) at ``bank_deg`` — for the faster of this leg
+    and the one before (a turn at its start is entered at the previous leg's speed)."""
+    leg, params, perf = b.legs[i], b.params0, b.perf
+    b.i, b.alt_cap_m = i, alt_cap_m
+    if leg.rec.missed_approach_start:
+        b.climbing = True
+    speed_in = b.speed_mps if i else None
+    alt_plan = alt_m
+    b.params = params.for_altitude(alt_plan)
+    if b.climbing and leg_cls_hold(leg) and params.climb_top_m is not None:
+        # guidance climbs on to the top in the hold (an HA is left only at the end of a
+        # circuit): its turns are planned for the TAS at the top (constant CAS: the largest)
+        top = max(alt_plan, min(params.climb_top_m, b.alt_cap_m))
+        b.params = params.for_band(alt_plan, top)
+        alt_plan = top
+    b.leg_params[i] = b.params
+    b.leg_alt_m[i] = alt_plan
+    b.speed_mps = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
+    b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
+    b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank_deg, b.g)
 
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
@@ -308,70 +341,88 @@ def round_corners(b: LegBuilder, perf: Performance, params: BuildParams, bank_de
                 or not isinstance(out[-1].geom, Line):
             out.append(seg)
             continue
-        a = out[-1]
-        omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
-        if abs(omega) < 0.5:
-            out.append(seg)
-            continue
-        # the aircraft enters the turn at the inbound speed and leaves it at the outbound one:
-        # plan the radius for the faster, which the bank limit must cover
-        v = max(a.speed_mps, seg.speed_mps)
-        # planned for the largest ground speed over the turn's tracks (class 1: the wind at
-        # the corner, where the leg after it starts)
-        cp = b.use_leg_params(seg.leg_index)
-        w = max_tailwind_mps(cp.wind_speed_mps, cp.wind_from_deg, a.geom.end_course_deg, omega)
-        r = turn_radius_m(v + w, bank_deg, b.g)
-        t = math.tan(math.radians(abs(omega)) / 2.0)
-        avail_a = a.geom.length_m()  # already trimmed by the previous corner, if any
-        avail_c = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
-        l_avail = max(min(avail_a, avail_c), 0.0)
-        bank = bank_deg
-        fix = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
-        if r * t > l_avail:
-            r_geom = l_avail / t
-            b.i = a.leg_index
-            why = conditions_text(v, w, cp.isa_dev_c, b.leg_alt_m.get(seg.leg_index, 0.0), r,
-                                  l_avail / t, bank_deg, b.g)
-            if r_geom <= 1.0:
-                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g), depth))
-                continue
-            g_reg = math.degrees(math.atan((v + w) ** 2 / (r_geom * b.g)))
-            if g_reg <= gmax:
-                b.finding("correction", f"fly-by at {fix}: radius {r:.0f} -> {r_geom:.0f} m, "
-                          f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°){why}", "R")
-                r, bank = r_geom, g_reg
-            else:
-                v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax))) - w
-                if v_reg >= perf.tas_min_mps:
-                    b.finding("correction", f"fly-by at {fix}: speed {v / KT_MPS:.0f} -> "
-                              f"{v_reg / KT_MPS:.0f} kt, bank {gmax:.0f}°, radius "
-                              f"{r_geom:.0f} m (turn {omega:+.0f}°){why}", "V,γ")
-                    r, bank, v = r_geom, gmax, v_reg
-                else:
-                    # flown over at the bank limit and the speed flown there: slowing down
-                    # needs distance the corner does not have
-                    out.extend(_flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g),
-                                        depth))
-                    continue
-        lead = r * t
-        la = a.geom.length_m()
-        t1 = a.geom.point_at(la - lead)
-        crs1 = a.geom.course_at(la - lead)
-        arc = turn_arc(t1[0], t1[1], crs1, omega, r)
-        new_a = Line(a.geom.start_lat_deg, a.geom.start_lon_deg, *arc.start)
-        out[-1] = replace(a, geom=new_a)
-        if new_a.length_m() < 0.01:
-            out.pop()
-        out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "flyby", v, bank,
-                               lead))
-        t2 = seg.geom.point_at(lead)
-        # end the arc exactly where the next line resumes
-        fixed = retarget_arc(arc, t2)
-        out[-1] = replace(out[-1], geom=fixed)
-        rest = Line(*fixed.end, seg.geom.end_lat_deg, seg.geom.end_lon_deg)
-        if rest.length_m() >= 0.01:
-            out.append(replace(seg, geom=rest))
+        _line_line_corner(b, out, seg, k, perf, params, bank_deg, gmax, depth)
     return out
+
+
+def _line_line_corner(b: LegBuilder, out: list[PathSegment], seg: PathSegment, k: int,
+                      perf: Performance, params: BuildParams, bank_deg: float, gmax: float,
+                      depth: int) -> None:
+    """Round the fly-by corner between the line ``out[-1]`` and the line ``seg`` (segment
+    ``k``) with an arc of R = V²/(g tan γ), lead L = R tan(Ω/2); where L does not fit the
+    monitor's branches R (R_geom = L_avail / tan(Ω/2)), V,γ (V_reg = √(R_geom g tan γ_max))
+    and V,γ,φ,λ (flown over) in turn. Appends to ``out`` (its last line trimmed in place)."""
+    a = out[-1]
+    omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
+    if abs(omega) < 0.5:
+        out.append(seg)
+        return
+    # the aircraft enters the turn at the inbound speed and leaves it at the outbound one:
+    # plan the radius for the faster, which the bank limit must cover
+    v = max(a.speed_mps, seg.speed_mps)
+    # planned for the largest ground speed over the turn's tracks (class 1: the wind at
+    # the corner, where the leg after it starts)
+    cp = b.use_leg_params(seg.leg_index)
+    w = max_tailwind_mps(cp.wind_speed_mps, cp.wind_from_deg, a.geom.end_course_deg, omega)
+    r = turn_radius_m(v + w, bank_deg, b.g)
+    t = math.tan(math.radians(abs(omega)) / 2.0)
+    avail_a = a.geom.length_m()  # already trimmed by the previous corner, if any
+    avail_c = seg.geom.length_m() * (0.5 if (k + 1) in b.corners else 1.0)
+    l_avail = max(min(avail_a, avail_c), 0.0)
+    bank = bank_deg
+    fix = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
+    if r * t > l_avail:
+        r_geom = l_avail / t
+        why = conditions_text(v, w, cp.isa_dev_c, b.leg_alt_m.get(seg.leg_index, 0.0), r,
+                              l_avail / t, bank_deg, b.g)
+        if r_geom <= 1.0:
+            out.extend(_flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g), depth))
+            return
+        g_reg = math.degrees(math.atan((v + w) ** 2 / (r_geom * b.g)))
+        if g_reg <= gmax:
+            b.finding("correction", f"fly-by at {fix}: radius {r:.0f} -> {r_geom:.0f} m, "
+                      f"bank {bank_deg:.0f} -> {g_reg:.1f}° (turn {omega:+.0f}°){why}", "R",
+                      leg_index=a.leg_index)
+            r, bank = r_geom, g_reg
+        else:
+            v_reg = math.sqrt(r_geom * b.g * math.tan(math.radians(gmax))) - w
+            if v_reg >= perf.tas_min_mps:
+                b.finding("correction", f"fly-by at {fix}: speed {v / KT_MPS:.0f} -> "
+                          f"{v_reg / KT_MPS:.0f} kt, bank {gmax:.0f}°, radius "
+                          f"{r_geom:.0f} m (turn {omega:+.0f}°){why}", "V,γ",
+                          leg_index=a.leg_index)
+                r, bank, v = r_geom, gmax, v_reg
+            else:
+                # flown over at the bank limit and the speed flown there: slowing down
+                # needs distance the corner does not have
+                out.extend(_flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g),
+                                    depth))
+                return
+    _fillet_lines(out, a, seg, omega, r, r * t, v, bank)
+
+
+def _fillet_lines(out: list[PathSegment], a: PathSegment, seg: PathSegment, omega: float,
+                  r: float, lead: float, v: float, bank: float) -> None:
+    """The fly-by arc of radius ``r`` (m) and turn ``omega`` (deg) between the line ``a``
+    (the last of ``out``, trimmed in place by ``lead`` m) and the line ``seg``; appended to
+    ``out`` with the rest of ``seg`` (planned at ``v`` m/s and ``bank`` deg)."""
+    la = a.geom.length_m()
+    t1 = a.geom.point_at(la - lead)
+    crs1 = a.geom.course_at(la - lead)
+    arc = turn_arc(t1[0], t1[1], crs1, omega, r)
+    new_a = Line(a.geom.start_lat_deg, a.geom.start_lon_deg, *arc.start)
+    out[-1] = replace(a, geom=new_a)
+    if new_a.length_m() < 0.01:
+        out.pop()
+    out.append(PathSegment(arc, a.leg_index, a.path_term, a.fix_ident, "flyby", v, bank,
+                           lead))
+    t2 = seg.geom.point_at(lead)
+    # end the arc exactly where the next line resumes
+    fixed = retarget_arc(arc, t2)
+    out[-1] = replace(out[-1], geom=fixed)
+    rest = Line(*fixed.end, seg.geom.end_lat_deg, seg.geom.end_lon_deg)
+    if rest.length_m() >= 0.01:
+        out.append(replace(seg, geom=rest))
 
 
 def planned_conditions(tas_mps: float, tailwind_mps: float, isa_dev_c: float,
@@ -454,9 +505,9 @@ def _line_arc_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
             res.append(replace(seg, geom=f.gap, role="connector"))
         res.append(replace(seg, geom=f.arc))
         if bank > bank_deg:
-            b.i = seg.leg_index
             b.finding("correction", f"fly-by onto the {seg.path_term} arc: bank "
-                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ")
+                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ",
+                      leg_index=seg.leg_index)
         return res
     return [seg]
 
@@ -488,9 +539,9 @@ def _arc_line_fillet(b: LegBuilder, out: list[PathSegment], seg: PathSegment,
         if f.line is not None:
             res.append(replace(seg, geom=f.line))
         if bank > bank_deg:
-            b.i = a.leg_index
             b.finding("correction", f"fly-by off the {a.path_term} arc at {a.fix_ident}: bank "
-                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ")
+                      f"{bank_deg:.0f} -> {g_used:.1f}°, radius {r:.0f} m", "γ",
+                      leg_index=a.leg_index)
         return res
     omega = wrap180(seg.geom.start_course_deg - a.geom.end_course_deg)
     return _flyover(b, a, seg, omega, turn_radius_m(v + w, gmax, b.g))
@@ -504,7 +555,7 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
     b.finding("correction", f"fly-by at {at} (turn {omega:+.0f}°) "
               f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
-              "V,γ,φ,λ")
+              "V,γ,φ,λ", leg_index=a.leg_index)
     lat, lon = a.geom.end
     end = seg.geom.end
     # rejoin the next line's own course before its end, so that the legs built after it (which
@@ -518,7 +569,7 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     tmp.climbing = False
     target = Fix(ident=seg.fix_ident, region="", section="", lat_deg=end[0], lon_deg=end[1])
     state = FlightState(lat, lon, a.geom.end_course_deg, 0.0, flyby=False)
-    tmp.join_course(state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
+    join_course(tmp, state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
     if depth == 0:
         segs = round_corners(tmp, b.perf, b.params, math.degrees(math.atan(
             (v_turn + b.wind_mps) ** 2 / (r * b.g))), depth=1)

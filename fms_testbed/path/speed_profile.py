@@ -77,6 +77,25 @@ def faf_leg_index(records) -> int | None:
     return None
 
 
+def _cas_caps(recs, m_end: int, faf: int | None, clean_cas_mps: float,
+              vapp_cas_mps: float) -> np.ndarray:
+    """The CAS each node may be planned at before decelerations, m/s: the clean speed under
+    every 'at' / 'at or below' limit coded so far (held for the rest of the approach), Vapp
+    from the FAF on (else at the missed-approach point), never below Vapp."""
+    cap = np.full(len(recs) + 1, float(clean_cas_mps))
+    carry = math.inf
+    for k, r in enumerate(recs[:m_end]):
+        if r.speed_limit_mps and r.speed_desc in ("", "@", "-"):
+            carry = min(carry, r.speed_limit_mps)
+            cap[k] = min(cap[k], carry)       # the leg is flown at its limit...
+        cap[k + 1] = min(cap[k + 1], carry)   # ...and it holds for the rest of the approach
+    if faf is not None:
+        cap[faf + 1:m_end + 1] = np.minimum(cap[faf + 1:m_end + 1], vapp_cas_mps)
+    else:   # no FAF coded: Vapp at the missed-approach point
+        cap[m_end] = min(cap[m_end], vapp_cas_mps)
+    return np.maximum(cap, vapp_cas_mps)       # never planned below Vapp
+
+
 def plan_speed_profile(path, along_m: np.ndarray, alt_m: np.ndarray, clean_cas_mps: float,
                        vapp_cas_mps: float, decel_mps2: float) -> SpeedProfile:
     """The planned CAS of an approach (module docstring).
@@ -92,21 +111,9 @@ def plan_speed_profile(path, along_m: np.ndarray, alt_m: np.ndarray, clean_cas_m
     decel_mps2 : planned deceleration (true airspeed), m/s²
     """
     recs = [lg.record for lg in path.legs]
-    n = len(recs)
-    m_end = next((k for k, r in enumerate(recs) if r.missed_approach_start), n)
+    m_end = next((k for k, r in enumerate(recs) if r.missed_approach_start), len(recs))
     faf = faf_leg_index(recs[:m_end])
-    cap = np.full(n + 1, float(clean_cas_mps))
-    carry = math.inf
-    for k, r in enumerate(recs[:m_end]):
-        if r.speed_limit_mps and r.speed_desc in ("", "@", "-"):
-            carry = min(carry, r.speed_limit_mps)
-            cap[k] = min(cap[k], carry)       # the leg is flown at its limit...
-        cap[k + 1] = min(cap[k + 1], carry)   # ...and it holds for the rest of the approach
-    if faf is not None:
-        cap[faf + 1:m_end + 1] = np.minimum(cap[faf + 1:m_end + 1], vapp_cas_mps)
-    else:   # no FAF coded: Vapp at the missed-approach point
-        cap[m_end] = min(cap[m_end], vapp_cas_mps)
-    cap = np.maximum(cap, vapp_cas_mps)       # never planned below Vapp
+    cap = _cas_caps(recs, m_end, faf, clean_cas_mps, vapp_cas_mps)
     s = np.asarray(along_m[:m_end + 1], dtype=float)
     h = np.asarray(alt_m[:m_end + 1], dtype=float)
     cas = cap[:m_end + 1].copy()

@@ -53,18 +53,22 @@ from pathlib import Path
 import numpy as np
 
 from fms_testbed.data import procedures_dir
-from fms_testbed.procedures.database import EMBEDDED_NAME, Database, _read, load_text
+from fms_testbed.procedures.database import EMBEDDED_NAME, Database, Sequence, _read, load_text
+from fms_testbed.procedures.integrity import Defect
+from fms_testbed.procedures.legrecord import FixRef, LegRecord
 from fms_testbed.procedures.loader import split_lines
 from fms_testbed.procedures.records import Fix
 
 log = logging.getLogger(__name__)
 
-INDEX_FORMAT = 1
+INDEX_FORMAT = 3
 """Version of the index layout; part of the cache key."""
 
 #: Modules of this package that do not read records (not part of the parser hash).
 _NOT_PARSER = frozenset({"index.py", "catalogue.py", "synth.py"})
 _FIX_FIELDS = tuple(f.name for f in dataclasses.fields(Fix))
+_FAST_CLASSES = (LegRecord, FixRef, Sequence, Defect)
+"""Frozen slotted dataclasses of the parsed procedures, pickled as field tuples."""
 
 
 @lru_cache(maxsize=1)
@@ -127,20 +131,42 @@ class DatabaseIndex:
         return hashlib.sha256(self.line_digests[idx].tobytes()).hexdigest()
 
 
+RECORD_NUMBER_COLS = slice(123, 128)
+"""ARINC-424 columns 124-128, the file record number: where a record sits in the file, not
+what it says (left out of a line's digest)."""
+
+
+def record_content(line: str) -> str:
+    """A record's text without its file record number (columns 124-128 blanked; a line shorter
+    than 128 characters is kept whole).
+
+    Parameters
+    ----------
+    line : one line of the file
+    """
+    if len(line) < RECORD_NUMBER_COLS.stop:
+        return line
+    return line[:RECORD_NUMBER_COLS.start] + " " * 5 + line[RECORD_NUMBER_COLS.stop:]
+
+
 def line_digests(text: str) -> np.ndarray:
-    """64-bit BLAKE2b digest of each line of ``text`` (split as the loader splits it)."""
+    """64-bit BLAKE2b digest of each line of ``text`` (split as the loader splits it), over the
+    record's content: the file record number (columns 124-128) left out
+    (:func:`record_content`), so a record inserted earlier in the file changes no digest of
+    the records after it."""
     out = np.empty(0, dtype=np.uint64)
     lines = split_lines(text)
     if lines:
-        raw = b"".join(hashlib.blake2b(ln.encode("latin-1", "replace"), digest_size=8).digest()
-                       for ln in lines)
+        raw = b"".join(hashlib.blake2b(record_content(ln).encode("latin-1", "replace"),
+                                       digest_size=8).digest() for ln in lines)
         out = np.frombuffer(raw, dtype=np.uint64).copy()
     return out
 
 
-#: Database fields held packed (:class:`PackedMapping`): read-only after loading, and large.
+#: Database fields held packed (:class:`PackedMapping`): read-only after loading, and large
+#: (``_parsed``: every airport's procedure transitions, parsed when the index is written).
 PACKED_FIELDS = ("fixes", "terminal", "airports", "_raw_procs", "_key_lines",
-                 "_keys_by_airport")
+                 "_keys_by_airport", "_parsed")
 _MISSING = object()
 
 
@@ -199,12 +225,15 @@ class PackedMapping(Mapping):
 
 
 def packed(db: Database) -> Database:
-    """The database with its large read-only tables packed (:data:`PACKED_FIELDS`).
+    """The database with every airport's procedures parsed (their rejected records in
+    ``issues``) and its large read-only tables packed (:data:`PACKED_FIELDS`).
 
     Parameters
     ----------
-    db : a loaded database (before any airport is parsed: ``_parsed`` is not packed)
+    db : a loaded database
     """
+    for airport in db.airport_idents():
+        db.sequences(airport)
     repl = {f: PackedMapping.pack(getattr(db, f)) for f in PACKED_FIELDS
             if isinstance(getattr(db, f, None), dict)}
     return dataclasses.replace(db, **repl)
@@ -220,12 +249,23 @@ def _reduce_fix(f: Fix):
     return Fix, tuple(getattr(f, n) for n in _FIX_FIELDS)
 
 
+def _reducer(cls):
+    """A pickle reducer of a frozen slotted dataclass to its field tuple (unpickled by one
+    constructor call, not field by field)."""
+    names = tuple(f.name for f in dataclasses.fields(cls))
+
+    def reduce(obj):
+        return cls, tuple(getattr(obj, n) for n in names)
+    return reduce
+
+
 def _dump(obj) -> bytes:
     """Pickle with fixes reduced to their field tuples (a frozen slotted dataclass unpickles
     field by field otherwise: 2.5 times slower for the CIFP's 107,000 fixes)."""
     buf = io.BytesIO()
     p = pickle.Pickler(buf, protocol=pickle.HIGHEST_PROTOCOL)
-    p.dispatch_table = {**copyreg.dispatch_table, Fix: _reduce_fix}
+    p.dispatch_table = {**copyreg.dispatch_table, Fix: _reduce_fix,
+                        **{c: _reducer(c) for c in _FAST_CLASSES}}
     p.dump(obj)
     return buf.getvalue()
 
@@ -378,5 +418,5 @@ def _bytes(path: Path) -> bytes:
 
 
 __all__ = ["INDEX_FORMAT", "PACKED_FIELDS", "DatabaseIndex", "PackedMapping", "packed",
-           "cache_dir", "line_digests", "load_index",
+           "cache_dir", "line_digests", "load_index", "record_content",
            "parser_hash", "resolve_db_path"]

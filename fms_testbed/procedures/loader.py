@@ -163,6 +163,34 @@ def _neighbour(scan: Scan, lines: list[str], line: int, step: int, skip: set[int
     return scan.owner.get(j)
 
 
+def _reject_refs(scan: Scan, rec: str, bad: RecordError) -> None:
+    """Record a rejected fix-like record under the idents legs would look it up by (its
+    airport's, the enroute one, or both for a VHF navaid)."""
+    sec = "PN" if rec[4:6] == "PN" else (
+        "P" + rec[12:13] if rec[4:5] in ("P", "H") else rec[4:6])
+    cols = _IDENT_COLS.get(sec)
+    ident = rec[cols[0] - 1:cols[1]].strip() if cols else ""
+    if not ident:
+        return
+    apt = rec[6:10].strip()
+    scopes = (("airport", ident),) if sec == "PA" else (
+        (("", ident),) if sec in ("EA", "DB") or not apt else
+        ((apt, ident),) if sec != "D " else (("", ident), (apt, ident)))
+    for scope in scopes:
+        scan.rejected_refs.setdefault(scope, []).append(bad)
+
+
+def _attribute_to_neighbours(scan: Scan, lines: list[str], unattributed: list) -> None:
+    """A rejected line whose own transition cannot be read degrades the transitions of the
+    records next to it."""
+    skip = {e.line for e in unattributed}
+    for err in unattributed:
+        for key in {k for k in (_neighbour(scan, lines, err.line, -1, skip),
+                                _neighbour(scan, lines, err.line, +1, skip)) if k}:
+            scan.key_defects.setdefault(key, []).append(rejected_defect(
+                err, " (a line next to its records whose own transition cannot be read)"))
+
+
 def scan_text(text: str, file: str) -> Scan:
     """Classify and check every record of an ARINC-424 file's text (module docstring)."""
     scan = Scan(file)
@@ -206,23 +234,9 @@ def scan_text(text: str, file: str) -> Scan:
         if bad is not None:
             scan.errors.append(bad)
             unattributed.append(bad)
-            sec = "PN" if rec[4:6] == "PN" else (
-                "P" + rec[12:13] if rec[4:5] in ("P", "H") else rec[4:6])
-            cols = _IDENT_COLS.get(sec)
-            ident = rec[cols[0] - 1:cols[1]].strip() if cols else ""
-            if ident:
-                apt = rec[6:10].strip()
-                scopes = (("airport", ident),) if sec == "PA" else (
-                    (("", ident),) if sec in ("EA", "DB") or not apt else
-                    ((apt, ident),) if sec != "D " else (("", ident), (apt, ident)))
-                for scope in scopes:
-                    scan.rejected_refs.setdefault(scope, []).append(bad)
+            _reject_refs(scan, rec, bad)
+    _attribute_to_neighbours(scan, lines, unattributed)
     skip = {e.line for e in unattributed}
-    for err in unattributed:
-        for key in {k for k in (_neighbour(scan, lines, err.line, -1, skip),
-                                _neighbour(scan, lines, err.line, +1, skip)) if k}:
-            scan.key_defects.setdefault(key, []).append(rejected_defect(
-                err, " (a line next to its records whose own transition cannot be read)"))
     for key, found in structure_defects(scan.key_lines, scan.owner, file, skip).items():
         scan.key_defects.setdefault(key, []).extend(found)
     return scan

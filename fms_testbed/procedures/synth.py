@@ -126,6 +126,25 @@ def vor_record(ident: str, lat: float, lon: float, var_deg: float = 0.0,
     return "".join(b)
 
 
+def _put_numbers(b: list[str], arc_radius_nm, theta_deg, rho_nm, course_deg, distance_nm,
+                 time_min) -> None:
+    """The numeric fields of a leg record, cols 57-78 (each left blank when None): radius
+    (thousandths of NM), theta and rho (tenths), course (tenths of a degree), distance (tenths
+    of NM) or time ('T' + tenths of a minute)."""
+    if arc_radius_nm is not None:
+        _put(b, 57, f"{round(arc_radius_nm * 1000):06d}")
+    if theta_deg is not None:
+        _put(b, 63, f"{round(theta_deg * 10):04d}")
+    if rho_nm is not None:
+        _put(b, 67, f"{round(rho_nm * 10):04d}")
+    if course_deg is not None:
+        _put(b, 71, f"{round(course_deg * 10) % 3600:04d}")
+    if distance_nm is not None:
+        _put(b, 75, f"{round(distance_nm * 10):04d}")
+    elif time_min is not None:
+        _put(b, 75, f"T{round(time_min * 10):03d}")
+
+
 def leg_record(airport: str, proc: str, pt: str, seq: int, *, proc_type: str = "F",
                transition: str = "", route_type: str = "R", fix: str = "",
                fix_section: str = "EA", region: str = "K1", desc: str = "E   ",
@@ -159,18 +178,7 @@ def leg_record(airport: str, proc: str, pt: str, seq: int, *, proc_type: str = "
         _put(b, 51, f"{navaid:<4}")
         _put(b, 55, region)
         _put(b, 79, navaid_section)
-    if arc_radius_nm is not None:
-        _put(b, 57, f"{round(arc_radius_nm * 1000):06d}")
-    if theta_deg is not None:
-        _put(b, 63, f"{round(theta_deg * 10):04d}")
-    if rho_nm is not None:
-        _put(b, 67, f"{round(rho_nm * 10):04d}")
-    if course_deg is not None:
-        _put(b, 71, f"{round(course_deg * 10) % 3600:04d}")
-    if distance_nm is not None:
-        _put(b, 75, f"{round(distance_nm * 10):04d}")
-    elif time_min is not None:
-        _put(b, 75, f"T{round(time_min * 10):03d}")
+    _put_numbers(b, arc_radius_nm, theta_deg, rho_nm, course_deg, distance_nm, time_min)
     _put(b, 83, alt_desc)
     if alt1_ft is not None:
         _put(b, 85, f"{alt1_ft:05d}")

@@ -25,6 +25,25 @@ from fms_testbed.run.results import Results
 from fms_testbed.run.summary import ProcedureInfo, assemble
 
 
+def with_truth_model(nav: dict | None, truth_model: str, where: str) -> dict:
+    """The navigation block ``nav`` with ``truth_model`` set (``strapdown`` or ``linear``).
+
+    Parameters
+    ----------
+    nav : a scenario's ``navigation:`` mapping (None: truth navigation)
+    truth_model : the INS units' truth side
+    where : the scenario's name for the error line
+
+    Raises
+    ------
+    UserError : the block names no source with INS units
+    """
+    if not nav or nav.get("source", "truth") == "truth":
+        raise UserError(f"{where}: --truth-model needs a navigation source with INS units "
+                        "(--nav sins|ins_gnss|attitude_reference, or the scenario's)")
+    return {**nav, "truth_model": truth_model}
+
+
 def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedProcedure | None]:
     """Validate a scenario (path, mapping or :class:`Scenario`) and build its procedure.
 
@@ -51,6 +70,7 @@ def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedPro
         raw = read_mapping(path, "scenario file")
         raw.setdefault("name", path.stem)
     proc_over = overrides.pop("procedure", None)
+    truth_model = overrides.pop("navigation_truth_model", None)
     if proc_over is not None:
         if isinstance(raw.get("procedure"), dict):
             raw["procedure"] = {**raw["procedure"], **proc_over}
@@ -61,6 +81,8 @@ def load(scenario, overrides: dict | None = None) -> tuple[Scenario, PreparedPro
             raise UserError(f"{source}: procedure options need a scenario with a 'procedure:' "
                             "block")
     raw.update(overrides)
+    if truth_model is not None:
+        raw["navigation"] = with_truth_model(raw.get("navigation"), truth_model, source)
     raw.pop("source_file", None)
     _relative_to(raw, source)
     if raw.get("procedure") is not None:
@@ -132,8 +154,9 @@ def results_of(flight: Flight) -> Results:
     so_far = {**record_dict(record), **record_dict({k: v for k, v in blocks.items()
                                                      if v is not None})}
     decision = decide(so_far, df, flight.cfg, rnp_nm)
+    rec = getattr(flight.navigation, "recorded_sensors", None)
     return Results(df=df, summary=assemble(record, decision, **blocks), scenario=flight.scn,
-                   procedure=proc, flown_paths=rebuilt)
+                   procedure=proc, flown_paths=rebuilt, sensors=rec() if rec else None)
 
 
 def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None = None,

@@ -1,8 +1,11 @@
 """Output folders that can be trusted.
 
 * :func:`check_out_dir` runs before any work: the target must be a folder (or creatable), not a
-  file, not a symlink, writable; a folder that holds anything but a previous testbed run is
-  refused unless ``overwrite``. Problems are a one-line :class:`UserError` (CLI exit 2).
+  file, not a symlink, writable; a folder that holds anything but a previous run of the same
+  *kind* (the command that wrote it: ``fly``, ``imu-test``, ``montecarlo``, ``regress-run`` …,
+  recorded as ``kind`` in its ``run.json``) is refused unless ``overwrite``, and so is a target
+  that is, holds or lies inside one of the command's input folders or files (never with
+  ``overwrite``). Problems are a one-line :class:`UserError` (CLI exit 2).
 * :class:`OutputFolder` writes into a fresh temporary folder beside the target and moves it into
   place only when complete, with ``run.json`` written last as the completion marker; a previous
   run in the target is replaced as a whole (nothing of it stays). Nothing already in the target is
@@ -30,27 +33,81 @@ RUN_MARKER = "run.json"
 """Written last into a complete output folder; a folder holding it is a testbed run."""
 
 
-def _is_previous_run(folder: Path) -> bool:
+def previous_run(folder: str | Path) -> dict | None:
+    """The ``run.json`` of a testbed run in ``folder`` (None: there is none, or it is not one).
+
+    Parameters
+    ----------
+    folder : the folder
+    """
     try:
-        data = json.loads((folder / RUN_MARKER).read_text())
+        data = json.loads((Path(folder) / RUN_MARKER).read_text())
     except (OSError, ValueError):
-        return False
-    return isinstance(data, dict) and data.get("tool") == "fms-testbed"
+        return None
+    return data if isinstance(data, dict) and data.get("tool") == "fms-testbed" else None
 
 
-def check_out_dir(out_dir: str | Path, overwrite: bool = False) -> Path:
+def command_kind(argv: list[str] | None = None) -> str:
+    """The kind of run a command line writes: its command word, e.g. ``fly`` or ``imu-test``
+    (the word after the program name; ``unknown`` when it is an option or a path).
+
+    Parameters
+    ----------
+    argv : the command line (default ``sys.argv``)
+    """
+    words = [str(a) for a in (sys.argv if argv is None else argv)[1:2]]
+    words = [w for w in words if w and not w.startswith("-") and "/" not in w]
+    return words[0] if words else "unknown"
+
+
+def run_kind(info: dict) -> str:
+    """The kind of a previous run: ``kind`` of its ``run.json``, else the command it records.
+
+    Parameters
+    ----------
+    info : the run's ``run.json``
+    """
+    if info.get("kind"):
+        return str(info["kind"])
+    cmd = info.get("command")
+    return command_kind(cmd) if isinstance(cmd, list) else "unknown"
+
+
+def _check_inputs(out: Path, inputs) -> None:
+    """Refuse an output path that is, holds or lies inside an input (a file or a folder)."""
+    target = out.absolute().resolve()
+    for given in inputs or ():
+        if not given:
+            continue
+        src = Path(given).absolute().resolve()
+        folder = src if src.is_dir() else src.parent if previous_run(src.parent) else None
+        if target == src or src.is_relative_to(target) or (
+                folder is not None and target.is_relative_to(folder)):
+            raise UserError(f"--out {out}: is or lies inside the input {given}; write the "
+                            "outputs elsewhere (an input is never replaced)")
+
+
+def check_out_dir(out_dir: str | Path, overwrite: bool = False, kind: str | None = None,
+                  inputs=()) -> Path:
     """Check that ``out_dir`` can take a run's outputs; raise :class:`UserError` (one line) if not.
 
     Parameters
     ----------
     out_dir : the target folder
-    overwrite : replace a folder that holds something other than a previous testbed run
+    overwrite : replace a folder that holds something other than a previous run of this kind
+    kind : the kind of run to write (default :func:`command_kind` of ``sys.argv``)
+    inputs : the command's input files and folders (the target may not be one, hold one, or
+        lie inside an input folder or inside the run folder an input file belongs to)
 
     Returns
     -------
     the target as an absolute path
     """
     out = Path(out_dir)
+    if not str(out_dir).strip():
+        raise UserError("--out '': give a folder name")
+    _check_inputs(out, inputs)
+    kind = kind or command_kind()
     if out.is_symlink():
         raise UserError(f"--out {out}: is a symbolic link; give the real folder")
     if out.exists() and not out.is_dir():
@@ -60,10 +117,16 @@ def check_out_dir(out_dir: str | Path, overwrite: bool = False) -> Path:
             content = [p.name for p in out.iterdir() if not p.name.startswith(f".{out.name}.")]
         except OSError as exc:
             raise UserError(f"--out {out}: cannot list the folder: {exc.strerror}") from None
-        if content and not _is_previous_run(out) and not overwrite:
+        prev = previous_run(out)
+        if content and prev is None and not overwrite:
             raise UserError(f"--out {out}: the folder holds other files ({', '.join(content[:3])}"
                             f"{', ...' if len(content) > 3 else ''}); give an empty or new folder, "
                             "or --overwrite to replace it")
+        if prev is not None and run_kind(prev) != kind and not overwrite:
+            raise UserError(f"--out {out}: holds a {run_kind(prev)} run, not a {kind} run; give "
+                            "a new folder, or --overwrite to replace it")
+        if not os.access(out, os.W_OK | os.X_OK):
+            raise UserError(f"--out {out}: the folder is read-only (permission denied)")
     parent = out.absolute().parent
     probe = parent
     while not probe.exists():
@@ -101,8 +164,10 @@ class OutputFolder:
     as it was.
     """
 
-    def __init__(self, out_dir: str | Path, overwrite: bool = False):
-        self.out = check_out_dir(out_dir, overwrite)
+    def __init__(self, out_dir: str | Path, overwrite: bool = False, kind: str | None = None,
+                 inputs=()):
+        self.kind = kind or command_kind()
+        self.out = check_out_dir(out_dir, overwrite, self.kind, inputs)
         self.tmp: Path | None = None
         self.info: dict = {}
         self.started = datetime.now(timezone.utc)
@@ -132,7 +197,7 @@ class OutputFolder:
     def commit(self) -> Path:
         """Write ``run.json`` last, then move the folder into place (replacing a previous run)."""
         assert self.tmp is not None
-        run = {"tool": "fms-testbed", "version": __version__,
+        run = {"tool": "fms-testbed", "kind": self.kind, "version": __version__,
                "command": self.info.pop("command", sys.argv),
                **self.info,
                "started_utc": self.started.isoformat(timespec="seconds"),
@@ -168,4 +233,5 @@ class OutputFolder:
             self.tmp = None
 
 
-__all__ = ["RUN_MARKER", "OutputFolder", "check_out_dir", "file_sha256"]
+__all__ = ["RUN_MARKER", "OutputFolder", "check_out_dir", "command_kind", "file_sha256",
+           "previous_run", "run_kind"]

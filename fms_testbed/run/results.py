@@ -16,6 +16,7 @@ import pandas as pd
 
 from fms_testbed.config.scenario import Scenario
 from fms_testbed.core.errors import UserError
+from fms_testbed.core.jsonio import dumps
 from fms_testbed.loop.procedure import PreparedProcedure
 from fms_testbed.run.outputs import OutputFolder, file_sha256
 from fms_testbed.run.summary import Summary
@@ -25,6 +26,21 @@ from fms_testbed.viz.geojson import write_track_geojson
 from fms_testbed.viz.kml import write_track_kml
 from fms_testbed.viz.procedure import plot_procedure
 from fms_testbed.viz.run import plot_run
+
+
+def write_sensors(sensors: dict, folder: Path) -> None:
+    """Write recorded sensors as ``imu.parquet``, ``gnss.parquet``, ``truth.parquet`` and
+    ``init.json`` (the ``nav-replay`` inputs) into ``folder``.
+
+    Parameters
+    ----------
+    sensors : :meth:`fms_testbed.navigation.recording.SensorRecorder.tables`
+    folder : the target folder (created)
+    """
+    folder.mkdir(parents=True, exist_ok=True)
+    for name in ("imu", "gnss", "truth"):
+        sensors[name].to_parquet(folder / f"{name}.parquet", index=False)
+    (folder / "init.json").write_text(dumps(sensors["init"]))
 
 
 @dataclass
@@ -48,6 +64,10 @@ class Results:
     procedure: PreparedProcedure | None = None
     flown_paths: list = field(default_factory=list)
     out_dir: Path | None = None
+    sensors: dict | None = None
+    """A flight's recorded sensors (``navigation.record_sensors``: ``imu``, ``gnss``, ``truth``
+    tables and the ``init`` mapping, :mod:`fms_testbed.navigation.recording`), written to
+    ``sensors/`` in the replay's format."""
 
     def to_pandas(self) -> pd.DataFrame:
         """The timeseries as a DataFrame."""
@@ -73,8 +93,12 @@ class Results:
         return {k: {"path": str(v), "sha256": file_sha256(v)} for k, v in files.items()
                 if v and not str(v).startswith("<")}
 
+    def _input_paths(self) -> list[str]:
+        return [v["path"] for v in self.inputs().values()]
+
     def save(self, out_dir: str | Path, csv: bool = False, plots: bool = True,
-             overwrite: bool = False, command: list[str] | None = None) -> Path:
+             overwrite: bool = False, command: list[str] | None = None,
+             kind: str | None = None) -> Path:
         """Write ``timeseries.parquet``, ``summary.json``, the PNG plots (and ``timeseries.csv``)
         and the tracks for Google Earth/QGIS (``track.geojson``, ``track.kml``: the designed path
         of a procedure flight and the flown 3-D track) into ``out_dir``, atomically
@@ -87,8 +111,11 @@ class Results:
         csv : also write ``timeseries.csv``;  plots : write the PNG figures
         overwrite : replace a folder that holds something other than a testbed run
         command : the command line to record in ``run.json`` (default ``sys.argv``)
+        kind : the kind of run recorded in ``run.json`` (default: the command's word,
+            :func:`~fms_testbed.run.outputs.command_kind`); a previous run of another kind in
+            ``out_dir`` is replaced only with ``overwrite``
         """
-        folder = OutputFolder(out_dir, overwrite)
+        folder = OutputFolder(out_dir, overwrite, kind, self._input_paths())
         try:
             with folder as tmp:
                 self.df.to_parquet(tmp / "timeseries.parquet", index=False)
@@ -106,6 +133,8 @@ class Results:
                                         (write_track_kml, "track.kml"))]
                 self.summary = self.summary.with_outputs(names, tracks)
                 (tmp / "summary.json").write_text(self.summary.to_json())
+                if self.sensors is not None:
+                    write_sensors(self.sensors, tmp / "sensors")
                 folder.set_run_info(**({"command": command} if command is not None else {}),
                                     scenario=self.summary.get("scenario"),
                                     seed=self.summary.get("seed"),

@@ -113,6 +113,8 @@ class NavigationBlock(RecordView):
     events: list[NavigationEvent]
     rnp_alert: RnpAlert | None = _opt()
     nse95_m: dict[str, float] | None = _opt()
+    truth_model: str | None = _opt()
+    """The INS units' truth side, ``strapdown`` or ``linear`` (None: no INS units)."""
 
 
 @dataclass(frozen=True)

@@ -7,7 +7,12 @@ Error model per ENU axis (seed 004's GNSS Markov states, plus white noise)::
 
 The Markov states are propagated exactly between epochs, m_k = e^{-Δt/τ} m_{k-1} + √(σ²(1 -
 e^{-2Δt/τ})) N. A fix is taken every ``1/rate_hz`` s (time of validity ``t_s``) and delivered
-``latency_s`` later. Faults (truth side, the filter is not told): outages (no fix), outlier bursts
+``latency_s`` later. The fix is of the antenna, at ``antenna_lever_arm_m`` (body axes, x forward,
+y right, z down, m) from the CG: p_ant = p_cg + C_b^n l, v_ant = v_cg + C_b^n (ω_eb × l). A
+time-tag error δt (``time_tag_error_s``: the receiver stamps a fix t that is valid at t - δt)
+adds -v δt to the position (first order in δt). Each fix carries the σ the receiver reports
+for it (``pos_sigma_m``, ``vel_sigma_mps``: its white part times ``reported_sigma_scale``; a
+filter's R). Faults (truth side, the filter is not told): outages (no fix), outlier bursts
 (extra white position noise of ``sigma_m``, the "outliers even with RAIM" of seed 000), and slow
 ramps (a position error growing at ``rate_mps`` per ENU axis from ``start_s`` — the classic
 integrity test). Every random draw comes from the receiver's own seeded generator, in epoch order,
@@ -24,6 +29,7 @@ import numpy as np
 from fms_testbed.core.earth import radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState
+from fms_testbed.sensors.imu.kinematics import euler_to_quat, qrot
 
 
 @dataclass(frozen=True)
@@ -69,6 +75,10 @@ class GnssSpec:
     pos_white_sigma_m, vel_white_sigma_mps : white noise per fix, m, m/s
     rate_hz : fix rate, Hz;  latency_s : delivery delay after the time of validity, s
     outages, outliers, ramps : truth-side faults (see the module docstring)
+    antenna_lever_arm_m : antenna position from the CG, body axes (x fwd, y right, z down), m
+    time_tag_error_s : truth side: the fixes are valid ``time_tag_error_s`` before their stamp, s
+    time_tag_sigma_s : declared 1σ of the time-tag error (what a filter allows for), s
+    reported_sigma_scale : the receiver reports its white σ times this (1: honestly)
     """
 
     pos_markov_sigma_m: tuple[float, float, float] = (1.0, 1.0, 2.0)
@@ -82,6 +92,10 @@ class GnssSpec:
     outages: tuple[Interval, ...] = ()
     outliers: tuple[OutlierBurst, ...] = ()
     ramps: tuple[Ramp, ...] = ()
+    antenna_lever_arm_m: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    time_tag_error_s: float = 0.0
+    time_tag_sigma_s: float = 0.0
+    reported_sigma_scale: float = 1.0
 
     def __post_init__(self):
         for name in ("pos_markov_sigma_m", "pos_white_sigma_m", "vel_markov_sigma_mps",
@@ -118,8 +132,9 @@ class GnssFix:
 
     t_s : time of validity, s;  t_delivered_s : when the navigation system gets it, s
     lat_rad, lon_rad, alt_m : position;  v_enu_mps : (3,) velocity, m/s
-    err_enu_m, err_v_enu_mps : (3,) true fix error (fix - truth), m, m/s
+    err_enu_m, err_v_enu_mps : (3,) true fix error (fix - truth at the antenna), m, m/s
     markov : (6,) the Markov part of that error (what a filter's GNSS states estimate)
+    pos_sigma_m, vel_sigma_mps : (3,) the 1σ the receiver reports (ENU), m, m/s
     """
 
     t_s: float
@@ -131,6 +146,21 @@ class GnssFix:
     err_enu_m: np.ndarray
     err_v_enu_mps: np.ndarray
     markov: np.ndarray = field(repr=False)
+    pos_sigma_m: np.ndarray | None = None
+    vel_sigma_mps: np.ndarray | None = None
+
+
+def antenna_offset_enu(truth: AircraftState, lever_arm_m) -> tuple[np.ndarray, np.ndarray]:
+    """(C_b^n l, C_b^n (ω_eb × l)) in ENU, m and m/s: the antenna's position and velocity
+    relative to the CG for the lever arm ``lever_arm_m`` (3,) m in body axes (x fwd, y right,
+    z down), at the true attitude and body rate of ``truth``."""
+    lv = np.asarray(lever_arm_m, float)
+    if not np.any(lv):
+        return np.zeros(3), np.zeros(3)
+    q = euler_to_quat(truth.roll_rad, truth.pitch_rad, truth.heading_rad)
+    w = np.array([truth.p_rps, truth.q_rps, truth.r_rps])
+    d, dv = qrot(q, tuple(lv)), qrot(q, tuple(np.cross(w, lv)))
+    return np.array([d[1], d[0], -d[2]]), np.array([dv[1], dv[0], -dv[2]])
 
 
 class GnssReceiver:
@@ -149,6 +179,7 @@ class GnssReceiver:
         self._sigma = spec.markov_sigma
         self._tau = spec.markov_tau_s
         self._white = spec.white_sigma
+        self._reported = spec.white_sigma * spec.reported_sigma_scale
         self.markov = self._sigma * self.rng.standard_normal(6)    # stationary start
         self._t_markov: float | None = None
         self._next_epoch_s: float | None = None
@@ -180,12 +211,15 @@ class GnssReceiver:
         for r in self.spec.ramps:
             err_p = err_p + r.offset_m(t)
         err_v = self.markov[3:] + white[3:]
+        p_ant, v_ant = antenna_offset_enu(truth, self.spec.antenna_lever_arm_m)
+        v_true = np.asarray(truth.v_enu_mps, float) + v_ant
+        err_p = err_p + p_ant - v_true * self.spec.time_tag_error_s
         rm, rn = radii_m(truth.lat_rad)
         h = truth.alt_m
         return GnssFix(t, t + self.spec.latency_s, truth.lat_rad + err_p[1] / (rm + h),
                        truth.lon_rad + err_p[0] / ((rn + h) * math.cos(truth.lat_rad)),
-                       h + err_p[2], np.asarray(truth.v_enu_mps, float) + err_v, err_p, err_v,
-                       self.markov.copy())
+                       h + err_p[2], v_true + err_v, err_p - p_ant, err_v,
+                       self.markov.copy(), self._reported[:3].copy(), self._reported[3:].copy())
 
     def update(self, truth: AircraftState) -> list[GnssFix]:
         """Take a fix when an epoch is due at ``truth.t_s`` and return the fixes delivered by
@@ -207,4 +241,4 @@ class GnssReceiver:
         return out
 
 
-__all__ = ["GnssFix", "GnssReceiver", "GnssSpec", "Interval", "OutlierBurst", "Ramp"]
+__all__ = ["antenna_offset_enu", "GnssFix", "GnssReceiver", "GnssSpec", "Interval", "OutlierBurst", "Ramp"]

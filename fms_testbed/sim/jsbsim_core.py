@@ -120,12 +120,19 @@ def has_piston_engines(model: str) -> bool:
     return False
 
 
+BALLAST_XML = ('<pointmass name="fms-ballast"><weight unit="LBS">0</weight>'
+               '<location unit="IN"><x>0</x><y>0</y><z>0</z></location></pointmass>')
+"""The point mass every sanitised model carries (weight 0: no effect until a design point
+sets its weight and position, :func:`fms_testbed.sim.linearise.set_mass_and_cg`)."""
+
+
 def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None,
                             frames_per_update: int = 1) -> Path:
     """Copy ``model`` from the jsbsim wheel into the sandbox without I/O elements.
 
     Returns the sandbox's ``aircraft`` folder (to pass to ``set_aircraft_path``). Removes every
-    top-level ``<input>`` and ``<output>`` element and appends the inner-loop ``<system>``
+    top-level ``<input>`` and ``<output>`` element, adds the zero-weight ballast point mass
+    (:data:`BALLAST_XML`) and appends the inner-loop ``<system>``
     (not when ``elevator_rate_max_ps`` is None: the bare model, for benchmarks), updated every
     ``frames_per_update`` frames.
     """
@@ -147,6 +154,9 @@ def sanitized_aircraft_path(model: str, elevator_rate_max_ps: float | None,
             root.remove(el)
             removed += 1
     n_eng = len(root.findall("./propulsion/engine"))
+    mb = root.find("mass_balance")
+    if mb is not None:     # zero-weight ballast, moved by design points for CG shifts
+        mb.append(ET.fromstring(BALLAST_XML))
     if elevator_rate_max_ps:
         root.append(ET.fromstring(system_xml(n_eng, elevator_rate_max_ps, DT_S, frames_per_update,
                                              piston=has_piston_engines(model))))
@@ -258,7 +268,66 @@ _STATE_ORDER = ("t_s", "lat_deg", "lon_deg", "alt_m", "agl_m", "tas_mps", "cas_m
                 "wow", "flap_pos_norm", "gear_pos_norm", "p_static_pa", "t_static_k")
 
 
-class JSBSimAircraft:
+class InnerLoopCommands:
+    """The inner-loop and configuration commands of :class:`JSBSimAircraft` (its ``fdm`` and the
+    cached property nodes ``_w``, ``_setters``, ``_w_flap``, ``_w_gear`` that ``_load`` makes)."""
+
+    def hold_trim(self, res: TrimResult) -> TrimResult:
+        """Make ``res`` the state the inner loops start from: its control positions as their
+        trim offsets, its throttle as the command, wings level at 1 g, the loops engaged; and
+        the start condition the flight summary reports (:meth:`trim_result`)."""
+        fdm = self.fdm
+        fdm["fms/trim/elevator"] = res.elevator
+        fdm["fms/trim/aileron"] = res.aileron
+        fdm["fms/trim/rudder"] = res.rudder
+        fdm["fms/trim/throttle"] = res.throttle
+        fdm["fms/cmd/throttle"] = res.throttle
+        fdm["fms/cmd/bank-rad"] = 0.0
+        fdm["fms/cmd/ny"] = 1.0
+        fdm["fms/cmd/nx"] = 0.0
+        fdm["fms/ap/master"] = 1.0
+        self._trim = res
+        return res
+
+    def engage(self, bank: bool = True, yaw: bool = True, ny: bool = True, nx: bool = True) -> None:
+        """Engage (or release) the inner loops."""
+        w = self._w
+        for loop, on in (("bank", bank), ("yaw", yaw), ("ny", ny)):
+            w[f"fms/ap/{loop}-engage"].set_double_value(float(on))
+            # JSBSim pid trigger: 0 integrates, < 0 resets the integrator
+            w[f"fms/ap/{loop}-trigger"].set_double_value(0.0 if on else -1.0)
+        w["fms/ap/nx-engage"].set_double_value(float(nx))
+
+    def command(self, bank_rad: float | None = None, ny: float | None = None,
+                nx: float | None = None, throttle: float | None = None) -> None:
+        """Set inner-loop targets: bank (rad), normal/tangential load factor (g), throttle (0..1).
+
+        A throttle command disengages the n_x loop; an n_x command engages it.
+        """
+        set_bank, set_ny, set_nx, set_thr, set_nx_engage = self._setters
+        if bank_rad is not None:
+            set_bank(bank_rad)
+        if ny is not None:
+            set_ny(ny)
+        if nx is not None:
+            set_nx(nx)
+            set_nx_engage(1.0)
+        if throttle is not None:
+            set_thr(throttle)
+            set_nx_engage(0.0)
+
+    def configure(self, flap_cmd_norm: float | None = None,
+                  gear_down: bool | None = None) -> None:
+        """Select a flap detent (``fcs/flap-cmd-norm``, the model's normalised flap command;
+        the model's kinematic moves the flaps at its own rate) and/or the gear
+        (``gear/gear-cmd-norm`` 1 down, 0 up); None leaves a control as it is."""
+        if flap_cmd_norm is not None:
+            self._w_flap.set_double_value(float(flap_cmd_norm))
+        if gear_down is not None:
+            self._w_gear.set_double_value(1.0 if gear_down else 0.0)
+
+
+class JSBSimAircraft(InnerLoopCommands):
     """One JSBSim instance flying one aircraft at 120 Hz, with the inner loops installed.
 
     Parameters
@@ -418,65 +487,10 @@ class JSBSimAircraft:
                             f"[{c.inner_loops.throttle_min}, {c.inner_loops.throttle_max}]")
         return self.hold_trim(res)
 
-    def hold_trim(self, res: TrimResult) -> TrimResult:
-        """Make ``res`` the state the inner loops start from: its control positions as their
-        trim offsets, its throttle as the command, wings level at 1 g, the loops engaged; and
-        the start condition the flight summary reports (:meth:`trim_result`)."""
-        fdm = self.fdm
-        fdm["fms/trim/elevator"] = res.elevator
-        fdm["fms/trim/aileron"] = res.aileron
-        fdm["fms/trim/rudder"] = res.rudder
-        fdm["fms/trim/throttle"] = res.throttle
-        fdm["fms/cmd/throttle"] = res.throttle
-        fdm["fms/cmd/bank-rad"] = 0.0
-        fdm["fms/cmd/ny"] = 1.0
-        fdm["fms/cmd/nx"] = 0.0
-        fdm["fms/ap/master"] = 1.0
-        self._trim = res
-        return res
-
     @property
     def trim_result(self) -> TrimResult | None:
         """The last trim, or ``None``."""
         return self._trim
-
-    # -- inner-loop commands -------------------------------------------------------------
-    def engage(self, bank: bool = True, yaw: bool = True, ny: bool = True, nx: bool = True) -> None:
-        """Engage (or release) the inner loops."""
-        w = self._w
-        for loop, on in (("bank", bank), ("yaw", yaw), ("ny", ny)):
-            w[f"fms/ap/{loop}-engage"].set_double_value(float(on))
-            # JSBSim pid trigger: 0 integrates, < 0 resets the integrator
-            w[f"fms/ap/{loop}-trigger"].set_double_value(0.0 if on else -1.0)
-        w["fms/ap/nx-engage"].set_double_value(float(nx))
-
-    def command(self, bank_rad: float | None = None, ny: float | None = None,
-                nx: float | None = None, throttle: float | None = None) -> None:
-        """Set inner-loop targets: bank (rad), normal/tangential load factor (g), throttle (0..1).
-
-        A throttle command disengages the n_x loop; an n_x command engages it.
-        """
-        set_bank, set_ny, set_nx, set_thr, set_nx_engage = self._setters
-        if bank_rad is not None:
-            set_bank(bank_rad)
-        if ny is not None:
-            set_ny(ny)
-        if nx is not None:
-            set_nx(nx)
-            set_nx_engage(1.0)
-        if throttle is not None:
-            set_thr(throttle)
-            set_nx_engage(0.0)
-
-    def configure(self, flap_cmd_norm: float | None = None,
-                  gear_down: bool | None = None) -> None:
-        """Select a flap detent (``fcs/flap-cmd-norm``, the model's normalised flap command;
-        the model's kinematic moves the flaps at its own rate) and/or the gear
-        (``gear/gear-cmd-norm`` 1 down, 0 up); None leaves a control as it is."""
-        if flap_cmd_norm is not None:
-            self._w_flap.set_double_value(float(flap_cmd_norm))
-        if gear_down is not None:
-            self._w_gear.set_double_value(1.0 if gear_down else 0.0)
 
     # -- stepping and state ----------------------------------------------------------------
     def run(self, n_steps: int = 1) -> bool:

@@ -88,6 +88,33 @@ def test_case_id_changes_exactly_with_the_records_a_case_uses(tmp_path):
     assert changed and all(key[2] == "CBAIN1" for key in changed)
 
 
+def _renumbered(lines: list[str], start: int) -> list[str]:
+    """Records from ``start`` on with their file record number (cols 124-128) one higher."""
+    out = list(lines)
+    for i in range(start, len(out)):
+        ln = out[i]
+        if len(ln) >= 128 and ln[123:128].isdigit():
+            out[i] = ln[:123] + f"{int(ln[123:128]) + 1:05d}" + ln[128:]
+    return out
+
+
+def test_case_ids_do_not_change_with_the_file_record_number(tmp_path):
+    """A new cycle that inserts a record near the top renumbers every later record (cols
+    124-128) and nothing else: no case id changes."""
+    base = _cases()
+    lines = Path(load_index(None).path).read_text(encoding="latin-1").split("\n")
+    k = next(i for i, ln in enumerate(lines) if ln.startswith("S") and len(ln) >= 132)
+    extra = lines[k][:13] + "ZZZZZ" + lines[k][18:]     # an unrelated record, inserted at k
+    moved = _renumbered(lines, k)
+    moved.insert(k, extra)
+    assert sum(a != b for a, b in zip(lines[k:], moved[k + 1:])) > 100   # every id's lines moved
+    copy = tmp_path / "cycle-b.dat"
+    copy.write_text("\n".join(moved), encoding="latin-1")
+    after = _cases(copy)
+    assert [(c.key, c.case_id, c.records_sha256) for c in base] == \
+        [(c.key, c.case_id, c.records_sha256) for c in after]
+
+
 def test_airport_sample_is_a_seeded_rule():
     db = load_index(None).db
     known = db.airport_idents()

@@ -36,9 +36,9 @@ def test_dask_cluster_gives_the_local_pools_rows(cluster, small_run, tmp_path):
 def test_multithreaded_workers_are_refused(tmp_path, capsys):
     from distributed import LocalCluster
 
-    # an in-process cluster (inproc:// transport): enough to be refused, quick to start
-    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False,
-                      dashboard_address=None, silence_logs=40) as c:
+    # an in-process cluster on loopback TCP: enough to be refused, quick to start
+    with LocalCluster(n_workers=1, threads_per_worker=2, processes=False, protocol="tcp://",
+                      host="127.0.0.1", dashboard_address=None, silence_logs=40) as c:
         assert regress("run", *SMALL, "--scheduler", c.scheduler_address, "--no-progress",
                        "--out", str(tmp_path / "o")) == 2
     err = capsys.readouterr().err

@@ -78,6 +78,9 @@ def test_chromium_renders_every_figure(report, tmp_path):
 def test_report_of_a_run_with_no_row_yet(small_run, tmp_path):
     out = tmp_path / "empty"
     out.mkdir()
-    shutil.copy(small_run / "run.json", out / "run.json")
+    shutil.copy(small_run / "run.json", out / "run.json")      # says complete; no flights/
+    shutil.copy(small_run / "plan.parquet", out / "plan.parquet")
     assert regress("report", str(out)) == 0
-    assert "No case written yet" in (out / "report.html").read_text()
+    page = (out / "report.html").read_text()
+    assert "No case written yet" in page
+    assert "incomplete: 0 of 20 planned cases written; 20 missing" in page

@@ -74,7 +74,7 @@ def test_a_profile_file_and_a_subset_of_stages(tmp_path):
     (["--stages", "none,kalman"], "unknown compensation stage 'kalman'"),
     (["--temperature-profile", "sauna"], "expected warmup, ramp, constant or a .csv"),
     (["--temperature-profile", "BAD"], "columns t_s, temperature_degC"),
-    (["--duration-h", "0"], "--duration-h must be > 0"),
+    (["--duration-h", "0"], "--duration-h 0: must be a finite number of hours >= 0.0167"),
 ])
 def test_bad_input_is_one_line_and_exit_2(tmp_path, capsys, args, match):
     bad = tmp_path / "bad.csv"

@@ -59,8 +59,12 @@ def test_derived_seeds_are_distinct_and_a_new_unit_changes_no_other():
     assert len(set(s4)) == 4 and s4[:3] == s3
     n1 = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 1}, seed=7)
     n3 = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=7)
-    assert n1.bank.units[0].seed == n3.bank.units[0].seed
-    assert len({u.seed for u in n3.bank.units}) == 3
+    assert n1.bank.seeds[0] == n3.bank.seeds[0]
+    assert len(set(n3.bank.seeds)) == 3
+    lin = {"source": "ins_gnss", "imu": "STIM300", "truth_model": "linear"}
+    l1, l3 = make_source({**lin, "n_ins": 1}, seed=7), make_source({**lin, "n_ins": 3}, seed=7)
+    assert l1.bank.units[0].seed == l3.bank.units[0].seed == n1.bank.seeds[0]
+    assert len({u.seed for u in l3.bank.units}) == 3
 
 
 def test_solution_carries_the_covariance_and_anp_is_its_95_percent_radius(states):

@@ -141,13 +141,14 @@ def test_path_flown_twice_is_flagged_as_a_loop(tmp_path):
     p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
                          app("TF", 30, fix="WS"), app("TF", 40, fix="WA"),
                          app("TF", 50, fix="WB")])
-    assert "loop" in cats(p)
+    assert "loop" in cats(p) and p.status == "coding_suspect"   # class 3: never ok
 
 
 def test_initial_fix_away_from_the_path_is_a_discontinuity(tmp_path):
     p = build(tmp_path, [app("IF", 10, fix="WA"), app("TF", 20, fix="WB"),
                          app("IF", 30, fix="WE"), app("TF", 40, fix="WS")])
-    assert "discontinuity" in cats(p) and p.status == "corrected"
+    # a path with a discontinuity is never ok or corrected: the built path is not the coded one
+    assert "discontinuity" in cats(p) and p.status == "impossible"
 
 
 def test_intercept_that_never_happens_is_flagged_and_bounded(tmp_path):

@@ -117,3 +117,68 @@ def test_cli_refuses_a_bad_out_before_flying(tmp_path):
     assert r.returncode == 2 and "is a file" in r.stderr and "Traceback" not in r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
     assert time.perf_counter() - t0 < 5        # checked before loading JSBSim or flying (0.6 s here)
+
+
+def test_a_run_of_another_kind_is_replaced_only_with_overwrite(tmp_path):
+    out = tmp_path / "r"
+    with OutputFolder(out, kind="regress-run") as tmp:
+        (tmp / "flights").mkdir()
+    assert json.loads((out / RUN_MARKER).read_text())["kind"] == "regress-run"
+    with pytest.raises(UserError, match="holds a regress-run run, not a fly run"):
+        check_out_dir(out, kind="fly")
+    with OutputFolder(out, overwrite=True, kind="fly") as tmp:
+        (tmp / "summary.json").write_text("{}")
+    assert not (out / "flights").exists()
+    check_out_dir(out, kind="fly")                   # its own kind: replaced without a word
+
+
+def test_an_input_is_never_an_output(tmp_path):
+    run = tmp_path / "run"
+    with OutputFolder(run, kind="fly") as tmp:
+        (tmp / "timeseries.parquet").write_text("x")
+    for target in (run, run / "sub", tmp_path):
+        with pytest.raises(UserError, match="input"):
+            check_out_dir(target, overwrite=True, kind="fly", inputs=[run])
+    db = tmp_path / "db.dat"
+    db.write_text("records")
+    with pytest.raises(UserError, match="input"):
+        check_out_dir(tmp_path, overwrite=True, kind="fly", inputs=[db])
+    check_out_dir(tmp_path / "elsewhere", kind="fly", inputs=[db])      # beside it: fine
+
+
+@pytest.mark.parametrize("argv", [
+    ["fly", "--airport", "KENV", "--procedure", "X", "--no-plots"],
+    ["imu-test", "--duration-h", "0.02"],
+    ["montecarlo", "--runs", "1", "--duration-min", "1"],
+])
+def test_commands_never_replace_a_regress_run(argv, tmp_path, capsys):
+    from fms_testbed.cli import main
+
+    out = tmp_path / "campaign"
+    with OutputFolder(out, kind="regress-run") as tmp:
+        (tmp / "flights").mkdir()
+        (tmp / "flights" / "part-1.parquet").write_text("rows")
+    assert main([*argv, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "holds a regress-run run" in err and len(err.splitlines()) == 1
+    assert (out / "flights" / "part-1.parquet").read_text() == "rows"
+
+
+def test_montecarlo_never_writes_into_its_trajectory(tmp_path, capsys):
+    from fms_testbed.cli import main
+
+    run = tmp_path / "flight"
+    with OutputFolder(run, kind="montecarlo") as tmp:
+        (tmp / "timeseries.parquet").write_text("x")
+    for out in (run, run / "mc"):
+        assert main(["montecarlo", "--runs", "1", "--duration-min", "1", "--trajectory",
+                     str(run), "--out", str(out), "--overwrite"]) == 2
+        assert "input" in capsys.readouterr().err
+    assert (run / "timeseries.parquet").read_text() == "x"
+
+
+def test_empty_out_is_refused(capsys):
+    from fms_testbed.cli import main
+
+    assert main(["imu-test", "--duration-h", "0.02", "--out", ""]) == 2
+    assert "give a folder name" in capsys.readouterr().err

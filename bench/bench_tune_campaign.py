@@ -1,0 +1,115 @@
+"""Campaign check of a tuned schedule: the same procedure sample flown with the file's gains and
+with the tuned aircraft file, in wind and turbulence, and the shift of the error distributions.
+
+    python bench/bench_tune_campaign.py --new RUN/aircraft.yaml [--old 737]
+        [--airports KBFI KDLS ...] [--types STAR,APPROACH] [--limit N] [--workers 2] [--wind 270/30]
+        [--turbulence moderate] --out DIR
+
+Two ``fms-testbed regress run`` campaigns over the same cases (embedded excerpt, ``--airports``,
+one condition set: steady wind ``--wind`` and ``--turbulence``, truth navigation), one per
+aircraft file; the flights are paired by (airport, type, procedure, runway, transition,
+conditions). Written to ``DIR``: ``campaign-shift.md`` (per run: flights, status counts,
+median and 90th percentile of ``fte_p95_m``, ``vpe_p95_m``, ``spd_err_p95_kt``, constraints
+missed; per pair the median of the differences new − old) and ``campaign-shift.png`` (the
+empirical distributions).
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+KEY = ["airport", "type", "procedure", "runway", "transition", "conditions"]
+METRICS = ("fte_p95_m", "vpe_p95_m", "spd_err_p95_kt")
+
+
+def _run(aircraft: str, cond: Path, args, out: Path) -> pd.DataFrame:
+    from fms_testbed.cli import main
+
+    argv = ["regress", "run", "--aircraft", aircraft, "--conditions", str(cond),
+            "--workers", str(args.workers), "--no-progress", "--out", str(out)]
+    if args.airports:
+        argv += ["--airports", *args.airports]
+    if args.limit:
+        argv += ["--limit", str(args.limit)]
+    if args.types:
+        argv += ["--types", args.types]
+    rc = main(argv)
+    if rc not in (0, 1):
+        raise SystemExit(f"regress run for {aircraft} exited {rc}")
+    return pd.read_parquet(out / "flights")
+
+
+def summary(df: pd.DataFrame) -> dict:
+    """Per-run figures: flights, ok, medians and p90 of the error metrics, constraints missed."""
+    flown = df[df[list(METRICS)].notna().any(axis=1)]
+    row = {"cases": len(df), "flown": len(flown), "ok": int((df.status == "ok").sum()),
+           "constraints_checked": int(df.constraints_checked.fillna(0).sum()),
+           "constraints_missed": int(df.constraints_missed.fillna(0).sum())}
+    for m in METRICS:
+        v = flown[m].dropna()
+        row[f"{m} median"] = float(v.median()) if len(v) else np.nan
+        row[f"{m} p90"] = float(v.quantile(0.9)) if len(v) else np.nan
+    return row
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--new", required=True, help="tuned aircraft file (tune --envelope's aircraft.yaml)")
+    ap.add_argument("--old", default="737", help="aircraft with the file gains (name or file)")
+    ap.add_argument("--airports", nargs="*", default=None)
+    ap.add_argument("--limit", type=int, default=None)
+    ap.add_argument("--types", default="STAR,APPROACH",
+                    help="procedure types (descending profiles carry the vertical path error)")
+    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--wind", default="270/30", help="FROM_DEG/SPEED_KT")
+    ap.add_argument("--turbulence", default="moderate", choices=("light", "moderate", "severe"))
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--md", help="also write docs/results/MD and docs/figures/tuning/")
+    args = ap.parse_args()
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    frm, spd = (float(x) for x in args.wind.split("/"))
+    cond = out / "conditions.yaml"
+    cond.write_text(f"conditions:\n  - name: wind-{frm:.0f}-{spd:.0f}kt-{args.turbulence}\n"
+                    f"    wind: {{from_deg: {frm:g}, speed_kt: {spd:g}}}\n"
+                    f"    turbulence: {{severity: {args.turbulence}}}\n")
+    runs = {"file gains": _run(args.old, cond, args, out / "old"),
+            "tuned schedule": _run(args.new, cond, args, out / "new")}
+    table = pd.DataFrame({k: summary(v) for k, v in runs.items()})
+    a, b = (runs[k].set_index(KEY) for k in ("file gains", "tuned schedule"))
+    both = a.join(b, lsuffix="_old", rsuffix="_new", how="inner")
+    diffs = {m: float((both[f"{m}_new"] - both[f"{m}_old"]).median()) for m in METRICS}
+    from fms_testbed.cli.common import markdown_table
+    from fms_testbed.viz.figure import save
+    from fms_testbed.viz.tuning import plot_campaign_shift
+
+    md = ("<!-- written by python bench/bench_tune_campaign.py; rerun it to refresh, do not edit "
+          f"by hand -->\n\nCommand: `python bench/bench_tune_campaign.py {' '.join(sys.argv[1:])}`"
+          f"\n\nAircraft: `{args.old}` (file gains) and `{args.new}` (tuned schedule). "
+          f"Conditions: wind {args.wind} kt, {args.turbulence} turbulence; "
+          f"{len(both)} paired flights.\n\n{markdown_table(table.reset_index())}\n\n"
+          "Median of the paired differences (tuned − file gains): "
+          + ", ".join(f"{m} {v:+.3g}" for m, v in diffs.items()) + "\n")
+    (out / "campaign-shift.md").write_text(md)
+    if args.md:
+        (Path(__file__).resolve().parents[1] / "docs" / "results" / args.md).write_text(md)
+        fig = Path(__file__).resolve().parents[1] / "docs" / "figures" / "tuning"
+        fig.mkdir(parents=True, exist_ok=True)
+    save(plot_campaign_shift(runs, METRICS, f"{args.old}: file gains vs tuned schedule, wind "
+                             f"{args.wind} kt, {args.turbulence} turbulence ({len(both)} paired "
+                             "flights)"), out / "campaign-shift.png")
+    if args.md:
+        import shutil
+
+        shutil.copy(out / "campaign-shift.png", fig / "campaign-shift.png")
+    print(md)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,70 @@
+"""Benches check themselves: the one guard (``bench/report.py``) refuses a degenerate run, every
+bench writes its page through it, and the procedure benches run in a quick mode (two airports
+of the FAA cycle) and write a page whose figures are measured."""
+
+import math
+import re
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCH = Path(__file__).resolve().parents[2] / "bench"
+sys.path.insert(0, str(BENCH))
+import report  # noqa: E402
+
+
+@pytest.mark.parametrize("outcomes, headline", [({}, None), ({"impossible": 51706}, None),
+                                                ({"impossible": 3, "error": 2}, None),
+                                                ({"ok": 3}, math.nan), ({"ok": 1}, math.inf)])
+def test_the_guard_refuses_a_degenerate_run(outcomes, headline):
+    with pytest.raises(report.DegenerateRun):
+        report.refuse_degenerate(outcomes, headline=headline, what="bench")
+
+
+def test_the_guard_passes_a_real_run():
+    report.refuse_degenerate({"ok": 10, "impossible": 3}, headline=4.6)
+
+
+def test_write_refuses_a_table_with_a_nan_figure(tmp_path):
+    body = report.table(["stage", "time, s"], [["build", "nan"], ["total", "4.6"]])
+    with pytest.raises(report.DegenerateRun):
+        report.write(tmp_path / "x.md", body)
+    assert not (tmp_path / "x.md").exists()
+    ok = report.table(["stage", "time, s"], [["build (nano seconds)", "1.2"]])
+    assert report.write(tmp_path / "y.md", ok).exists()
+
+
+def test_every_bench_writes_its_page_through_the_guard():
+    """No bench writes a file of docs/results/ by itself: each page goes through
+    ``report.write`` (where the NaN guard is)."""
+    direct = []
+    for f in sorted(BENCH.glob("*.py")):
+        text = f.read_text()
+        if f.name != "report.py" and re.search(r"RESULTS\s*/|docs/results/[\w.]+\"\)\.write",
+                                               text):
+            direct.append(f.name)
+    assert not direct, direct
+
+
+AIRPORTS = ["KDLS", "KAUS"]
+
+
+def _cifp():
+    if not report.CIFP.exists():
+        pytest.skip(f"the FAA CIFP is not at {report.CIFP}")
+    return str(report.CIFP)
+
+
+@pytest.mark.parametrize("name", ["bench_check", "bench_procedures", "bench_coding"])
+def test_procedure_benches_run_in_quick_mode(tmp_path, name, monkeypatch):
+    monkeypatch.setenv("FMS_TESTBED_CACHE", str(tmp_path / "cache"))
+    mod = __import__(name)
+    md = tmp_path / f"{name}.md"
+    argv = ["--db", _cifp(), "--airports", *AIRPORTS, "--md", str(md)]
+    if name != "bench_check":
+        argv += ["--workers", "2"]
+    mod.main(argv)
+    text = md.read_text()
+    assert "Command: `python" in text and "|---|" in text
+    assert not re.search(r"\|\s*nan\s*\|", text, re.I)

@@ -1,0 +1,68 @@
+"""`fms-testbed tune --envelope` and `analyse --plant jsbsim`: outputs, goals, user errors."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+import yaml
+
+from fms_testbed.cli import main
+from fms_testbed.config.aircraft import load_aircraft_file
+from fms_testbed.control import procedure_law
+from fms_testbed.evaluation.envelope_tuning import POINT_COLUMNS
+
+
+def test_bad_grid_file_is_one_line_naming_the_field(tmp_path, capsys):
+    grid = tmp_path / "grid.yaml"
+    grid.write_text("points:\n  - {alt_m: 3000, tas_mps: 111, config: landing}\n")
+    assert main(["tune", "--aircraft", "737", "--envelope", "--grid", str(grid),
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "grid.yaml" in err and "config" in err and "Traceback" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_too_few_trimmed_points_is_a_user_error(tmp_path, capsys):
+    grid = tmp_path / "grid.yaml"
+    grid.write_text("points:\n  - {alt_m: 3000, tas_mps: 111}\n  - {alt_m: 1000, tas_mps: 105}\n")
+    assert main(["tune", "--aircraft", "737", "--envelope", "--grid", str(grid), "--workers", "1",
+                 "--no-robust", "--out", str(tmp_path / "out")]) == 2
+    assert "at least 3" in capsys.readouterr().err
+
+
+def test_envelope_tuning_writes_points_schedule_and_a_flyable_aircraft(tmp_path, capsys):
+    grid = tmp_path / "grid.yaml"
+    grid.write_text(yaml.safe_dump({"points": [
+        {"alt_m": 1000.0, "tas_mps": 105.0}, {"alt_m": 3000.0, "tas_mps": 111.1},
+        {"alt_m": 6000.0, "tas_mps": 150.0}]}))
+    out = tmp_path / "env"
+    rc = main(["tune", "--aircraft", "737", "--envelope", "--grid", str(grid), "--workers", "1",
+               "--no-robust", "--out", str(out)])
+    text = capsys.readouterr().out
+    df = pd.read_csv(out / "points.csv")
+    assert list(df.columns[:len(POINT_COLUMNS)]) == list(POINT_COLUMNS)
+    assert len(df) == 3 and (df.status == "ok").all()
+    for b in ("throttle", "elevator", "nx_cmd", "dny_cmd", "aileron", "bank_cmd"):
+        assert df[f"pm_{b}_deg"].notna().all()
+    assert (df.gm_min_db <= df[[c for c in df if c.startswith("gm_") and c.endswith("_db")
+                                and c != "gm_min_db"]].min(axis=1) + 1e-9).all()
+    met = (df.gm_min_db >= 6).all() and (df.pm_min_deg >= 45).all() and \
+        (df.max_dv_kmh <= 1).all() and (df.max_dh_m <= 1.5).all()
+    assert rc == (0 if met else 1), text
+    cfg = load_aircraft_file(out / "aircraft.yaml")
+    assert cfg.coupled_law_schedule is not None and len(cfg.coupled_law_schedule.points) == 3
+    law = procedure_law(cfg)
+    for _, r in df.iterrows():
+        got = law.schedule.values(r.qbar_pa, r.mass_kg)
+        assert got["T_V_s"] == pytest.approx(r.tuned_T_V_s, rel=1e-3)
+    for f in ("schedule.yaml", "report.md", "nichols.png", "bode-worst.png", "steps.png",
+              "schedule.png"):
+        assert (out / f).stat().st_size > 1000, f
+
+
+def test_analyse_jsbsim_prints_modes_checked_against_the_nonlinear_model(tmp_path, capsys):
+    out = tmp_path / "an"
+    assert main(["analyse", "--aircraft", "737", "--plant", "jsbsim", "--out", str(out)]) == 0
+    text = capsys.readouterr().out
+    assert "short period" in text and "JSBSim linearisation + inner loops" in text
+    assert (out / "linear-vs-jsbsim.png").stat().st_size > 10_000
