@@ -58,7 +58,12 @@ def test_multi_rate_prediction_follows_the_per_step_filter():
     a, sa, ea, na = _run(True, True)
     b, sb, eb, nb = _run(False, True)
     assert na == nb                             # every fix found its step boundary
-    assert [e for e in ea if e[1] != "detected"] == [e for e in eb if e[1] != "detected"]
+    # the same events; their times within 0.5 s (the fused prediction builds one F from the
+    # units' mean measured f, ω, the per-step one each unit's own)
+    ka = [e for e in ea if e[1] != "detected"]
+    kb = [e for e in eb if e[1] != "detected"]
+    assert [e[1:] for e in ka] == [e[1:] for e in kb]
+    assert all(abs(x[0] - y[0]) <= 0.5 for x, y in zip(ka, kb))
     k = 100                                     # after the first 10 s
     rel = np.abs(sa[k:] - sb[k:]) / sb[k:]
     assert np.median(rel, axis=0).max() < 0.03
@@ -79,9 +84,9 @@ def test_intervals_end_at_gnss_epochs_and_after_the_rotation_limit():
         if iv_flush is None and nav._interval is not None:
             iv_flush = nav._interval.flush
 
-            def counted(ins, truth, _f=iv_flush):
-                flushes.append(truth.t_s)
-                _f(ins, truth)
+            def counted(ins, t_s, f_b, w_ib, _f=iv_flush):
+                flushes.append(t_s)
+                _f(ins, t_s, f_b, w_ib)
             nav._interval.flush = counted
     t = np.array(flushes)
     straight, turn = t[(t > 5) & (t < 29)], t[t > 35]
