@@ -48,9 +48,10 @@ import report  # noqa: E402
 
 RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 PAGES = ("fdi_calibration.md", "fdi_false_alarms.md", "detection_limits_without_drift.md",
-         "detection_limits_drift.md")
-"""The docs/results pages this bench writes with the default options (``--only 'gyro drift'``
-with and without ``--exclude`` for the two detection-limit pages)."""
+         "detection_limits_drift.md", "detection_limits_cusum_step.md")
+"""The docs/results pages this bench writes (``--only 'gyro drift'`` with and without
+``--exclude`` for the two detection-limit pages; ``--only 'gyro step' --sensor-test cusum`` for
+the CUSUM comparison)."""
 RATE_PER_H = 3e-3
 """The goal's false-alarm rate (zero in 1,000 one-hour flights: ≤ 3e-3/h at 95 %)."""
 FAULT_AT_S = 200.0

@@ -2,10 +2,14 @@
 
 :func:`plan` loads the database through its index, picks the airports (given, all, or a seeded
 sample: :func:`~.cases.sample_airports`) and enumerates the cases (:mod:`.cases`).
-:func:`run_campaign` checks the output folder, resumes what a previous run of the same cases
-left there (same case set, or a one-line refusal), flies the rest on the local pool or a Dask
-cluster (:mod:`.executors`) and writes rows as they arrive (:mod:`.store`), with a progress bar
-(cases/s and ETA) on a terminal. Interrupted (Ctrl-C, SIGTERM, SIGKILL), it leaves ``run.json``
+:func:`run_campaign` checks the output folder (its kind, the inputs, permissions:
+:func:`~fms_testbed.run.outputs.check_out_dir`), resumes what a previous run of the same cases
+left there (same case set, or a one-line refusal; ``overwrite`` replaces another kind of run,
+other files or a run of other cases), writes the plan, checks every part file already written
+and moves the damaged ones into ``DIR/quarantine/`` (:mod:`.audit`), flies the cases without a
+row on the local pool or a Dask cluster (:mod:`.executors`) and writes rows as they arrive
+(:mod:`.store`), with a progress bar (cases/s and ETA) on a terminal. ``status: complete`` is
+written only when every planned case has a row in a kept part. Interrupted (Ctrl-C, SIGTERM, SIGKILL), it leaves ``run.json``
 with ``status: running`` and every finished batch; the same command resumes.
 """
 

@@ -12,8 +12,9 @@ Atomic and resumable: rows are written a batch at a time (:class:`BatchWriter`: 
 file in ``flights/`` that is renamed into place once written and synced. A run killed at any
 moment (SIGKILL of everything) leaves only whole part files; the hidden temporary files are
 ignored by every Parquet reader (names starting with '.') and removed by the next run. Resuming
-lists the case ids already in ``flights/`` (:func:`finished_ids`) and flies only the others, so
-nothing is lost or written twice. One run at a time: ``DIR/.lock`` is held (``flock``) while a
+lists the case ids of the part files that pass :func:`~.audit.audit` (:func:`finished_ids`) and
+flies only the others, so nothing is lost or written twice. A part that cannot be written (no
+space left) is removed and the run stops with a one-line :class:`UserError`. One run at a time: ``DIR/.lock`` is held (``flock``) while a
 run writes (the kernel releases it when the process dies).
 """
 

@@ -183,6 +183,10 @@ class InsGnssBlock(BaseModel):
     alignment: Literal["stationary", "gnss_heading"] = Field(
         "stationary", description="strapdown units' initial alignment (levelling + "
                                   "gyrocompassing at rest, or in-air levelling + GNSS heading)")
+    adaptive: bool = Field(
+        False, description="seed 001's adaptive variant of the fault-tolerant estimator: a "
+                           "component failing its residual test switched off (artificial noise)"
+                           ", divergence reset")
     record_sensors: bool = Field(
         False, description="write the flight's IMU/GNSS/init files (the nav-replay format) "
                            "into the run folder's sensors/")

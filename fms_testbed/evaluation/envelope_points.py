@@ -10,7 +10,10 @@ coupled law's (T_V, ξ_V, T_H, ξ_H) and its n_y-trim time constant are tuned th
   :data:`PM_MIN_DEG`, disk margin ≥ :data:`DM_MIN`, closed-loop damping ≥ :data:`ZETA_MIN`;
 * soft goals (cost), on the linear closed loop's responses to an altitude step ``dH`` and a
   speed step ``dV``: tracking (integral of |error| over the step, in step sizes × 10 s),
-  decoupling ((max|ΔV| / 0.5 km/h)² + (max|ΔH| / 0.75 m)², half the nonlinear goals), and
+  decoupling ((max|ΔV| / 0.5 km/h)² + (max|ΔH| / 0.75 m)², half the nonlinear goals), path
+  tracking (the steady altitude error on a :data:`RAMP_MPS` descent path read ahead by the
+  guidance's fixed lead 2 ξ_H T_H of the aircraft file, / :data:`RAMP_ERR_M`, squared: a
+  schedule that moves ξ_H T_H away from that lead leaves the path), and
   activity (peak throttle in 0.3 of its range and peak elevator in 0.1, per step), plus a pull
   towards the starting tuning (:data:`REG_WEIGHT`).
 
@@ -63,6 +66,10 @@ DH_STEP_M = 100.0
 DV_STEP_FRAC = 0.10
 """Speed step of the soft goals and of the nonlinear check, fraction of the TAS."""
 T_STEP_S = 120.0
+RAMP_MPS = 5.0
+"""Soft goal: altitude-command ramp (a descent path), m/s."""
+RAMP_ERR_M = 5.0
+"""Soft goal: the ramp's steady altitude error is scored against this, m."""
 _DT_S = 0.1
 _OMEGA = np.logspace(-3, 2, 400)
 
@@ -156,8 +163,9 @@ class LinearGoals:
     cost: float
 
 
-def linear_goals(pl: PointLoops) -> LinearGoals:
-    """Evaluate :class:`LinearGoals` for the loops ``pl`` (module docstring)."""
+def linear_goals(pl: PointLoops, lead_s: float = 0.0) -> LinearGoals:
+    """Evaluate :class:`LinearGoals` for the loops ``pl`` (module docstring); ``lead_s`` is the
+    guidance's altitude read-ahead, s (:func:`fms_testbed.guidance.vertical.altitude_lead_s`)."""
     ms = [grid_margins(pl.loop(b)) for b in LON_BREAKS]
     zeta, _ = closed_loop_damping(pl, "lon")
     sys = pl.closed("lon", ["V_cmd", "H_cmd"], ["V", "h", "throttle", "elevator"])
@@ -169,6 +177,11 @@ def linear_goals(pl: PointLoops) -> LinearGoals:
     max_dv = float(np.abs(yh[:, 0]).max() / KMH_MPS)
     max_dh = float(np.abs(yv[:, 1]).max())
     couple = (max_dv / 0.5) ** 2 + (max_dh / 0.75) ** 2
+    # a descent path read ahead by the guidance's lead L: H_cmd = r (t + L); LTI, so the
+    # response is r (∫ y_step dt + L y_step) / ΔH; its error from the path r t at the end
+    y = yh[:, 1] / DH_STEP_M
+    e_end = RAMP_MPS * (np.sum(y) * _DT_S + lead_s * y[-1] - len(y) * _DT_S)
+    couple += (float(e_end) / RAMP_ERR_M) ** 2
     act = (np.abs(yv[:, 2]).max() + np.abs(yh[:, 2]).max()) / 0.3 + \
         (np.abs(yv[:, 3]).max() + np.abs(yh[:, 3]).max()) / 0.1
     return LinearGoals(min(m[0] for m in ms), min(m[1] for m in ms), min(m[2] for m in ms),
@@ -207,8 +220,11 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
     cfg : aircraft;  model : linear airframe at the point
     start : starting tuning (clipped into :data:`BOUNDS`);  max_iter : SLSQP iterations
     """
+    from fms_testbed.guidance.vertical import altitude_lead_s
+
     lo = np.array([BOUNDS[n][0] for n in NAMES])
     hi = np.array([BOUNDS[n][1] for n in NAMES])
+    lead = altitude_lead_s(cfg)
     cache: dict[tuple, tuple[np.ndarray, LinearGoals]] = {}
 
     def params(u):
@@ -218,7 +234,7 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
     def goals(u) -> LinearGoals:
         key = tuple(np.round(np.clip(u, 0.0, 1.0), 4))
         if key not in cache:
-            cache[key] = (np.array(key), linear_goals(point_loops(cfg, model, params(u))))
+            cache[key] = (np.array(key), linear_goals(point_loops(cfg, model, params(u)), lead))
         return cache[key][1]
 
     u0 = (np.clip([getattr(start, n) for n in NAMES], lo, hi) - lo) / (hi - lo)

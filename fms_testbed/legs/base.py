@@ -56,6 +56,9 @@ class Leg:
     """DF: flown from wherever the aircraft is; on a rebuild a fix already behind is passed."""
     initial: ClassVar[bool] = False
     """IF: a point where the path (re)starts; no path of its own."""
+    manual_end: ClassVar[bool] = False
+    """FM/VM/HM: ended by the crew (vectors, a hold left on clearance); a route resumed after
+    it at an IF is the coded direct-to, not a gap in the coding."""
     hold: ClassVar[bool] = False
     """HA/HF/HM: a racetrack hold at the fix."""
     course_reversal: ClassVar[bool] = False

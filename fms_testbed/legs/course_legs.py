@@ -212,6 +212,7 @@ class VM(_CourseLeg):
 
     code = "VM"
     heading_leg = True
+    manual_end = True
     end = staticmethod(_manual)
 
 
@@ -259,6 +260,7 @@ class FM(_FixCourseLeg):
     """Fix to manual termination."""
 
     code = "FM"
+    manual_end = True
     end = staticmethod(_manual)
 
 

@@ -14,7 +14,7 @@ from dataclasses import replace
 from fms_testbed.core.geodesy import direct, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.units import NM_M
-from fms_testbed.legs.base import (Leg, LegError, course_of, dme_position, fix_course,
+from fms_testbed.legs.base import (LEG_TYPES, Leg, LegError, course_of, dme_position, fix_course,
                                    fix_of, fix_termination, navaid_of)
 from fms_testbed.legs.builder import LegBuilder
 from fms_testbed.legs.coded import CodedCircle, course_into, track_between
@@ -42,6 +42,11 @@ class IF(Leg):
             # the final's IF after a procedure turn lies on the inbound course the turn
             # intercepts: join that course through the IF (no direct-to onto it)
             s = join_course(b, s, f, nxt.course_true_deg, None, not b.leg.rec.fly_over)
+        elif prev is not None and LEG_TYPES[prev.pt].manual_end:
+            # vectors: after a manual termination the coded route resumes at the IF, flown
+            # as a direct-to (the record's intent, not a gap in the coding)
+            s = connect(b, s, f.lat_deg, f.lon_deg,
+                        f"direct to IF {f.ident} after the manual termination of {prev.pt}", "info")
         elif s.track_deg is not None or b.segments:
             s = connect(b, s, f.lat_deg, f.lon_deg, f"IF {f.ident} away from the previous leg")
         return fix_state(b, s, f), fix_termination(f)

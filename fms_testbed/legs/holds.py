@@ -199,6 +199,7 @@ class HM(_Hold):
     """Hold to manual termination: one circuit drawn; the crew ends it."""
 
     code = "HM"
+    manual_end = True
 
     @classmethod
     def build(cls, b, s):

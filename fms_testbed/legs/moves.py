@@ -368,8 +368,8 @@ def join_from_fix(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float
     return replace(st, track_deg=course_deg, flyby=True)
 
 
-def connect(b: LegBuilder, state: FlightState, lat: float, lon: float, why: str
-            ) -> FlightState:
+def connect(b: LegBuilder, state: FlightState, lat: float, lon: float, why: str,
+            category: str = "discontinuity") -> FlightState:
     """Bridge a gap (> 1 cm) to a point (deg); a gap above 0.05 NM is also recorded as a
     discontinuity finding.
 
@@ -388,7 +388,7 @@ def connect(b: LegBuilder, state: FlightState, lat: float, lon: float, why: str
     if s <= 0.01:
         return replace(state, lat_deg=lat, lon_deg=lon)
     if s > 0.05 * NM_M:
-        b.finding("discontinuity", f"{why}: gap of {s / NM_M:.2f} NM bridged")
+        b.finding(category, f"{why}: gap of {s / NM_M:.2f} NM bridged")
     omega = abs(wrap180(az - state.track_deg)) if state.track_deg is not None else 0.0
     # the turn anticipation a direct-to onto the gap would need — the roll-in distance
     # (V · CLOSE_S) bounds it: a larger gap is flown as a real direct-to

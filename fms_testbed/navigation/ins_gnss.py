@@ -254,6 +254,7 @@ class InsGnssNavigation(NavigationSourceBase):
         src = cls(bank, GnssReceiver(g, seeds[0]), baro, filters,
                   DEFAULT_ALERT_DELAY_S if b.alert_delay_s is None else b.alert_delay_s, fdi)
         src.seed = sd
+        src.ft.adaptive = b.adaptive
         src.truth_model = b.truth_model
         if b.record_sensors:
             src.recorder = SensorRecorder(b.imu, dict(spec.get("gnss") or {}))
@@ -492,7 +493,12 @@ class InsGnssNavigation(NavigationSourceBase):
         if self.refdesc is not None:
             used = self._reference_description(truth, ins, C, used, extra, nse, means)
         valid = bool(used)
-        pick = used if valid else [int(np.argmin([np.trace(f.P[:3, :3]) for f in self.filters]))]
+        if valid:
+            pick = used
+        elif self.refdesc is not None:      # none kept: the closest to its reference description
+            pick = [int(self.refdesc.rank[0])]
+        else:
+            pick = [int(np.argmin([np.trace(f.P[:3, :3]) for f in self.filters]))]
         key = tuple(pick)
         if key not in means:
             means[key] = _mean_solution(C, pick)

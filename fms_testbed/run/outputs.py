@@ -47,6 +47,23 @@ def previous_run(folder: str | Path) -> dict | None:
     return data if isinstance(data, dict) and data.get("tool") == "fms-testbed" else None
 
 
+def _marker_problem(folder: Path) -> str:
+    """Why the folder's ``run.json`` is not a run record ('' when there is none to name)."""
+    path = folder / RUN_MARKER
+    if not path.is_file():
+        return ""
+    try:
+        data = json.loads(path.read_text())
+    except UnicodeDecodeError:
+        return f"; its {RUN_MARKER} is not text"
+    except json.JSONDecodeError as exc:
+        return f"; its {RUN_MARKER} is not valid JSON: line {exc.lineno} col {exc.colno}"
+    except OSError as exc:
+        return f"; its {RUN_MARKER} cannot be read: {exc.strerror}"
+    return "" if isinstance(data, dict) and data.get("tool") == "fms-testbed" else \
+        f"; its {RUN_MARKER} is not a run record of fms-testbed"
+
+
 def command_kind(argv: list[str] | None = None) -> str:
     """The kind of run a command line writes: its command word, e.g. ``fly`` or ``imu-test``
     (the word after the program name; ``unknown`` when it is an option or a path).
@@ -120,8 +137,8 @@ def check_out_dir(out_dir: str | Path, overwrite: bool = False, kind: str | None
         prev = previous_run(out)
         if content and prev is None and not overwrite:
             raise UserError(f"--out {out}: the folder holds other files ({', '.join(content[:3])}"
-                            f"{', ...' if len(content) > 3 else ''}); give an empty or new folder, "
-                            "or --overwrite to replace it")
+                            f"{', ...' if len(content) > 3 else ''}){_marker_problem(out)}; give "
+                            "an empty or new folder, or --overwrite to replace it")
         if prev is not None and run_kind(prev) != kind and not overwrite:
             raise UserError(f"--out {out}: holds a {run_kind(prev)} run, not a {kind} run; give "
                             "a new folder, or --overwrite to replace it")

@@ -83,3 +83,21 @@ def test_a_folder_of_another_kind_is_not_reported(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "holds a montecarlo run, not a regress run folder" in err
     assert not (out / "report.html").exists()
+
+
+def test_regress_run_replaces_another_kind_only_with_overwrite(tmp_path, capsys):
+    from fms_testbed.run.outputs import OutputFolder
+
+    out = tmp_path / "was-a-flight"
+    with OutputFolder(out, kind="fly") as tmp:
+        (tmp / "timeseries.parquet").write_text("x")
+    argv = ["run", *SMALL, "--limit", "1", "--workers", "1", "--no-progress", "--out", str(out)]
+    assert regress(*argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert "holds a fly run, not a regress-run run" in err and "--overwrite" in err
+    assert (out / "timeseries.parquet").exists()
+    assert regress(*argv, "--overwrite") == 0
+    assert not (out / "timeseries.parquet").exists()
+    info = json.loads((out / "run.json").read_text())
+    assert info["kind"] == "regress-run" and info["status"] == "complete"
+    assert len(read_flights(out)) == 1

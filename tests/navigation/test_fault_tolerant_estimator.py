@@ -166,3 +166,9 @@ def test_adaptive_r_rides_out_a_gnss_noise_burst_and_returns_to_nominal():
     np.testing.assert_allclose(out[True][2], 1.0, atol=1e-3)   # back to nominal after the burst
     assert out[True][1] < out[False][1]                        # the burst pulls it less
     assert not [e for e in out[True][3] if e["kind"] == "reset"]
+
+
+def test_navigation_adaptive_key_selects_the_adaptive_variant():
+    base = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 1}
+    assert not make_source(base, seed=0).ft.adaptive
+    assert make_source({**base, "adaptive": True}, seed=0).ft.adaptive

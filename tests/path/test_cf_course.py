@@ -72,13 +72,25 @@ def test_no_cf_straight_of_an_ok_transition_is_off_its_course(cifp, airport):
     assert n > 20
 
 
-@pytest.mark.parametrize("airport", ["KATL", "KMCO", "KLAN", "KBCT", "KSFO"])
+@pytest.mark.parametrize("airport", ["KATL", "KMCO", "KLAN", "KSFO"])
 def test_paths_with_a_discontinuity_or_loop_are_never_ok_or_corrected(cifp, airport):
     rows = check_airport(cifp, airport, PERF, BuildParams())
     flagged = [r for r in rows if "discontinuity" in r["flags"] or "loop" in r["flags"]]
     assert flagged
     for r in flagged:
         assert r["status"] not in ("ok", "corrected"), (r["procedure"], r["transition"])
+
+
+def test_route_resumed_after_vectors_is_the_coded_direct_to_not_a_discontinuity(cifp):
+    """KBCT MYZNR2 RW05/RW23: VA VM IF TF TF, the route resumes at JAVAA after the vectors of
+    the VM (a manual termination): flown direct, an 'info' finding, the transition ok."""
+    rows = {r["transition"]: r for r in check_airport(cifp, "KBCT", PERF, BuildParams())
+            if r["procedure"] == "MYZNR2"}
+    for t in ("RW05", "RW23"):
+        assert rows[t]["legs"].startswith("VA VM IF"), rows[t]["legs"]
+        assert "discontinuity" not in rows[t]["flags"]
+        assert rows[t]["status"] == "ok", rows[t]["findings"]
+        assert "after the manual termination of VM" in rows[t]["findings"]
 
 
 def test_pde_of_a_course_flown_backwards_is_its_length_not_zero():

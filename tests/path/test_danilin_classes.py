@@ -51,7 +51,7 @@ def test_class1_real_rf_bank_forced_by_wind_and_temperature(cifp):
 
 
 @pytest.mark.parametrize("name, text, cls", [
-    ("KBCT SID MYZNR2 RW05", "IF JAVAA away", 2),       # a discontinuity the geometry bridges
+    ("KSMX SID BUELT4 RW12", "IF GLJ away", 2),         # a discontinuity the geometry bridges
     ("3AU APPROACH VDM-A", "doubles back", 3),          # the coding: the path drawn twice
 ])
 def test_classes_2_and_3_real(cifp, name, text, cls):

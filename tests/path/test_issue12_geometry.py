@@ -403,7 +403,7 @@ def test_cf_abeam_its_fix_after_vectors_is_joined_upstream(cifp):
 
 @pytest.mark.parametrize("name, text, cls", [
     ("KDFW SID ARDIA7 RW35C", "fly-by at MECHL", 1),         # speed/bank: the conditions
-    ("KBCT SID MYZNR2 RW05", "IF JAVAA away", 2),             # a discontinuity bridged
+    ("KSMX SID BUELT4 RW12", "IF GLJ away", 2),               # a discontinuity bridged
     ("3AU APPROACH VDM-A", "doubles back", 3),                # the coding (Fig. 4)
 ])
 def test_findings_say_which_of_danilins_classes_forced_them(cifp, name, text, cls):

@@ -295,12 +295,14 @@ def test_fly_by_slowed_for_in_a_tailwind_is_flown_within_the_goal(cifp, airport,
     within_goals(res)
 
 
-@pytest.mark.parametrize("airport, procedure, transition, runway, wind_from_deg", [
-    ("KPHX", "BALDY3", "CNX", "RW07L", 272.4),   # VI: drift 0.9° off the prediction, 2.3 km
-    ("KDHN", "I14", "SKIPO", None, 136.4),       # initial VI in the wind ramp: 215 m
+@pytest.mark.parametrize("airport, procedure, transition, runway, wind_from_deg, rebuilt", [
+    # VI: drifted 0.9° off the prediction (2.3 km) under the earlier climb planning; with the
+    # one climb planner inside the envelope its drift stays within the threshold (no rebuild)
+    ("KPHX", "BALDY3", "CNX", "RW07L", 272.4, False),
+    ("KDHN", "I14", "SKIPO", None, 136.4, True),       # initial VI in the wind ramp: 215 m
 ])
 def test_heading_leg_that_drifts_off_its_prediction_is_rebuilt_in_flight(
-        cifp, airport, procedure, transition, runway, wind_from_deg):
+        cifp, airport, procedure, transition, runway, wind_from_deg, rebuilt):
     """A heading leg more than HEADING_DRIFT_REBUILD_M off the track its planned drift
     predicted is rebuilt from the present position, so its intercept starts where the aircraft
     is (guidance.fms.ProcedureGuidance._heading_drifted): KPHX BALDY3 was not_contained (max FTE
@@ -314,5 +316,5 @@ def test_heading_leg_that_drifts_off_its_prediction_is_rebuilt_in_flight(
     res = fly_procedure(scn, spec, fp, d, progress=False, plots=False)
     within_goals(res)
     assert res.summary["status"] == "ok", res.summary["reason"]
-    assert any(e["kind"] == "rebuild" and "heading leg" in e.get("detail", "")
-               for e in res.summary["guidance_events"])
+    assert rebuilt == any(e["kind"] == "rebuild" and "heading leg" in e.get("detail", "")
+                          for e in res.summary["guidance_events"])

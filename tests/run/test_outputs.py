@@ -182,3 +182,11 @@ def test_empty_out_is_refused(capsys):
 
     assert main(["imu-test", "--duration-h", "0.02", "--out", ""]) == 2
     assert "give a folder name" in capsys.readouterr().err
+
+
+def test_a_run_json_that_is_not_json_is_named(tmp_path):
+    out = tmp_path / "r"
+    out.mkdir()
+    (out / RUN_MARKER).write_text("{oops")
+    with pytest.raises(UserError, match="its run.json is not valid JSON: line 1 col 2"):
+        check_out_dir(out, kind="fly")
