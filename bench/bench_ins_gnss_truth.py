@@ -19,16 +19,19 @@ from __future__ import annotations
 import argparse
 import math
 import time
+import sys
 from pathlib import Path
 
 import numpy as np
 from scipy.stats import chi2
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
 from fms_testbed.navigation import make_source
 from fms_testbed.sensors.profiles import Segment, aircraft_states, fly_profile
 from fms_testbed.sensors.sins.analysis import horizontal_radius
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "results" / "ins_gnss_on_measurements.md"
 IMU = {"name": "matched-tactical",
        "gyro": {"arw_deg_per_sqrt_h": 0.05, "bias_instability_deg_per_h": 0.05,
                 "bias_correlation_time_s": 3600},
@@ -123,12 +126,11 @@ def write(c, tm, a, wall_s) -> None:
     rz = c["rms_z"]
     d = c["drift"]
     names = ["δp E", "δp N", "δp U", "δV E", "δV N", "δV U", "ε E", "ε N", "ε U"]
-    L = ["# The INS/GNSS filter on its measurements (strapdown truth)", "",
-         f"Written by `python bench/bench_ins_gnss_truth.py --runs {a.runs} --seeds {a.seeds}` "
-         f"({wall_s:.0f} s wall on 2 shared cores). Profile: 600 s at 150 m/s, 47° N, 3000 m; "
+    L = ["**The INS/GNSS filter on its measurements (strapdown truth)**", "",
+         f"{a.runs} runs, {a.seeds} seeds, {wall_s:.0f} s wall on 2 shared cores. Profile: 600 s at 150 m/s, 47° N, 3000 m; "
          "level, ±3 °/s turns, a 3° climb and descent, 1 °/s turns; GNSS 1 Hz, 0.1 s latency, "
          "the default receiver; baro; one INS.", "",
-         "## Consistency", "",
+         "**Consistency.**", "",
          f"{m} fault-free runs (seeds 2000, 2002, ...; the test IMU of "
          "tests/navigation/test_ins_gnss_consistency.py, no scale-factor or misalignment "
          f"errors). Mean NEES of the 9 navigation states inside its 95 % χ² band "
@@ -143,13 +145,13 @@ def write(c, tm, a, wall_s) -> None:
          + ", ".join(f"{n} {v:.2f}" for n, v in zip(names, np.median(rz, axis=0)))
          + f". Innovation RMS < 3 in {int(np.sum(c['innov'] < 3))} of {len(c['innov'])} runs "
          f"(max {c['innov'].max():.2f}).", "",
-         "## A 120-s GNSS outage", "",
+         "**A 120-s GNSS outage.**", "",
          f"{len(d)} runs with no fix from {OUTAGE[0]:g} to {OUTAGE[1]:g} s. Horizontal drift at "
          f"the outage's end: 95th percentile {np.percentile(d[:, 0], 95):.2f} m against the "
          f"filter's own 95 % radius there, mean {d[:, 1].mean():.2f} m (ratio "
          f"{np.percentile(d[:, 0], 95) / d[:, 1].mean():.2f}; goal within ±20 %); "
          f"{int(np.sum(d[:, 0] <= d[:, 1]))} of {len(d)} runs inside their own 95 % radius.", "",
-         "## Strapdown against linear truth", "",
+         "**Strapdown against linear truth.**", "",
          f"{len(tm)} seeds, the STIM300 preset (with its scale factors and misalignments), the "
          "same outage; the linear unit starts at the strapdown unit's errors after the "
          "alignment, the in-run noise is each model's own. Median over seeds of the RMS in "
@@ -165,8 +167,7 @@ def write(c, tm, a, wall_s) -> None:
                 vals.append(np.median(x))
         L.append(f"| {label} | " + " | ".join(
             f"{v:.3f}" for v in (vals[0], vals[1], vals[2], vals[3], vals[4], vals[5])) + " |")
-    DOC.write_text("\n".join(L) + "\n")
-    print(DOC.read_text())
+    report.write("ins_gnss_on_measurements.md", "\n".join(L))
 
 
 if __name__ == "__main__":

@@ -12,15 +12,18 @@ from __future__ import annotations
 import argparse
 import json
 import tempfile
+import sys
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
 from pyins import filters, inertial_sensor, measurements, sim, strapdown, transform
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
 from fms_testbed.cli.nav_replay import replay_files
 
-DOC = Path(__file__).resolve().parents[1] / "docs" / "results" / "nav_replay.md"
 DH = transform.DH_TO_RS
 GYRO_BIAS_DPH, ARW_DPSH = 0.5, 0.15            # the STIM300 preset's gyro
 ACCEL_BIAS_MPS2, VRW_MPSSH = 0.75e-3 * 9.80665, 0.06
@@ -111,9 +114,8 @@ def write(rows, a) -> None:
     """The results page."""
     o95, p95, oh, ph, ol, pl = (np.array([r[i] for r in rows]) for i in (1, 2, 3, 4, 6, 7))
     z = pd.DataFrame([r[5] for r in rows])
-    lines = ["# Replay on another simulator's data: nav-replay vs pyins' feedback filter", "",
-             "Written by `python bench/bench_nav_replay.py --seeds "
-             f"{a.seeds} --duration {a.duration:g}`. pyins {_pyins_version()} makes the data "
+    lines = ["**Replay on another simulator's data: nav-replay vs pyins' feedback filter**", "",
+             f"{a.seeds} seeds of {a.duration:g} s. pyins {_pyins_version()} makes the data "
              "(sine-velocity motion at 47° N, 3000 m, V = (60, 40, 0) + 15 sin m/s NED over "
              "90 s, IMU rates at 100 Hz with STIM300-class biases and noise: gyro 0.5 °/h, ARW "
              "0.15 °/√h, accelerometer 0.75 mg, VRW 0.06 m/s/√h; GNSS position σ 1 m and NED "
@@ -135,8 +137,7 @@ def write(rows, a) -> None:
               "nav-replay's RMS(error/σ) per state, median over the seeds (1 for an honest "
               "covariance; pyins' tests ask < 1.5): " + ", ".join(
                   f"{k} {v:.2f}" for k, v in z.median().items()) + "."]
-    DOC.write_text("\n".join(lines) + "\n")
-    print(DOC.read_text())
+    report.write("nav_replay.md", "\n".join(lines))
 
 
 def _pyins_version() -> str:

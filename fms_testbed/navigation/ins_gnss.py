@@ -47,7 +47,7 @@ from fms_testbed.core.earth import radii_and_derivatives, radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import G0_MPS2
-from fms_testbed.navigation.inertial.bank import StrapdownBank
+from fms_testbed.navigation.inertial.bank import StrapdownBank, set_lever_arm
 from fms_testbed.navigation.ins_bank import InsBank, derive_seeds
 from fms_testbed.navigation.faults import check_fault, inject
 from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
@@ -164,6 +164,19 @@ def _mean_solution(C: np.ndarray, units: list[int]) -> tuple:
     return c[0], c[1], c[2], c[3:6], c[6], c[7], c[8]
 
 
+def alignment_s(bank) -> float | None:
+    """The stationary alignment's duration (s) of a strapdown bank, whose white-noise means are
+    in the initial errors; None for another bank or alignment.
+
+    Parameters
+    ----------
+    bank : the INS bank
+    """
+    if isinstance(bank, StrapdownBank) and bank.alignment == "stationary":
+        return bank.alignment_s
+    return None
+
+
 class InsGnssNavigation(NavigationSourceBase):
     """INS/GNSS navigation source; see the module docstring for the scenario keys.
 
@@ -207,7 +220,7 @@ class InsGnssNavigation(NavigationSourceBase):
         self._mean_P_cache: dict[tuple, tuple] = {}
         self._anp = math.nan
         self._interval: PredictionInterval | None = None      # built at the first step
-        self.recorder: SensorRecorder | None = None   # navigation.record_sensors
+        self.recorder: SensorRecorder | None = None   # navigation.record_sensors (its tables)
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "InsGnssNavigation":
@@ -253,7 +266,7 @@ class InsGnssNavigation(NavigationSourceBase):
         """The IMU's position from the CG (the aircraft file's ``imu_lever_arm_m``, body axes,
         m), set before the first update; the linear model has none."""
         if isinstance(self.bank, StrapdownBank):
-            self.bank.set_lever_arm(lever_arm_m)
+            set_lever_arm(self.bank, lever_arm_m)
             self.frame_properties = tuple(self.bank.frame_properties)
 
     # -- faults ----------------------------------------------------------------------------
@@ -322,12 +335,12 @@ class InsGnssNavigation(NavigationSourceBase):
         fixes = self.receiver.update(truth)
         reading = self.baro.update(truth) if self.baro is not None else None
         if self.recorder is not None:
-            self._record(truth, prev, fixes)
+            self.recorder.record(truth, prev, fixes, self.bank)
         if prev is None:
             for i, f in enumerate(self.filters):
-                f.initialise(ins[i], self._alignment_s())
+                f.initialise(ins[i], alignment_s(self.bank))
             if self.recorder is not None:
-                self.recorder.start(ins[0], self.filters[0].P, self._alignment_s())
+                self.recorder.start(ins[0], self.filters[0].P, alignment_s(self.bank))
         elif t > prev.t_s:
             # an interval ends where a measurement is valid: at a GNSS epoch (the fix, delivered
             # later, is then used at the filters' time, its time of validity) and at a baro
@@ -371,31 +384,6 @@ class InsGnssNavigation(NavigationSourceBase):
                 self.events += self.ft.check(i, t, [g])
         self._prev_truth, self._prev_ins = truth, ins
         return self.solution(truth, ins)
-
-    def _record(self, truth: AircraftState, prev: AircraftState | None, fixes) -> None:
-        """Record unit 0's raw step increments, the delivered fixes and the truth."""
-        rec = self.recorder
-        rec.true_state(truth)
-        for fix in fixes:
-            rec.fix(fix)
-        if prev is not None and truth.t_s > prev.t_s:
-            f, w = self.bank.measured(0)
-            comp = self.bank.comp[0] if isinstance(self.bank, StrapdownBank) else \
-                self.bank.compensation[0]
-            rec.step(truth.t_s, np.concatenate([f, w]) + comp, truth.t_s - prev.t_s)
-
-    def recorded_sensors(self) -> dict | None:
-        """The recorded sensors (:meth:`~.recording.SensorRecorder.tables`; None: not
-        recording)."""
-        return None if self.recorder is None else self.recorder.tables()
-
-    def _alignment_s(self) -> float | None:
-        """The stationary alignment's duration of a strapdown bank (its white-noise means are
-        in the initial errors), else None."""
-        b = self.bank
-        if isinstance(b, StrapdownBank) and b.alignment == "stationary":
-            return b.alignment_s
-        return None
 
     def _sensor_pairs(self, truth: AircraftState) -> tuple:
         """Sensor-level stage 1 on the units' raw IMU outputs over the last step."""

@@ -76,6 +76,19 @@ class SensorRecorder:
                                truth.v_enu_mps, truth.roll_rad, truth.pitch_rad,
                                truth.heading_rad))
 
+    def record(self, truth: AircraftState, prev: AircraftState | None, fixes, bank) -> None:
+        """One navigation step: the truth, the delivered ``fixes`` and unit 0's raw step
+        increments from ``bank`` (its compensated measured f̄, ω̄ plus the compensation it
+        applied: ``comp`` of a strapdown bank, ``compensation`` of the linear one) since
+        ``prev``."""
+        self.true_state(truth)
+        for fix in fixes:
+            self.fix(fix)
+        if prev is not None and truth.t_s > prev.t_s:
+            f, w = bank.measured(0)
+            comp = bank.comp[0] if hasattr(bank, "comp") else bank.compensation[0]
+            self.step(truth.t_s, np.concatenate([f, w]) + comp, truth.t_s - prev.t_s)
+
     def tables(self) -> dict:
         """{"imu", "gnss", "truth": DataFrames in the replay's columns, "init": mapping}."""
         return {"imu": pd.DataFrame(self.imu, columns=("t_s",) + INC_COLS),

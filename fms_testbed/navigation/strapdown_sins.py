@@ -20,7 +20,7 @@ from fms_testbed.core.contracts import NavigationSourceBase
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import DPH_RPS, G0_MPS2
-from fms_testbed.navigation.inertial.bank import StrapdownBank
+from fms_testbed.navigation.inertial.bank import StrapdownBank, set_lever_arm
 from fms_testbed.navigation.ins_bank import derive_seeds
 from fms_testbed.sensors.sins.presets import load_imu
 
@@ -44,7 +44,7 @@ class StrapdownSinsNavigation(NavigationSourceBase):
     def install_imu(self, lever_arm_m) -> None:
         """The IMU's position from the CG (the aircraft file's ``imu_lever_arm_m``, body axes,
         m), set before the first update."""
-        self.bank.set_lever_arm(lever_arm_m)
+        set_lever_arm(self.bank, lever_arm_m)
         self.frame_properties = tuple(self.bank.frame_properties)
 
     @classmethod

@@ -154,9 +154,10 @@ def results_of(flight: Flight) -> Results:
     so_far = {**record_dict(record), **record_dict({k: v for k, v in blocks.items()
                                                      if v is not None})}
     decision = decide(so_far, df, flight.cfg, rnp_nm)
-    rec = getattr(flight.navigation, "recorded_sensors", None)
+    rec = getattr(flight.navigation, "recorder", None)     # navigation.record_sensors
     return Results(df=df, summary=assemble(record, decision, **blocks), scenario=flight.scn,
-                   procedure=proc, flown_paths=rebuilt, sensors=rec() if rec else None)
+                   procedure=proc, flown_paths=rebuilt,
+                   sensors=rec.tables() if rec is not None else None)
 
 
 def run_scenario(scenario, out_dir: str | Path | None = None, seed: int | None = None,

@@ -112,20 +112,6 @@ class StrapdownBank:
     def __len__(self) -> int:
         return len(self.params)
 
-    def set_lever_arm(self, lever_arm_m) -> None:
-        """Place the IMU at ``lever_arm_m`` (3,) m from the CG, body axes (before the first
-        update: the aircraft file's ``imu_lever_arm_m``).
-
-        Raises
-        ------
-        ValueError : the bank has started
-        """
-        if self.rows is not None:
-            raise ValueError("StrapdownBank.set_lever_arm: the bank has started")
-        self.lever = np.ascontiguousarray(lever_arm_m, dtype=float).reshape(3)
-        self.use_rates = bool(np.any(self.lever != 0.0))
-        self.frame_properties = frame_properties(self.lever)
-
     # -- noise ------------------------------------------------------------------------------
     def _noise(self, n_frames: int) -> tuple[np.ndarray, int, np.ndarray]:
         """(white buffer (n, m, 6), its first row for this step, this step's slow-state normals
@@ -299,4 +285,23 @@ class StrapdownBank:
         raise ValueError(f"fault kind {kind!r} is not an INS fault")
 
 
-__all__ = ["StrapdownBank"]
+def set_lever_arm(bank: StrapdownBank, lever_arm_m) -> None:
+    """Place a bank's IMU at ``lever_arm_m`` (3,) m from the CG, body axes, before its first
+    update (the aircraft file's ``imu_lever_arm_m``).
+
+    Parameters
+    ----------
+    bank : the strapdown bank;  lever_arm_m : (3,) x forward, y right, z down, m
+
+    Raises
+    ------
+    ValueError : the bank has started
+    """
+    if bank.rows is not None:
+        raise ValueError("set_lever_arm: the bank has started")
+    bank.lever = np.ascontiguousarray(lever_arm_m, dtype=float).reshape(3)
+    bank.use_rates = bool(np.any(bank.lever != 0.0))
+    bank.frame_properties = frame_properties(bank.lever)
+
+
+__all__ = ["StrapdownBank", "set_lever_arm"]
