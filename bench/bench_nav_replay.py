@@ -23,10 +23,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report  # noqa: E402
 
 from fms_testbed.cli.nav_replay import replay_files
+from fms_testbed.core.units import G0_MPS2
 
 DH = transform.DH_TO_RS
 GYRO_BIAS_DPH, ARW_DPSH = 0.5, 0.15            # the STIM300 preset's gyro
-ACCEL_BIAS_MPS2, VRW_MPSSH = 0.75e-3 * 9.80665, 0.06
+ACCEL_BIAS_MPS2, VRW_MPSSH = 0.75e-3 * G0_MPS2, 0.06
 POS_SD_M, VEL_SD_MPS = 1.0, 0.1
 SETTLED_S = 60.0                               # "after the initial transient", s
 INIT = {"pos_m": 10.0, "vel_mps": 1.0, "level_deg": 1.0, "heading_deg": 5.0}

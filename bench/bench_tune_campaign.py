@@ -23,6 +23,11 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from report import machine  # noqa: E402
+
+PAGE = "tune_campaign.md"
+
 KEY = ["airport", "type", "procedure", "runway", "transition", "conditions"]
 METRICS = ("fte_p95_m", "vpe_p95_m", "spd_err_p95_kt")
 
@@ -69,7 +74,8 @@ def main() -> int:
     ap.add_argument("--wind", default="270/30", help="FROM_DEG/SPEED_KT")
     ap.add_argument("--turbulence", default="moderate", choices=("light", "moderate", "severe"))
     ap.add_argument("--out", required=True)
-    ap.add_argument("--md", help="also write docs/results/MD and docs/figures/tuning/")
+    ap.add_argument("--md", action="store_const", const=PAGE,
+                    help=f"also write docs/results/{PAGE} and docs/figures/tuning/")
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -90,7 +96,7 @@ def main() -> int:
 
     md = ("<!-- written by python bench/bench_tune_campaign.py; rerun it to refresh, do not edit "
           f"by hand -->\n\nCommand: `python bench/bench_tune_campaign.py {' '.join(sys.argv[1:])}`"
-          f"\n\nAircraft: `{args.old}` (file gains) and `{args.new}` (tuned schedule). "
+          f"  \nMachine: {machine()}.\n\nAircraft: `{args.old}` (file gains) and `{args.new}` (tuned schedule). "
           f"Conditions: wind {args.wind} kt, {args.turbulence} turbulence; "
           f"{len(both)} paired flights.\n\n{markdown_table(table.reset_index())}\n\n"
           "Median of the paired differences (tuned − file gains): "

@@ -37,6 +37,7 @@ from fms_testbed.control.loops import BREAKS, margins
 from fms_testbed.control.schedule import SCHEDULED, GainSchedule, schedule_from_points
 from fms_testbed.core.atmosphere import cas_to_tas
 from fms_testbed.core.errors import ConfigError, TrimError
+from fms_testbed.core.units import SLUG_KG
 from fms_testbed.evaluation.envelope_points import (point_loops, tune_bank_loop, tune_point,
                                                     verify)
 from fms_testbed.sim.inner_steps import check_aircraft, replace_gains
@@ -65,7 +66,7 @@ def loaded_mass_kg(cfg: AircraftConfig) -> float:
 
     ac = JSBSimAircraft(cfg)
     ac.fdm.run_ic()
-    return float(ac.fdm["inertia/mass-slugs"]) * 14.593902937
+    return float(ac.fdm["inertia/mass-slugs"]) * SLUG_KG
 
 
 def default_grid(cfg: AircraftConfig) -> list[DesignPoint]:

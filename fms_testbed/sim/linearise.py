@@ -32,7 +32,7 @@ import numpy as np
 
 from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.core.errors import UserError
-from fms_testbed.core.units import FT_M, G0_MPS2, LB_KG
+from fms_testbed.core.units import FT_M, G0_MPS2, LB_KG, SLUG_KG
 from fms_testbed.sim.jsbsim_core import JSBSimAircraft, TrimResult
 
 LON_STATES = ("V_mps", "alpha_rad", "theta_rad", "q_rps", "h_m")
@@ -350,7 +350,7 @@ def linearise(cfg: AircraftConfig, point: DesignPoint, ac: JSBSimAircraft | None
     fdm["fms/ap/master"] = 1.0
     V0 = trim.tas_mps
     qbar_pa = fdm["aero/qbar-psf"] * 47.88025898
-    mass = fdm["inertia/mass-slugs"] * 14.593902937
+    mass = fdm["inertia/mass-slugs"] * SLUG_KG
     tau_e = engine_lag_s(ac)
     lon = longitudinal_ss(A, B, V0, tau_e)
     Al, Bl = _reduce(lin, _JSB_LAT, ("DaCmd", "DrCmd"))

@@ -19,10 +19,22 @@ from campaign_helpers import SMALL, regress
 from test_campaign_run import comparable
 
 
+def _split_parts(out, n):
+    """Rewrite the run's rows as ``n`` part files (how many parts a run writes depends on its
+    timing: rows wait in memory up to a time limit)."""
+    t = pa.concat_tables([pq.read_table(p) for p in part_files(out)])
+    for p in part_files(out):
+        p.unlink()
+    k = -(-t.num_rows // n)
+    for i in range(n):
+        pq.write_table(t.slice(i * k, k), out / "flights" / f"part-{i:020d}-0-split.parquet")
+
+
 def _damage(src, out):
     """A copy of ``src`` with its first part truncated to 100 bytes, its second duplicated
     under another name and a part of rows of another run (foreign case ids) added."""
     shutil.copytree(src, out)
+    _split_parts(out, 4)
     parts = part_files(out)
     lost = set(pq.read_table(parts[0]).column("case_id").to_pylist())
     with open(parts[0], "r+b") as fh:

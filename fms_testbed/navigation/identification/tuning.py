@@ -5,6 +5,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.units import G0_MPS2
 
 
 @dataclass(frozen=True)
@@ -54,7 +55,7 @@ class FdiTuning:
     sensor_test: str = "window"
     k_sensor: float = 6.3
     cusum_h: float = 20.0
-    cusum_accel_mps2: float = 0.75e-3 * 9.80665
+    cusum_accel_mps2: float = 0.75e-3 * G0_MPS2
     cusum_gyro_rps: float = 22.0 * 3.141592653589793 / 180.0 / 3600.0
     accel_window_s: float = 1.0
     gyro_window_s: float = 10.0
