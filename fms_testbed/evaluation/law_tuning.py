@@ -39,7 +39,7 @@ from fms_testbed.control.metrics import StepMetrics, step_metrics
 from fms_testbed.control.pointmass import CommandEvent, PointMassParams, simulate
 
 BOUNDS = {"T_V_s": (5.0, 15.0), "xi_V": (0.6, 1.5), "T_H_s": (6.0, 20.0), "xi_H": (0.6, 1.5)}
-"""Search box: time constants in s, damping ratios dimensionless (issue 3: T_V ≥ 5, T_H ≥ 6)."""
+"""Search box: time constants in s, damping ratios dimensionless (T_V ≥ 5 s, T_H ≥ 6 s: the coupled law's design bounds, docs/coupled-law.md)."""
 NAMES = tuple(BOUNDS)
 _T_STEP_S = 5.0
 
