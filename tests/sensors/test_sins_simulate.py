@@ -79,7 +79,11 @@ from hypothesis import strategies as st  # noqa: E402
 def test_factor_recovers_rank_and_matrix_of_random_psd(seed, n, r):
     rng = np.random.default_rng(seed)
     r = min(r, n)
-    B = rng.normal(size=(n, r)) * 10.0 ** rng.uniform(-6, 3, size=(n, 1))   # mixed state scales
+    # r well-conditioned rows (singular values >= ~0.3), the rest in their span, then mixed state
+    # scales: the rank is decidable in double precision (independent Gaussian rows are, now and
+    # then, within 1e-9 of the span of the rows before them, and the rank is then ambiguous)
+    B0 = np.eye(r) + 0.1 * rng.normal(size=(r, r))
+    B = np.vstack([B0, rng.normal(size=(n - r, r)) @ B0]) * 10.0 ** rng.uniform(-6, 3, size=(n, 1))
     Q = B @ B.T
     S = factor_psd(Q)
     assert S.shape[1] == r
