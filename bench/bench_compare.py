@@ -61,11 +61,15 @@ def main() -> int:
                                        "scenarios' 737)")
     ap.add_argument("--skip-envelope", action="store_true")
     ap.add_argument("--skip-ablation", action="store_true")
+    report.add_quick(ap, "the altitude step of the coupled law, no envelope, one ablation row")
     args = ap.parse_args()
     extra = ["--aircraft", args.aircraft] if args.aircraft else []
+    first = ["--laws", "coupled", "coupled-altitude-step"] if args.quick else []
+    if args.quick:
+        args.skip_envelope = True
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
-        rc, wall = fms_testbed(["compare", *extra], tmp / "compare", "comparison.md")
+        rc, wall = fms_testbed(["compare", *first, *extra], tmp / "compare", "comparison.md")
         cmd = " ".join(["fms-testbed compare", *extra])
         report.write("coupled_law.md", body_of(tmp / "compare" / "comparison.md"),
                      note=f"`{cmd}` ({wall:.0f} s wall, exit code {rc}): each scenario flown "
@@ -82,7 +86,7 @@ def main() -> int:
                               "envelope point, each aircraft with its tuned gains.")
         if not args.skip_ablation:
             rows = []
-            for label, sets in ABLATION:
+            for label, sets in ABLATION[:1] if args.quick else ABLATION:
                 out = tmp / f"ablation-{len(rows)}"
                 argv = ["compare", "--laws", "coupled", "--no-small-step",
                         "coupled-altitude-step", "coupled-speed-step", *extra]

@@ -84,7 +84,10 @@ def main() -> None:
                     help="guidance/law rates to time, Hz (10 is the procedure default)")
     ap.add_argument("--md", default="fly_speed.md",
                     help="Markdown table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "60 s simulated at 10 Hz only")
     args = ap.parse_args()
+    if args.quick:
+        args.sim_s, args.rates = 60.0, [10.0]
     logging.basicConfig(level=logging.WARNING)
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     print(f"737, demo SID, {args.sim_s:.0f} s simulated at 120 Hz, each flight interleaved with "

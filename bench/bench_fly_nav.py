@@ -46,7 +46,10 @@ def main() -> int:
     ap.add_argument("--imus", nargs="+", default=["HG1700", "ADIS16488", "consumer_MEMS"])
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--md", default="fly_nav.md", help="Markdown table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "truth and one IMU")
     args = ap.parse_args()
+    if args.quick:
+        args.imus = args.imus[:1]
     logging.basicConfig(level=logging.WARNING)
     path = scenarios_dir() / SCENARIO
     rows = []

@@ -35,7 +35,10 @@ def main() -> int:
     ap.add_argument("--imus", nargs="+", default=["HG9900", "STIM300"])
     ap.add_argument("--md", default="ins_growth.md",
                     help="Markdown table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "one IMU")
     args = ap.parse_args()
+    if args.quick:
+        args.imus = args.imus[:1]
     rows, header = [], None
     with tempfile.TemporaryDirectory() as tmp:
         for imu in args.imus:

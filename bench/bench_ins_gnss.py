@@ -38,6 +38,9 @@ from pathlib import Path
 
 import numpy as np
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
 from fms_testbed.data import scenarios_dir
 from fms_testbed.navigation import make_source
 from fms_testbed.run import run_scenario
@@ -65,10 +68,10 @@ def approach(n_seeds: int) -> None:
               f" m, loop {s['loop_wall_time_s']:.2f} s")
 
 
-def faults(n_seeds: int) -> None:
+def faults(n_seeds: int, kinds: list[dict] = FAULTS) -> None:
     segs = [Segment(120), Segment(60, 3), Segment(120), Segment(60, -3), Segment(120)]
     states = aircraft_states(fly_profile(segs, dt_s=0.1))
-    for fault in FAULTS:
+    for fault in kinds:
         for seed in range(n_seeds):
             nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=seed)
             nse = []
@@ -87,10 +90,10 @@ def faults(n_seeds: int) -> None:
                   f"{max(nse):.2f} m")
 
 
-def false_alarms(n_runs: int, first_seed: int) -> None:
+def false_alarms(n_runs: int, first_seed: int, duration_s: float = 3600.0) -> None:
     rng = np.random.default_rng(0)
     segs: list[Segment] = []
-    while sum(s.duration_s for s in segs) < 3600:
+    while sum(s.duration_s for s in segs) < duration_s:
         segs += [Segment(float(rng.uniform(60, 240))),
                  Segment(float(rng.uniform(20, 90)), float(rng.choice([-3, -1.5, 1.5, 3])),
                          float(rng.choice([0, 0, 3, -3])), float(rng.choice([0, 0.3, -0.3])))]
@@ -105,9 +108,6 @@ def false_alarms(n_runs: int, first_seed: int) -> None:
 
 
 def speed(sim_s: float, md: str) -> None:
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    import report
-
     segs = [Segment(120), Segment(60, 3), Segment(120), Segment(60, -3), Segment(120)]
     states = aircraft_states(fly_profile(segs, dt_s=0.1))
     states = [s for s in states if s.t_s <= sim_s + 1e-9]
@@ -157,9 +157,6 @@ def montecarlo_table(dirs: list[str], md: str) -> None:
 
     import pandas as pd
 
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    import report
-
     ff_rows, f_rows, cmds = [], [], []
     for d in dirs:
         run = json.loads((Path(d) / "run.json").read_text())
@@ -201,7 +198,7 @@ def montecarlo_table(dirs: list[str], md: str) -> None:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    sub = ap.add_subparsers(dest="what", required=True)
+    sub = ap.add_subparsers(dest="what")
     sub.add_parser("approach").add_argument("--seeds", type=int, default=10)
     sub.add_parser("faults").add_argument("--seeds", type=int, default=2)
     fa = sub.add_parser("false-alarms")
@@ -213,8 +210,17 @@ def main() -> None:
     mp = sub.add_parser("montecarlo")
     mp.add_argument("--from", dest="dirs", nargs="+", required=True)
     mp.add_argument("--md", default="montecarlo.md", help="docs/results table ('' to skip)")
+    report.add_quick(ap, "without a subcommand: one approach, two faults, a 5-min fault-free "
+                         "run and the speed over 60 s simulated")
     a = ap.parse_args()
-    if a.what == "montecarlo":
+    if a.what is None:
+        if not a.quick:
+            ap.error("a subcommand is required (or --quick)")
+        approach(1)
+        faults(1, FAULTS[:2])
+        false_alarms(1, 200, duration_s=300.0)
+        speed(60.0, "ins_gnss_speed.md")
+    elif a.what == "montecarlo":
         montecarlo_table(a.dirs, a.md)
     elif a.what == "speed":
         speed(a.sim_s, a.md)

@@ -93,7 +93,10 @@ def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--duration", type=float, default=600.0)
+    report.add_quick(ap, "2 seeds of 200 s")
     a = ap.parse_args()
+    if a.quick:
+        a.seeds, a.duration = 2, 200.0
     rows = []
     for seed in range(a.seeds):
         with tempfile.TemporaryDirectory() as d:

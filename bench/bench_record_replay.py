@@ -11,11 +11,16 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+import sys
+
 import numpy as np
 
 from fms_testbed.cli.nav_replay import replay_files
-from fms_testbed.core.earth import ellipsoidal_height_m, radii_m
+from fms_testbed.navigation.replay import solution_minus_flight
 from fms_testbed.run.api import run_scenario
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
 
 SCN = {"aircraft": "737", "duration_s": 400, "hold": True, "vertical_law": "coupled",
        "initial": {"lat_deg": 47.0, "lon_deg": 8.0, "alt_m": 3000, "tas_kmh": 400,
@@ -30,28 +35,18 @@ SCN = {"aircraft": "737", "duration_s": 400, "hold": True, "vertical_law": "coup
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--out", default="/tmp/record-replay")
-    out = Path(ap.parse_args().out)
-    res = run_scenario(SCN, progress=None)
+    report.add_quick(ap, "120 s of the flight")
+    a = ap.parse_args()
+    out = Path(a.out)
+    res = run_scenario({**SCN, "duration_s": 120} if a.quick else SCN, progress=None)
     res.save(out, plots=False, overwrite=True)
     s = out / "sensors"
     rp = replay_files(s / "imu.parquet", s / "gnss.parquet", s / "init.json", s / "truth.parquet")
-    sol = rp["solution"].set_index("t_s")
-    fl = res.to_pandas().drop_duplicates("t_s").set_index("t_s")
-    t = np.array([x for x in sol.index if np.min(np.abs(fl.index - x)) < 1e-6])
-    f = fl.iloc[[int(np.argmin(np.abs(fl.index - x))) for x in t]]
-    lat = np.radians(f.nav_lat_deg.to_numpy())
-    rm, rn = radii_m(lat)
-    dn = np.radians(sol.loc[t, "nav_lat_deg"].to_numpy() - f.nav_lat_deg.to_numpy()) * rm
-    de = np.radians(sol.loc[t, "nav_lon_deg"].to_numpy() - f.nav_lon_deg.to_numpy()) * rn * \
-        np.cos(lat)
-    dh = sol.loc[t, "nav_alt_m"].to_numpy() - np.array(
-        [ellipsoidal_height_m(a, b) for a, b in zip(lat, f.nav_alt_m.to_numpy())])
-    a = np.abs((sol.loc[t, "nav_heading_deg"].to_numpy() - f.nav_heading_deg.to_numpy() + 180)
-               % 360 - 180)
-    h = np.hypot(dn, de)
-    print(f"replay - flight over {len(t)} steps: horizontal max {h.max():.4f} m (95 % "
-          f"{np.percentile(h, 95):.4f} m), height max {np.abs(dh).max():.4f} m, heading median "
-          f"{np.median(a):.5f} deg, max {a.max():.4f} deg at t = {t[np.argmax(a)]:.1f} s; "
+    d = solution_minus_flight(rp["solution"], res.to_pandas())
+    h, dh, a = d.d_horizontal_m, d.d_alt_m.abs(), d.d_heading_deg.abs()
+    print(f"replay - flight over {len(d)} steps: horizontal max {h.max():.4f} m (95 % "
+          f"{np.percentile(h, 95):.4f} m), height max {dh.max():.4f} m, heading median "
+          f"{a.median():.5f} deg, max {a.max():.4f} deg at t = {d.t_s[a.idxmax()]:.1f} s; "
           f"replay vs truth horizontal 95 % {rp['stats']['horizontal_m']['p95']:.2f} m")
 
 

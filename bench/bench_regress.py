@@ -101,7 +101,10 @@ def main() -> None:
     ap.add_argument("--airports", nargs="+", default=["KBFI", "KDLS", "KENV", "PASD"])
     ap.add_argument("--db", default=str(report.CIFP), help="file for the index timing")
     ap.add_argument("--md", default="regress.md", help="table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "one run pair over one airport")
     args = ap.parse_args()
+    if args.quick:
+        args.pairs, args.airports = 1, args.airports[:1]
     os.environ.setdefault("FMS_TESTBED_CACHE", tempfile.mkdtemp(prefix="bench-index-"))
     runs = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -186,7 +186,10 @@ def main() -> int:
     ap.add_argument("--skip-jsbsim", action="store_true")
     ap.add_argument("--md", default="sins_speed.md",
                     help="Markdown table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "10 Monte-Carlo realisations of 10 min, 60 s closed loops")
     args = ap.parse_args()
+    if args.quick:
+        args.n, args.mc_duration_s, args.sim_s = 10, 600.0, 60.0
     imu = load_imu(args.imu)
 
     d = bench_discretisation(imu)

@@ -30,6 +30,7 @@ def main() -> int:
     ap.add_argument("--out", help="working folder (default: a temporary one)")
     ap.add_argument("--workers", type=int, default=1, help="local workers (default 1)")
     ap.add_argument("--md", default="testdb.md", help="table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "the first 6 cases of the test database")
     args = ap.parse_args()
 
     from fms_testbed.campaign.manifest import PHASE1_MAX_RATE, check_run
@@ -42,7 +43,8 @@ def main() -> int:
     run = work / "run"
     report.run_cli(["regress", "testdb", "--out", str(db)], expect=db)
     _, wall, out = report.run_cli(["regress", "run", "--db", str(db), "--workers",
-                                   str(args.workers), "--no-progress", "--out", str(run)])
+                                   str(args.workers), "--no-progress", "--out", str(run),
+                                   *(["--limit", "6"] if args.quick else [])])
     print(out.strip())
     info = read_run_json(run)
     df = read_flights(run)

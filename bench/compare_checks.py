@@ -38,13 +38,31 @@ def compare(before: pd.DataFrame, after: pd.DataFrame) -> dict:
             "length_nm": float((m["length_nm_a"] - m["length_nm_b"]).abs().max())}
 
 
+def _quick_pair() -> tuple[str, str]:
+    """Two ``procedures check`` runs of KDLS on the FAA cycle beside the repository, in a
+    temporary folder (the quick mode's inputs)."""
+    import tempfile
+
+    tmp = Path(tempfile.mkdtemp(prefix="compare-checks-"))
+    for name in ("before", "after"):
+        report.run_cli(["procedures", "check", "--db", str(report.CIFP), "--airports", "KDLS",
+                        "--no-progress", "--out", str(tmp / name)],
+                       expect=tmp / name / "procedures_check.parquet", ok_codes=(0, 1))
+    return str(tmp / "before"), str(tmp / "after")
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("before")
-    ap.add_argument("after")
+    ap.add_argument("before", nargs="?")
+    ap.add_argument("after", nargs="?")
     ap.add_argument("--what", default="", help="what changed between the two runs")
     ap.add_argument("--md", default="procedures_refactor.md")
+    report.add_quick(ap, "check one airport twice (the same code: no difference) and compare")
     a = ap.parse_args(argv)
+    if a.quick:
+        a.before, a.after = _quick_pair()
+    elif not (a.before and a.after):
+        ap.error("BEFORE_DIR and AFTER_DIR are required (or --quick)")
     before = pd.read_parquet(Path(a.before) / "procedures_check.parquet")
     after = pd.read_parquet(Path(a.after) / "procedures_check.parquet")
     report.refuse_degenerate(before["status"].value_counts().to_dict(), what=a.before)

@@ -24,8 +24,11 @@ import tempfile
 import time
 from pathlib import Path
 
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
 ROOT = Path(__file__).resolve().parents[1]
-FIG = ROOT / "docs" / "figures"
+FIG = report.FIGURES
 SCN = ROOT / "scenarios"
 
 FIGURES: list[tuple[str, list[str], str]] = [
@@ -89,7 +92,10 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--only", nargs="+", help="figures to make (path under docs/figures or stem)")
     ap.add_argument("--list", action="store_true", help="list the figures and their commands")
+    report.add_quick(ap, "the two `procedures build` figures only")
     a = ap.parse_args()
+    if a.quick:
+        a.only = ["pafa-rf", "pabe-missed"]
     if a.list:
         for dest, cmd, png in FIGURES:
             print(f"{dest}: fms-testbed {' '.join(cmd)} --out DIR  ({png})")

@@ -319,7 +319,11 @@ def main() -> None:
     ap.add_argument("--conditions", default=",".join(CONDITIONS))
     ap.add_argument("--out", default="results/flight_table")
     ap.add_argument("--md", default="flight_table.md", help="report in docs/results/ ('' none)")
+    report.add_quick(ap, "6 procedures, calm and wind, a 2-procedure aircraft sample")
     args = ap.parse_args()
+    if args.quick:
+        args.max, args.sample = 6, 2
+        args.out = str(report.RESULTS / "flight_table")
     if not Path(args.db).exists():
         raise SystemExit(f"{args.db}: no such ARINC-424 file (give --db)")
     from fms_testbed.procedures.database import load_database

@@ -113,7 +113,11 @@ def main() -> None:
     ap.add_argument("--out", default="results/fly_table", help="folder for table.json")
     ap.add_argument("--md", default="fly_table.md",
                     help="Markdown table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "3 procedures")
     args = ap.parse_args()
+    if args.quick:
+        args.max = 3
+        args.out = str(report.RESULTS / "fly_table")
     if not Path(args.db).exists():
         raise SystemExit(f"{args.db}: no such ARINC-424 file (give --db)")
     logging.basicConfig(level=logging.WARNING)

@@ -38,7 +38,7 @@ from fms_testbed.campaign.store import read_flights, read_run_json  # noqa: E402
 
 FTE95_GOAL_M = 150.0
 FTE_MAX_GOAL_M = 185.2
-FIGURES = report.REPO / "docs" / "figures" / "regression"
+FIGURES = report.FIGURES / "regression"
 
 
 def _pct(k: int, n: int) -> str:
@@ -148,6 +148,19 @@ def diff_section(calm: Path, wind: Path) -> str:
     return "\n".join(out)
 
 
+def _quick_runs() -> tuple[Path, Path]:
+    """The quick mode's two runs: KDLS of the FAA cycle beside the repository, calm and in a
+    30 kt wind from 270°, in a temporary folder."""
+    import tempfile
+
+    tmp = Path(tempfile.mkdtemp(prefix="integration-page-"))
+    for name, wind in (("calm", []), ("wind", ["--wind", "270/30"])):
+        report.run_cli(["regress", "run", "--db", str(report.CIFP), "--airports", "KDLS",
+                        *wind, "--workers", "2", "--no-progress", "--out", str(tmp / name)],
+                       expect=tmp / name / "run.json", ok_codes=(0, 1))
+    return tmp / "calm", tmp / "wind"
+
+
 def main(argv=None) -> int:
     p = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     p.add_argument("--calm", type=Path, default=report.REPO / "results" / "integration")
@@ -156,7 +169,11 @@ def main(argv=None) -> int:
                    help="the commit the runs were flown with (stated on the page)")
     p.add_argument("--md", default="integration.md")
     p.add_argument("--figures", type=Path, default=FIGURES)
+    report.add_quick(ap=p, what="fly KDLS calm and in a 30 kt wind (regress run) and write "
+                                "the page from those runs")
     a = p.parse_args(argv)
+    if a.quick:
+        a.calm, a.wind = _quick_runs()
 
     calm_sum, calm = run_summary(a.calm)
     runs = [("calm", a.calm, calm_sum, calm)]

@@ -18,9 +18,22 @@ from pathlib import Path
 from typing import Iterable, Sequence
 
 REPO = Path(__file__).resolve().parents[1]
-RESULTS = REPO / "docs" / "results"
+#: where the pages go: ``docs/results/``, or the folder in ``$FMS_BENCH_RESULTS`` (the quick-mode
+#: test points it at a temporary folder, so a quick run never overwrites a published page)
+RESULTS = Path(os.environ.get("FMS_BENCH_RESULTS") or REPO / "docs" / "results")
+#: where the reference figures go: ``docs/figures/``, or ``$FMS_BENCH_FIGURES``
+FIGURES = Path(os.environ.get("FMS_BENCH_FIGURES") or REPO / "docs" / "figures")
 #: the FAA CIFP beside the repository (``../shared/data/cifp``); every CIFP bench defaults to it
 CIFP = REPO.parent / "shared" / "data" / "cifp" / "FAACIFP18_230126"
+
+
+def add_quick(ap, what: str) -> None:
+    """Add ``--quick`` to a bench's parser: the smallest run that exercises every code path of
+    the bench and writes its page(s) (``what``: what the quick run does, for the help text).
+    Quick figures are not the published ones: run it with ``$FMS_BENCH_RESULTS`` pointing
+    elsewhere (``tests/bench/test_benches_quick.py`` does)."""
+    ap.add_argument("--quick", action="store_true",
+                    help=f"quick mode, a smoke run of the bench: {what}")
 
 
 def machine() -> str:

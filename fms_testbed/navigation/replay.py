@@ -20,7 +20,7 @@ import numpy as np
 import pandas as pd
 from numba import njit
 
-from fms_testbed.core.earth import radii_m
+from fms_testbed.core.earth import ellipsoidal_height_m, radii_m
 from fms_testbed.core.state import NavSolution
 from fms_testbed.core.units import DPH_RPS, G0_MPS2
 from fms_testbed.navigation.ins_filter import FilterTuning, InsGnssFilter, _w_eb
@@ -286,6 +286,42 @@ def error_stats(err: pd.DataFrame, sol: pd.DataFrame) -> dict:
     return out
 
 
+def solution_minus_flight(sol: pd.DataFrame, flight: pd.DataFrame) -> pd.DataFrame:
+    """A replayed solution minus a flight's own navigation solution, at the replay's times that
+    the flight's log also holds (within 1 µs): ``t_s``, ``d_north_m``, ``d_east_m``,
+    ``d_horizontal_m``, ``d_alt_m``, ``d_heading_deg`` (wrapped to ±180°).
+
+    The flight log's ``nav_alt_m`` is JSBSim's sea-level height; the replay's is ellipsoidal
+    (WGS-84), so the flight's is converted (:func:`~fms_testbed.core.earth.ellipsoidal_height_m`)
+    before the difference. North/east are arcs on the meridian/prime-vertical radii at the
+    flight's latitude.
+
+    Parameters
+    ----------
+    sol : :meth:`Replay.run`'s table (``t_s``, ``nav_lat_deg``, ``nav_lon_deg``, ``nav_alt_m``,
+        ``nav_heading_deg``)
+    flight : the flight's log as a table (:meth:`Results.to_pandas`), same column names
+    """
+    s = sol.drop_duplicates("t_s").set_index("t_s")
+    fl = flight.drop_duplicates("t_s").set_index("t_s")
+    ft = fl.index.to_numpy()
+    j = np.clip(np.searchsorted(ft, s.index.to_numpy()), 1, len(ft) - 1)
+    j = np.where(np.abs(ft[j - 1] - s.index.to_numpy()) < np.abs(ft[j] - s.index.to_numpy()),
+                 j - 1, j)
+    same = np.abs(ft[j] - s.index.to_numpy()) < 1e-6
+    s, f = s[same], fl.iloc[j[same]]
+    lat = np.radians(f["nav_lat_deg"].to_numpy())
+    rm, rn = radii_m(lat)
+    d_n = np.radians(s["nav_lat_deg"].to_numpy() - f["nav_lat_deg"].to_numpy()) * rm
+    d_e = np.radians(s["nav_lon_deg"].to_numpy() - f["nav_lon_deg"].to_numpy()) * rn * np.cos(lat)
+    h = np.array([ellipsoidal_height_m(a, b) for a, b in zip(lat, f["nav_alt_m"].to_numpy())])
+    d_psi = (s["nav_heading_deg"].to_numpy() - f["nav_heading_deg"].to_numpy() + 180.0) \
+        % 360.0 - 180.0
+    return pd.DataFrame({"t_s": s.index.to_numpy(), "d_north_m": d_n, "d_east_m": d_e,
+                         "d_horizontal_m": np.hypot(d_n, d_e),
+                         "d_alt_m": s["nav_alt_m"].to_numpy() - h, "d_heading_deg": d_psi})
+
+
 __all__ = ["BIAS_COLS", "OUT_COLS", "Replay", "SIGMA_COLS", "error_stats", "error_table",
            "euler_sigma_rad", "initial_covariance", "initial_row", "mechanise_span",
-           "row_solution"]
+           "row_solution", "solution_minus_flight"]

@@ -12,7 +12,7 @@ import numpy as np
 import pytest
 
 from fms_testbed.cli.nav_replay import replay_files
-from fms_testbed.core.earth import ellipsoidal_height_m, radii_m
+from fms_testbed.navigation.replay import solution_minus_flight
 from fms_testbed.navigation import ins_filter, prediction
 from fms_testbed.run.api import run_scenario
 from tests.guidance.test_guidance_never_reads_truth import TruthRead, truth_poisoned
@@ -67,22 +67,10 @@ def test_a_recorded_flight_replays_to_its_own_solution(tmp_path):
     s = tmp_path / "flight" / "sensors"
     rp = replay_files(s / "imu.parquet", s / "gnss.parquet", s / "init.json", s / "truth.parquet")
     assert rp["summary"]["gnss_rejected"] == {"gnss_pos": 0, "gnss_vel": 0}
-    sol = rp["solution"].set_index("t_s")
-    fl = res.to_pandas().drop_duplicates("t_s").set_index("t_s")
-    t = [x for x in sol.index if np.min(np.abs(fl.index - x)) < 1e-6]
-    f = fl.iloc[[int(np.argmin(np.abs(fl.index - x))) for x in t]]
-    lat = np.radians(f.nav_lat_deg.to_numpy())
-    rm, rn = radii_m(lat)
-    dn = np.radians(sol.loc[t, "nav_lat_deg"].to_numpy() - f.nav_lat_deg.to_numpy()) * rm
-    de = np.radians(sol.loc[t, "nav_lon_deg"].to_numpy() - f.nav_lon_deg.to_numpy()) * rn * \
-        np.cos(lat)
-    dh = sol.loc[t, "nav_alt_m"].to_numpy() - np.array(
-        [ellipsoidal_height_m(a, b) for a, b in zip(lat, f.nav_alt_m.to_numpy())])
-    dpsi = (sol.loc[t, "nav_heading_deg"].to_numpy() - f.nav_heading_deg.to_numpy() + 180) \
-        % 360 - 180
-    assert len(t) > 1000
-    assert np.hypot(dn, de).max() < 0.05 and np.abs(dh).max() < 0.05
-    assert np.median(np.abs(dpsi)) < 0.005 and np.abs(dpsi).max() < 0.3
+    d = solution_minus_flight(rp["solution"], res.to_pandas())
+    assert len(d) > 1000
+    assert d.d_horizontal_m.max() < 0.05 and d.d_alt_m.abs().max() < 0.05
+    assert d.d_heading_deg.abs().median() < 0.005 and d.d_heading_deg.abs().max() < 0.3
     # and the flight's own NSE is metres: the agreement is not two copies of a broken filter
     assert math.isfinite(rp["stats"]["horizontal_m"]["p95"]) and \
         rp["stats"]["horizontal_m"]["p95"] < 5.0
