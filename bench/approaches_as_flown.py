@@ -25,7 +25,10 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-CIFP = Path("/work/shared/data/cifp/FAACIFP18_230126")
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
+CIFP = report.CIFP
 
 
 def rank(*parts) -> str:
@@ -228,9 +231,6 @@ def main(argv=None) -> int:
         lines += [f"- {r['airport']} {r['procedure']} {r['transition'] or ''}: {r['refused']}"
                   for r in refused]
         lines.append("")
-    sys.path.insert(0, str(Path(__file__).resolve().parent))
-    import report
-
     report.write(a.md, "\n".join(lines), note=note)
     if a.json:
         Path(a.json).write_text(json.dumps({"rows": rows, "missed": missed,

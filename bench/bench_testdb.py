@@ -87,8 +87,9 @@ def main() -> int:
         what = r["why not"] if r["agrees"] != "yes" else r["reason / findings"]
         what = (what or "").replace("\n", " ")
         what = what if len(what) <= 160 else what[:157] + "…"
+        flew = isinstance(r["status"], str)           # a case outside --limit has no row
         per.append((r["procedure"], r["coding"], r["legs"], r["expected"],
-                    f"{r['status']} / {r['monitor']}", r["agrees"], what))
+                    f"{r['status']} / {r['monitor']}" if flew else "not flown", r["agrees"], what))
     body.append(report.table(("procedure", "coding", "legs flown", "expected",
                               "status / monitor", "agrees", "why not / what it said"), per))
     note = ("Phase 1 of Danilin's method (seed 000): the synthesised test database "

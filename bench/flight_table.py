@@ -323,7 +323,7 @@ def main() -> None:
     args = ap.parse_args()
     if args.quick:
         args.max, args.sample = 6, 2
-        args.out = str(report.RESULTS / "flight_table")
+        args.out = "results/quick/flight_table"
     if not Path(args.db).exists():
         raise SystemExit(f"{args.db}: no such ARINC-424 file (give --db)")
     from fms_testbed.procedures.database import load_database

@@ -117,7 +117,7 @@ def main() -> None:
     args = ap.parse_args()
     if args.quick:
         args.max = 3
-        args.out = str(report.RESULTS / "fly_table")
+        args.out = "results/quick/fly_table"
     if not Path(args.db).exists():
         raise SystemExit(f"{args.db}: no such ARINC-424 file (give --db)")
     logging.basicConfig(level=logging.WARNING)

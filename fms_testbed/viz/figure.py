@@ -26,9 +26,10 @@ def save(fig: Figure, path: str | Path, dpi: int = 110) -> Path:
     Parameters
     ----------
     fig : the figure
-    path : the file to write
+    path : the file to write (its folder is made if missing)
     dpi : resolution, dots per inch
     """
     path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=dpi)
     return path
