@@ -22,8 +22,10 @@ streams: realisation i of seed s draws from SeedSequence([s, i])) with the defau
 tuning: every isolation, exclusion and GNSS/baro naming; writes
 ``docs/results/fdi_false_alarms.md``.
 
-``--quick``: the three in turn at the sizes of :data:`QUICK` (one fault of each source in the
-table, a few one-hour realisations in the other two), every page written.
+``--run-s`` (calibrate, false-alarms): realisations of that length instead of an hour (the
+rates per hour become chances per realisation in proportion). ``--quick``: the three in turn at
+the sizes of :data:`QUICK` (one fault of each source in the table, a few 300 s realisations in
+the other two), every page written.
 """
 
 from __future__ import annotations
