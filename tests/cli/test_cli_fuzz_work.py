@@ -12,7 +12,8 @@ The draw: run ``k`` fuzzes command ``k mod C`` (C the parser's commands, in the 
 ``random.Random(k)`` picks the option and the value — so every command gets ``N / C`` runs and
 any run is reproduced from its seed (printed on failure). The default suite checks the draw and
 runs :data:`QUICK_SEEDS`; ``pytest -m slow`` runs ``FUZZ_WORK_N`` runs (default 3 per command)
-over ``FUZZ_WORK_JOBS`` processes (default 2); ``FUZZ_WORK_REPORT=FILE`` writes the counts.
+from seed ``FUZZ_WORK_SEED0`` (default 0) over ``FUZZ_WORK_JOBS`` processes (default 2);
+``FUZZ_WORK_REPORT=FILE`` writes the counts.
 """
 
 from __future__ import annotations
@@ -196,10 +197,11 @@ def test_fuzz_work_quick(tmp_path, regress_case):
 def test_fuzz_work(tmp_path, regress_case):
     n = int(os.environ.get("FUZZ_WORK_N", 3 * len(BASES)))
     jobs = int(os.environ.get("FUZZ_WORK_JOBS", 2))
+    seed0 = int(os.environ.get("FUZZ_WORK_SEED0", 0))
     t0 = time.monotonic()
-    outcomes, failures, by_cmd = fuzz(range(n), tmp_path, regress_case, jobs)
+    outcomes, failures, by_cmd = fuzz(range(seed0, seed0 + n), tmp_path, regress_case, jobs)
     if os.environ.get("FUZZ_WORK_REPORT"):
         Path(os.environ["FUZZ_WORK_REPORT"]).write_text(json.dumps(
-            {"runs": n, "jobs": jobs, "wall_s": round(time.monotonic() - t0), **outcomes,
+            {"runs": n, "seeds": [seed0, seed0 + n - 1], "jobs": jobs, "wall_s": round(time.monotonic() - t0), **outcomes,
              "commands": by_cmd, "failures": failures}, indent=1))
     assert not failures, "\n".join(failures)
