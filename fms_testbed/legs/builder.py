@@ -34,6 +34,8 @@ CF_FROM_FIX_TURN_MAX_DEG = 120.0
 """:data:`CF_FROM_FIX_DEG` applies to a fly-by turn onto the course; a sharper one (a course
 reversal over the fix, e.g. a missed approach coded back along the final) keeps the course
 join, so the monitor still sees the reversal."""
+CF_OFF_COURSE_DEG = 20.0
+"""A CF's own straight more than this off its coded course is not the coded leg, deg."""
 PARALLEL_TOL_M = 30.0
 """A turn from over a fix that ends closer than this to the coded course line out of the fix
 is left parallel to it; beyond, the line is rejoined with a 45° intercept, m."""

@@ -569,7 +569,8 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     tmp.climbing = False
     target = Fix(ident=seg.fix_ident, region="", section="", lat_deg=end[0], lon_deg=end[1])
     state = FlightState(lat, lon, a.geom.end_course_deg, 0.0, flyby=False)
-    join_course(tmp, state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
+    join_course(tmp, state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False,
+                course_leg=LEG_TYPES[seg.path_term].course_to_fix)
     if depth == 0:
         segs = round_corners(tmp, b.perf, b.params, math.degrees(math.atan(
             (v_turn + b.wind_mps) ** 2 / (r * b.g))), depth=1)
