@@ -22,7 +22,7 @@ from fms_testbed.core.geodesy import direct, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line, turn_angle_deg
 from fms_testbed.core.units import KT_MPS, NM_M
 from fms_testbed.legs.builder import (CF_FROM_FIX_DEG, CF_FROM_FIX_TURN_MAX_DEG, CF_OFF_COURSE_DEG,
-                                      CLOSE_S,
+                                      CLOSE_S, DECEL_PLAN_MPS2,
                                       DIRECT_XTK_M, PARALLEL_TOL_M, LegBuilder,
                                       intercept_angle_deg)
 from fms_testbed.legs.construct import (_foot, direct_to_arc, ray_geodesic_intersection,
@@ -320,12 +320,14 @@ def direct_no_room(b: LegBuilder, state: FlightState, fix: Fix, direction: str |
 
     Any leg but a CF (a TF joined away from its first fix) flies direct to the fix, and an
     'info' finding says its track is not flown. A leg whose path is the course (CF:
-    ``course_deg`` given, deg true) flies direct only when the direct line's straight is
-    within :data:`~.builder.CF_OFF_COURSE_DEG` of the course; else it joins the course at the
-    aircraft's minimum speed at the bank limit (:func:`min_speed_radius`; branch V,γ, a
-    correction) when that radius leaves room; else the coded course cannot be flown before
-    the fix and the leg is 'impossible' with the reason (the direct line to the fix is kept
-    as its geometry)."""
+    ``course_deg`` given, deg true) flies direct when the direct line's straight is within
+    :data:`~.builder.CF_OFF_COURSE_DEG` of the course, or when the path behind is shorter than
+    the distance to slow to the minimum speed, (V² − V_min²) / (2 a) with a
+    :data:`~.builder.DECEL_PLAN_MPS2` (the monitor then reports the course not flown); else
+    it joins the course at the aircraft's minimum speed at the bank limit
+    (:func:`min_speed_radius`; branch V,γ, a correction) when that radius leaves room; else
+    the coded course cannot be flown before the fix and the leg is 'impossible' with the
+    reason (the direct line to the fix is kept as its geometry)."""
     why = (f"no room to join the course into {fix.ident} at the planned radius "
            f"{b.radius_m:.0f} m: flown direct to the fix")
     if course_deg is None:
@@ -341,6 +343,16 @@ def direct_no_room(b: LegBuilder, state: FlightState, fix: Fix, direction: str |
         b.finding("info", why)
         return st
     v_min, r_min = min_speed_radius(b, state.alt_m)
+    flown = b.flown_before_m + sum(sg.geom.length_m() for sg in b.segments)
+    slow_m = max(b.speed_mps ** 2 - v_min ** 2, 0.0) / (2.0 * DECEL_PLAN_MPS2)
+    if flown < slow_m:
+        # no distance behind to slow down in (a SID just after the runway): flown direct,
+        # the monitor reports the coded course not flown
+        commit(b, t)
+        b.finding("info", f"{why} (no room to slow to the minimum speed "
+                  f"{v_min / KT_MPS:.0f} kt: {slow_m / NM_M:.1f} NM needed, "
+                  f"{flown / NM_M:.1f} NM flown)")
+        return st
     if r_min < 0.99 * b.radius_m:
         t = trial(b)
         t.speed_mps, t.radius_m = min(t.speed_mps, v_min), r_min
