@@ -49,6 +49,7 @@ def markdown(summary: dict, table: pd.DataFrame, cmd: str, wall_s: float) -> str
              ["class 3 (database coding) found", f"{summary['class3_transitions']:,}"],
              ["highest planned altitude, TAS",
               f"{table['max_plan_alt_ft'].max():,.0f} ft, {table['max_plan_tas_kt'].max():.0f} kt"],
+             *path_rows(table),
              ["wall time, workers", f"{wall_s:.1f} s, {summary['workers']}"]]
     legs = [[pt, f"{v['coded']:,}", f"{v['built']:,}"]
             for pt, v in summary["by_leg_type"].items() if v["coded"]]
@@ -67,6 +68,23 @@ def markdown(summary: dict, table: pd.DataFrame, cmd: str, wall_s: float) -> str
            f"**Impossible transitions ({len(imp)})**, each with its last finding\n",
            report.table(["transition", "reason"], imp_rows)]
     return "\n".join(out)
+
+
+def path_rows(table: pd.DataFrame) -> list[list[str]]:
+    """Counts from the findings: CF legs off their coded course in transitions that are not
+    impossible, CF legs whose course cannot be flown, CF courses joined at the minimum speed,
+    holds built off their coded distance/time by more than the tolerance."""
+    f = table["findings"].astype(str)
+    live = table["status"] != "impossible"
+    off = f.str.contains(r"CF \S* built \d+° off", regex=True)
+    return [["CF legs built > 20° off their coded course (transitions not impossible)",
+             f"{int((off & live).sum())}"],
+            ["CF legs whose coded course cannot be flown (impossible, with the reason)",
+             f"{int(f.str.count('the coded course cannot be flown').sum())}"],
+            ["CF courses joined at the minimum speed (branch V,γ)",
+             f"{int(f.str.count('joined at the minimum speed').sum())}"],
+            ["holds built off their coded distance or time by > 0.1 NM",
+             f"{int(f.str.count('hold_length:').sum())}"]]
 
 
 def main(argv=None) -> int:
