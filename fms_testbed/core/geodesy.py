@@ -14,7 +14,7 @@ import math
 
 from geographiclib.geodesic import Geodesic
 
-from fms_testbed.core.earth import normal_gravity_mps2
+from fms_testbed.core.earth import normal_gravity_and_gradient
 from fms_testbed.core.vincenty import vincenty_direct, vincenty_inverse
 
 WGS84 = Geodesic.WGS84
@@ -56,7 +56,8 @@ def gravity_mps2(lat_deg: float, alt_m: float = 0.0) -> float:
     """Normal gravity of WGS-84, m/s², at geodetic latitude ``lat_deg`` (deg) and height ``alt_m``
     (m, default on the ellipsoid): :func:`fms_testbed.core.earth.normal_gravity_mps2` (TR8350.2
     eq. 4-1, 4-3) in the degree convention of this module."""
-    return float(normal_gravity_mps2(math.radians(lat_deg), float(alt_m)))
+    # the kernel's Python body: one scalar call needs no compilation (or cache load) of numba
+    return float(normal_gravity_and_gradient.py_func(math.radians(lat_deg), float(alt_m))[0])
 
 
 def wrap180(a_deg: float) -> float:

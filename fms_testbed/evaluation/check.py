@@ -220,10 +220,8 @@ def _init_worker(db_path: str, perf: Performance, params: BuildParams) -> None:
 
 
 def _share_with_workers(db: Database) -> None:
-    """Leave the parent's loaded database (and the compiled gravity kernel, called once) where
-    forked workers find them: they start without loading the index again, or the kernel's
-    cache. Spawned workers (another start method) load their own."""
-    gravity_mps2(45.0)
+    """Leave the parent's loaded database where forked workers find it: they start without
+    loading the index again. Spawned workers (another start method) load their own."""
     _WORKER["db"] = db
     _WORKER["db_path"] = str(db.path)
 
