@@ -40,9 +40,9 @@ def test_every_runnable_bench_is_listed_and_the_rest_are_helpers():
 
 
 NOT_YET = {"bench_check.py", "bench_cli_fuzz.py", "bench_closed_loop.py", "bench_coding.py",
-           "bench_detection.py", "bench_ins_gnss_truth.py", "bench_procedures.py",
+           "bench_detection.py", "bench_procedures.py",
            "bench_refdesc.py", "bench_strapdown.py", "bench_tune.py", "bench_tune_campaign.py",
-           "flight_test_attitude.py"}
+           }
 """Benches without ``--quick`` yet (the list only shrinks)."""
 
 
