@@ -5,7 +5,9 @@ codes, how many reached the work, the wall time, the runs per command, and every
 is the goal: no traceback, exit codes 0/1/2, a 2 on one line, no hang, no folder that looks
 complete when the run failed).
 
-    python bench/bench_cli_fuzz.py [--md cli_fuzz.md]
+    python bench/bench_cli_fuzz.py [--md cli_fuzz.md] [--quick]
+
+``--quick``: the default suite's small fuzz (``test_cli_fuzz_small``) instead of the large one.
 """
 
 from __future__ import annotations
@@ -19,17 +21,21 @@ import tempfile
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
 from report import REPO, refuse_degenerate, table, write  # noqa: E402
 
+TESTS = {False: ("-m", "slow", "tests/cli/test_cli_fuzz.py::test_cli_fuzz_large"),
+         True: ("tests/cli/test_cli_fuzz.py::test_cli_fuzz_small",)}
+"""The pytest arguments of the large fuzz and of the small one (``--quick``)."""
 
-def run_fuzz() -> dict:
-    """Run the large fuzz test in a subprocess; its JSON report."""
+
+def run_fuzz(quick: bool = False) -> dict:
+    """Run the large fuzz test (``quick``: the small one) in a subprocess; its JSON report."""
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp) / "fuzz.json"
         env = {**os.environ, "FUZZ_REPORT": str(out),
                "PYTHONPATH": os.pathsep.join([str(REPO), os.environ.get("PYTHONPATH", "")])}
-        res = subprocess.run([sys.executable, "-m", "pytest", "-q", "-m", "slow",
-                              "tests/cli/test_cli_fuzz.py::test_cli_fuzz_large"],
+        res = subprocess.run([sys.executable, "-m", "pytest", "-q", *TESTS[quick]],
                              cwd=REPO, env=env, capture_output=True, text=True)
         if not out.exists():
             raise SystemExit(f"the fuzz wrote no report:\n{res.stdout[-2000:]}")
@@ -56,8 +62,9 @@ def page(r: dict) -> str:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--md", default="cli_fuzz.md", help="results file (default cli_fuzz.md)")
+    report.add_quick(ap, "the small fuzz of the default suite")
     args = ap.parse_args()
-    r = run_fuzz()
+    r = run_fuzz(args.quick)
     refuse_degenerate({k: r.get(k, 0) for k in ("rc0", "rc1", "rc2", "work", "FAILED")},
                       what="cli fuzz", bad=("FAILED",))
     write(args.md, page(r))

@@ -13,10 +13,11 @@ file's inner-loop rate (60 Hz, ``frames_per_update: 2``) and, for reference, at 
 60 Hz flying on the ``ins_gnss`` source with three INS (STIM300, two-stage identification) instead
 of the true state (issue 14's goal: closed loop with it ≥ 0.5 × bare JSBSim).
 
-    python bench/bench_closed_loop.py [--aircraft 737] [--sim-s 600] [--md closed_loop.md]
+    python bench/bench_closed_loop.py [--aircraft 737] [--sim-s 600] [--md closed_loop.md] [--quick]
 
 Prints the figures and writes them as a Markdown table to ``docs/results/closed_loop.md``
-(``--md ''``: do not write).
+(``--md ''``: do not write). ``--quick``: :data:`QUICK` (one 80 s flight per configuration,
+short warm-up, fewer floor repetitions): every stage runs, the ratios are not the published ones.
 """
 
 from __future__ import annotations
@@ -41,6 +42,9 @@ from fms_testbed.config.scenario import parse_scenario  # noqa: E402
 
 INS3 = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}
 """The navigation of the third configuration: three INS, GNSS, baro, two-stage identification."""
+QUICK = {"sim_s": 80.0, "repeat": 1, "warmup_s": 20.0, "floor_n": 2000}
+"""``--quick``: simulated s per flight (the turn and the start of the climb), flights per
+configuration, simulated s of each warm-up flight, calls per floor repetition."""
 
 
 def bench_scenario(aircraft: str, alt_m: float, tas_mps: float, sim_s: float) -> dict:
@@ -52,9 +56,9 @@ def bench_scenario(aircraft: str, alt_m: float, tas_mps: float, sim_s: float) ->
                        {"t_s": 200, "heading_deg": 90}]}
 
 
-def python_floor_us(cfg, scn: dict) -> dict[str, float]:
-    """Process time of the Python work no outer step can skip (µs, best of 5 × 20,000): the 37
-    property reads the log needs, the true state, the coupled law, the three inner-loop
+def python_floor_us(cfg, scn: dict, n: int = 20000) -> dict[str, float]:
+    """Process time of the Python work no outer step can skip (µs, best of 5 × ``n`` calls):
+    the 37 property reads the log needs, the true state, the coupled law, the three inner-loop
     commands."""
     import time
 
@@ -71,9 +75,9 @@ def python_floor_us(cfg, scn: dict) -> dict[str, float]:
         best = 1e9
         for _ in range(5):
             t0 = time.process_time()
-            for _ in range(20000):
+            for _ in range(n):
                 fn()
-            best = min(best, (time.process_time() - t0) / 20000)
+            best = min(best, (time.process_time() - t0) / n)
         out[name] = 1e6 * best
     return out
 
@@ -95,7 +99,12 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3, help="interleaved flights per configuration")
     ap.add_argument("--md", default="closed_loop.md",
                     help="Markdown table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "one 80 s flight per configuration, a 20 s warm-up")
     args = ap.parse_args()
+    warmup_s, floor_n, ceiling_s = 60.0, 20000, 300.0
+    if args.quick:
+        args.sim_s, args.repeat = QUICK["sim_s"], QUICK["repeat"]
+        warmup_s, floor_n, ceiling_s = QUICK["warmup_s"], QUICK["floor_n"], QUICK["sim_s"]
     logging.basicConfig(level=logging.WARNING)
     load = ", ".join(f"{x:.2f}" for x in os.getloadavg())
     cfg = load_aircraft(args.aircraft)
@@ -108,15 +117,15 @@ def main() -> None:
     nav = {"navigation": INS3}
     # warm-up (imports, first JSBSim load, caches): a short flight of each, not measured
     for c in (cfg, cfg120):
-        measure(c, bench_scenario(args.aircraft, pt.alt_m, pt.tas_mps, 60.0), args.chunk_s)
-    measure(cfg, {**bench_scenario(args.aircraft, pt.alt_m, pt.tas_mps, 60.0), **nav},
+        measure(c, bench_scenario(args.aircraft, pt.alt_m, pt.tas_mps, warmup_s), args.chunk_s)
+    measure(cfg, {**bench_scenario(args.aircraft, pt.alt_m, pt.tas_mps, warmup_s), **nav},
             args.chunk_s)
     for _ in range(args.repeat):
         runs["default"].append(measure(cfg, scn, args.chunk_s))
         runs["120"].append(measure(cfg120, scn, args.chunk_s))
         runs["ins3"].append(measure(cfg, {**scn, **nav}, args.chunk_s))
-    ceil = [system_only_ratio(Flight(parse_scenario(scn), cfg=cfg, progress=False), cfg)
-            for _ in range(args.repeat)]
+    ceil = [system_only_ratio(Flight(parse_scenario(scn), cfg=cfg, progress=False), cfg,
+                              ceiling_s) for _ in range(args.repeat)]
     res = run_scenario(scn, progress=False)
     whole = res.summary["duration_s"] / DT_S / res.summary["wall_time_s"]
     print(f"aircraft {args.aircraft}, {args.sim_s:.0f} s simulated at 120 Hz, outer loop "
@@ -141,7 +150,7 @@ def main() -> None:
     py_us = [1e6 * n_frames * (1.0 / m["closed_fps"] - 1.0 / (m["bare_fps"] * c_med))
              for m in runs["default"]]
     print(f"Python per outer step (default): median {statistics.median(py_us):.1f} us")
-    floor = python_floor_us(cfg, scn)
+    floor = python_floor_us(cfg, scn, floor_n)
     print("Python no outer step can skip: " + ", ".join(f"{k} {v:.2f}" for k, v in floor.items())
           + f" = {sum(floor.values()):.1f} us")
     b = statistics.median(m["bare_fps"] for m in runs["default"])
@@ -165,8 +174,11 @@ def main() -> None:
     report.write(args.md, report.table(
         ["configuration", "ratio closed loop / bare JSBSim, each flight", "median",
          "bare JSBSim frames/s", "goal"], rows),
-        note=f"{args.aircraft}, {args.sim_s:.0f} s simulated per flight (hold, 90° turn, 300 m "
-             f"climb, turn back; a short unmeasured warm-up flight first), JSBSim at 120 Hz, heading hold and coupled law at "
+        note=f"{args.aircraft}, {args.sim_s:.0f} s simulated per flight ("
+             + ("quick run: hold, 90° turn, the start of the 300 m climb" if args.quick else
+                "hold, 90° turn, 300 m climb, turn back")
+             + f"; a {warmup_s:.0f} s unmeasured warm-up flight first), JSBSim at 120 Hz, "
+             f"heading hold and coupled law at "
              f"{scn.get('outer_rate_hz', 10)} Hz, logging at 10 Hz; each flight timed "
              f"interleaved with a bare JSBSim instance in {args.chunk_s:g} s chunks. Python work "
              f"per outer step at the default configuration, from the rates: median "

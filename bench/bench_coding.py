@@ -13,7 +13,10 @@ verdict (``--per-stratum`` transitions each) is listed for review with its large
 disagreement.
 
     python bench/bench_coding.py [--db FILE] [--run DIR] [--workers 2] [--seed 7]
-                                 [--per-stratum 5] [--md procedures_coding.md]
+                                 [--per-stratum 5] [--airports A B ...]
+                                 [--md procedures_coding.md] [--quick]
+
+``--quick``: only the airports of ``bench_check.QUICK_AIRPORTS`` (the whole file is still read).
 """
 
 from __future__ import annotations
@@ -30,6 +33,7 @@ import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report  # noqa: E402
+from bench_check import QUICK_AIRPORTS  # noqa: E402
 
 from fms_testbed.core.geodesy import inverse, wrap180, wrap360  # noqa: E402
 from fms_testbed.core.units import NM_M  # noqa: E402
@@ -196,9 +200,12 @@ def main(argv=None) -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--seed", type=int, default=7)
     ap.add_argument("--per-stratum", type=int, default=5)
-    ap.add_argument("--airports", nargs="*", default=None, help="only these (quick mode)")
+    ap.add_argument("--airports", nargs="*", default=None, help="only these airports")
     ap.add_argument("--md", default="procedures_coding.md")
+    report.add_quick(ap, "the airports " + " ".join(QUICK_AIRPORTS) + " only")
     a = ap.parse_args(argv)
+    if a.quick and not a.airports:
+        a.airports = QUICK_AIRPORTS
     import json
     tmp = None
     if a.run is None:

@@ -5,6 +5,7 @@ limits").
     python bench/bench_detection.py table [--seeds 20] [--workers 2]      # writes the table
     python bench/bench_detection.py calibrate [--runs 200] [--seed 1000]  # fault-free maxima
     python bench/bench_detection.py false-alarms [--runs 1000] [--seed 2000] [--workers 2]
+    python bench/bench_detection.py --quick                               # all three, small
 
 ``table``: each fault kind and size on INS 2 (GNSS and baro faults on those sensors) at
 t = 200 s of the ``manoeuvres`` profile, ``--seeds`` realisations of seed 0: median and worst
@@ -20,6 +21,11 @@ fit exceeds once in 1/(3e-4) hours per layer; writes ``docs/results/fdi_calibrat
 streams: realisation i of seed s draws from SeedSequence([s, i])) with the default (calibrated)
 tuning: every isolation, exclusion and GNSS/baro naming; writes
 ``docs/results/fdi_false_alarms.md``.
+
+``--run-s`` (calibrate, false-alarms): realisations of that length instead of an hour (the
+rates per hour become chances per realisation in proportion). ``--quick``: the three in turn at
+the sizes of :data:`QUICK` (one fault of each source in the table, a few 300 s realisations in
+the other two), every page written.
 """
 
 from __future__ import annotations
@@ -46,7 +52,6 @@ from fms_testbed.sensors.sins.presets import load_imu
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report  # noqa: E402
 
-RESULTS = Path(__file__).resolve().parents[1] / "docs" / "results"
 PAGES = ("fdi_calibration.md", "fdi_false_alarms.md", "detection_limits_without_drift.md",
          "detection_limits_drift.md", "detection_limits_cusum_step.md")
 """The docs/results pages this bench writes (``--only 'gyro drift'`` with and without
@@ -56,6 +61,19 @@ RATE_PER_H = 3e-3
 """The goal's false-alarm rate (zero in 1,000 one-hour flights: ≤ 3e-3/h at 95 %)."""
 FAULT_AT_S = 200.0
 DT_S = 0.1
+QUICK = {"table": {"seeds": 2, "after_s": 60.0,
+                   "rows": ("gyro step x 100 °/h", "GNSS ramp E 2 m/s", "baro step 20 m")},
+         "calibrate": {"runs": 4, "chunk": 4, "run_s": 300.0},
+         "false-alarms": {"runs": 2, "chunk": 1, "run_s": 300.0}}
+"""``--quick``: seeds, rows (one fault on an INS, on GNSS, on baro) and simulated s after the
+fault of the table; realisations, chunk and simulated s of each realisation of the calibration
+and false-alarm sets."""
+HOUR_S = 3600.0
+
+
+def _span(run_s: float) -> str:
+    """The length of a realisation, in words."""
+    return "one hour" if run_s == HOUR_S else f"{run_s:g} s"
 
 
 def _rows(imu):
@@ -137,6 +155,8 @@ def _tuning(args) -> FdiTuning:
 def _cli(args) -> str:
     """The non-default options, as typed."""
     out = f" --sensor-test {args.sensor_test}" if args.sensor_test else ""
+    run_s = getattr(args, "run_s", HOUR_S)
+    out += f" --run-s {run_s:g}" if run_s != HOUR_S else ""
     return out + (f" --cusum-h {args.cusum_h:g}" if args.cusum_h else "")
 
 
@@ -159,6 +179,9 @@ def table(args) -> None:
     for label, fault, gspec, tstar, source, after in _rows(imu):
         if args.only and (args.only in label) == args.exclude:
             continue
+        if args.quick and label not in QUICK["table"]["rows"]:
+            continue
+        after = getattr(args, "after_s", None) or after
         states = synthetic_states("manoeuvres", FAULT_AT_S + after)
         cfg = McConfig(fdi=_tuning(args)) if gspec is None else McConfig(gnss=gspec,
                                                                          fdi=_tuning(args))
@@ -173,10 +196,13 @@ def table(args) -> None:
                      f"{time.perf_counter() - t0:.0f} |")
         print(lines[-1], flush=True)
     part = "" if not args.only else ("_without_" if args.exclude else "_") + args.only.split()[-1]
-    out = RESULTS / f"detection_limits{_suffix(args)}{part}.md"
+    out = f"detection_limits{_suffix(args)}{part}.md"
+    rows = (f" (quick run: the rows {', '.join(QUICK['table']['rows'])}, each run ending "
+            f"{args.after_s:g} s after the fault)" if args.quick else "")
     head = (f"Seeds 0-{args.seeds - 1} of run seed 0, fault at t = {FAULT_AT_S:g} s of the "
             f"`manoeuvres` profile (`python bench/bench_detection.py table --seeds "
-            f"{args.seeds}{_cli(args)}{_rows_cli(args)}`); T* at {RATE_PER_H:g} false alarms per hour.\n\n")
+            f"{args.seeds}{_cli(args)}{_rows_cli(args)}`{rows}); T* at {RATE_PER_H:g} false "
+            "alarms per hour.\n\n")
     report.write(out, head + "\n".join(lines))
 
 
@@ -185,30 +211,33 @@ LAYERS = ("stage-1 output pair |Δ|/σ", "sensor-level |z|", "stage-2 |Z_i − �
 
 
 def calibrate(args) -> None:
-    states = synthetic_states("manoeuvres", 3600.0)
+    states = synthetic_states("manoeuvres", args.run_s)
     t0 = time.perf_counter()
     r = run_chunks(MonteCarlo(states, McConfig(fdi=_tuning(args)), seed=args.seed), args.runs,
                    args.chunk, workers=args.workers)
     per_layer = 3e-4
-    lines = ["| layer | max over the set | Gumbel (loc, scale) | threshold at "
-             f"{per_layer:g}/h |", "|---|---|---|---|"]
+    rows = []
     for j, name in enumerate(LAYERS):
         m = r.stat_max[:, j]
         loc, scale = gumbel_r.fit(m)
-        lines.append(f"| {name} | {m.max():.2f} | {loc:.2f}, {scale:.3f} | "
-                     f"{gumbel_r.isf(per_layer, loc, scale):.2f} |")
-        print(lines[-1], flush=True)
-    head = (f"Calibration set: realisations 0-{args.runs - 1} of seed {args.seed}, one hour of "
+        per_run = per_layer * args.run_s / HOUR_S       # the rate per hour as a chance per run
+        rows.append((name, f"{m.max():.2f}", f"{loc:.2f}, {scale:.3f}",
+                     f"{gumbel_r.isf(per_run, loc, scale):.2f}"))
+        print(rows[-1], flush=True)
+    lines = [report.table(("layer", "max over the set", "Gumbel (loc, scale)",
+                           f"threshold at {per_layer:g}/h"), rows)]
+    head = (f"Calibration set: realisations 0-{args.runs - 1} of seed {args.seed}, "
+            f"{_span(args.run_s)} of "
             f"the `manoeuvres` profile each (`python bench/bench_detection.py calibrate --runs "
             f"{args.runs} --seed {args.seed}{_cli(args)}`, {time.perf_counter() - t0:.0f} s "
             "wall).\n\n")
-    report.write(RESULTS / f"fdi_calibration{_suffix(args)}.md", head + "\n".join(lines))
+    report.write(f"fdi_calibration{_suffix(args)}.md", head + "\n".join(lines))
 
 
 def _fa_chunk(job):
     """One chunk of the false-alarm set (worker process)."""
-    seed, first, n, tuning = job
-    states = synthetic_states("manoeuvres", 3600.0)
+    seed, first, n, tuning, run_s = job
+    states = synthetic_states("manoeuvres", run_s)
     return run_chunks(MonteCarlo(states, McConfig(fdi=tuning), seed=seed), n, n, first=first)
 
 
@@ -218,7 +247,7 @@ def false_alarms(args) -> None:
     from concurrent.futures import ProcessPoolExecutor
 
     t0 = time.perf_counter()
-    jobs = [(args.seed, a, min(args.chunk, args.runs - a), _tuning(args))
+    jobs = [(args.seed, a, min(args.chunk, args.runs - a), _tuning(args), args.run_s)
             for a in range(0, args.runs, args.chunk)]
     done = []
     with ProcessPoolExecutor(max_workers=args.workers) as ex:
@@ -236,9 +265,9 @@ def _write_false_alarms(args, parts, wall_s) -> None:
     det = np.isfinite(r.t_detect_s)
     anyf = iso | exc | sens
     k = int(anyf.sum())
-    bound = chi2.ppf(0.95, 2 * k + 2) / 2 / n
+    bound = chi2.ppf(0.95, 2 * k + 2) / 2 / (n * args.run_s / HOUR_S)
     state = "" if n == args.runs else f" — interrupted: {n} of the {args.runs} realisations run"
-    text = (f"Disjoint set: realisations 0-{n - 1} of seed {args.seed}, one hour of the "
+    text = (f"Disjoint set: realisations 0-{n - 1} of seed {args.seed}, {_span(args.run_s)} of the "
             f"`manoeuvres` profile each, default tuning (`python bench/bench_detection.py "
             f"false-alarms --runs {args.runs} --seed {args.seed} --chunk {args.chunk} "
             f"--workers {args.workers}{_cli(args)}`, {wall_s:.0f} s wall{state}).\n\n"
@@ -248,13 +277,14 @@ def _write_false_alarms(args, parts, wall_s) -> None:
             f"{int(sens.sum())} | {k} | {bound:.2e} |\n")
     if k:
         text += f"\nRealisations with a false removal: {list(r.index[anyf])}\n"
-    report.write(RESULTS / f"fdi_false_alarms{_suffix(args)}.md", text)
+    report.write(f"fdi_false_alarms{_suffix(args)}.md", text)
     print(text, flush=True)
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    sub = ap.add_subparsers(dest="cmd", required=True)
+    report.add_quick(ap, "table, calibrate and false-alarms in turn at a few realisations each")
+    sub = ap.add_subparsers(dest="cmd")
     t = sub.add_parser("table")
     t.add_argument("--seeds", type=int, default=20)
     t.add_argument("--only", default=None, help="rows whose label contains this text")
@@ -267,11 +297,24 @@ def main() -> None:
         c.add_argument("--seed", type=int, default=seed)
         c.add_argument("--chunk", type=int, default=100)
         c.add_argument("--workers", type=int, default=1)
+        c.add_argument("--run-s", type=float, default=HOUR_S,
+                       help="simulated s of each realisation (default one hour)")
     for c in subs:
         c.add_argument("--sensor-test", choices=("window", "cusum"), default=None)
         c.add_argument("--cusum-h", type=float, default=None)
     args = ap.parse_args()
-    {"table": table, "calibrate": calibrate, "false-alarms": false_alarms}[args.cmd](args)
+    run = {"table": table, "calibrate": calibrate, "false-alarms": false_alarms}
+    if not args.quick:
+        if args.cmd is None:
+            ap.error("name the run: table, calibrate or false-alarms (or --quick)")
+        run[args.cmd](args)
+        return
+    for cmd in [args.cmd] if args.cmd else list(run):
+        one = args if cmd == args.cmd else ap.parse_args(["--quick", cmd])
+        for k, v in QUICK[cmd].items():
+            if k != "rows":
+                setattr(one, k, v)
+        run[cmd](one)
 
 
 if __name__ == "__main__":

@@ -2,7 +2,7 @@
 whole-cycle ``procedures check`` with 2 workers (the goal: ≤ 15 s wall).
 
     python bench/bench_procedures.py [--db FILE] [--aircraft 737] [--workers 2]
-                                     [--airports A B ...] [--md procedures_timing.md]
+                                     [--airports A B ...] [--md procedures_timing.md] [--quick]
 
 Prints the wall-clock times of (1) a bare read of the file (read + split into lines), (2) the
 load through the database index, (3) every airport's procedure transitions taken from it
@@ -11,7 +11,7 @@ on one core — wall and CPU time each — then (5)
 the wall time of ``fms-testbed procedures check --workers N`` (a subprocess: imports, the
 index load in every worker and the tables written included), all measured in this one run;
 writes them as a Markdown table to ``docs/results/procedures_timing.md`` (``--md ''``: do
-not). ``--airports``: only those (quick mode). A run whose transitions are all impossible, or
+not). ``--airports``: only those; ``--quick``: only ``bench_check.QUICK_AIRPORTS``. A run whose transitions are all impossible, or
 none, writes nothing (``report.refuse_degenerate``).
 """
 
@@ -25,6 +25,7 @@ from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report  # noqa: E402
+from bench_check import QUICK_AIRPORTS  # noqa: E402
 
 from fms_testbed.evaluation.check import check_airport, perf_for  # noqa: E402
 from fms_testbed.procedures.database import load_database  # noqa: E402
@@ -85,10 +86,13 @@ def main(argv=None) -> None:
     ap.add_argument("--db", default=str(DEFAULT), help="ARINC-424 file (default: FAA CIFP 2301)")
     ap.add_argument("--aircraft", default="737")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--airports", nargs="*", default=None, help="only these (quick mode)")
+    ap.add_argument("--airports", nargs="*", default=None, help="only these airports")
     ap.add_argument("--md", default="procedures_timing.md",
                     help="Markdown table in docs/results/ ('' to skip)")
+    report.add_quick(ap, "the airports " + " ".join(QUICK_AIRPORTS) + " only")
     args = ap.parse_args(argv)
+    if args.quick and not args.airports:
+        args.airports = QUICK_AIRPORTS
     if not Path(args.db).exists():
         raise SystemExit(f"{args.db}: no such ARINC-424 file (give --db)")
     perf = perf_for(args.aircraft)

@@ -4,6 +4,7 @@ linear 33-state model against it with the same sensor-error realisations.
     python bench/bench_strapdown.py speed  [--sim-s 600] [--md strapdown_speed.md]
     python bench/bench_strapdown.py exact  [--sim-s 600] [--md strapdown_exact.md]
     python bench/bench_strapdown.py linear [--sim-s 600] [--seeds 5] [--md strapdown_linear.md]
+    python bench/bench_strapdown.py [speed|exact|linear] --quick
 
 ``speed``: bare JSBSim (12 frames per 10-Hz step), the closed loop on truth navigation, and the
 same closed loop with three strapdown INS (STIM300) riding along on the per-frame samples (the
@@ -19,6 +20,8 @@ increments against JSBSim's trajectory.
 in the strapdown and in the 33-state model (:func:`fms_testbed.navigation.inertial.twin.linear_twin`)
 along the same flight: horizontal position error of each at the end, their difference relative
 to the strapdown's, and the second-order prediction ½|ε| (ε the largest attitude error).
+
+``--quick``: :data:`QUICK` (the first 120 s of the flight, one seed), all three when none is named.
 """
 
 from __future__ import annotations
@@ -47,9 +50,19 @@ from fms_testbed.navigation.inertial.bank import StrapdownBank  # noqa: E402
 from fms_testbed.navigation.inertial.twin import linear_twin  # noqa: E402
 from fms_testbed.navigation.ins_bank import derive_seeds  # noqa: E402
 from fms_testbed.navigation.truth import TruthNavigation  # noqa: E402
-from tests.navigation.strapdown_helpers import BankProbe, fly_with, scenario  # noqa: E402
+from tests.navigation.strapdown_helpers import EVENTS, BankProbe, fly_with, scenario  # noqa: E402
 
 PRESETS = ["HG9900", "HG1700", "STIM300", "ADIS16488", "consumer_MEMS"]
+QUICK = {"sim_s": 120.0, "seeds": 1}
+"""``--quick``: simulated s (a heading change and the start of a climb), seeds per preset."""
+
+
+def flight_words(sim_s: float) -> str:
+    """What the strapdown tests' flight does in its first ``sim_s`` s (its events before then)."""
+    ev = [e for e in EVENTS if e["t_s"] < sim_s]
+    words = {"heading_deg": "heading change", "alt_m": "altitude change", "tas_kmh": "speed change"}
+    n = {k: sum(k in e for e in ev) for k in words}
+    return ", ".join(f"{n[k]} {w}{'' if n[k] == 1 else 's'}" for k, w in words.items())
 
 
 class TimedProbe(BankProbe):
@@ -155,8 +168,8 @@ def _speed_md(us: dict, sim_s: float) -> str:
             ("   of which the per-frame sampling (6 properties × 12 frames)",
              f"{us['sampling']:.1f}", "", "")]
     load = os.getloadavg()
-    return (f"737, {sim_s:.0f} s simulated (the strapdown tests' flight: turns, climbs, a speed "
-            f"change), JSBSim at 120 Hz, navigation step 10 Hz; the three timed in rotating "
+    return (f"737, {sim_s:.0f} s simulated (the strapdown tests' flight: {flight_words(sim_s)}), "
+            f"JSBSim at 120 Hz, navigation step 10 Hz; the three timed in rotating "
             f"10 s chunks. Load average at the end {load[0]:.2f} (2 cores).\n\n"
             + report.table(["configuration", "µs per 10-Hz step", "speed / bare JSBSim",
                             "speed / closed loop on truth"], rows))
@@ -165,27 +178,41 @@ def _speed_md(us: dict, sim_s: float) -> str:
 def main() -> None:
     """Command line (module docstring)."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("what", choices=["speed", "exact", "linear"])
+    ap.add_argument("what", nargs="?", choices=["speed", "exact", "linear"],
+                    help="the measurement (with --quick and none named: all three)")
     ap.add_argument("--sim-s", type=float, default=600.0)
     ap.add_argument("--seeds", type=int, default=5)
     ap.add_argument("--md", default=None, help="output file in docs/results ('' : none)")
+    report.add_quick(ap, "the first 120 s of the flight, one seed per preset")
     a = ap.parse_args()
-    if a.what == "speed":
+    if a.quick:
+        a.sim_s, a.seeds = QUICK["sim_s"], QUICK["seeds"]
+    elif a.what is None:
+        ap.error("name the measurement: speed, exact or linear (or --quick)")
+    if a.what is None and a.md:
+        ap.error("--md names one page: name the measurement too")
+    for what in [a.what] if a.what else ["speed", "exact", "linear"]:
+        measure(what, a)
+
+
+def measure(what: str, a) -> None:
+    """Run the measurement ``what`` with the options ``a`` and write its page."""
+    if what == "speed":
         # warm-up: JSBSim's and numba's caches (the kernels load at a bank's first call)
         _flight(30.0, TimedProbe(StrapdownBank(["STIM300"] * 3, derive_seeds(0, 3)))).run()
         us = speed(a.sim_s)
         print({k: round(v, 1) for k, v in us.items()})
         report.write("strapdown_speed.md" if a.md is None else a.md, _speed_md(us, a.sim_s))
-    elif a.what == "exact":
+    elif what == "exact":
         rows = exact(a.sim_s)
         body = report.table(
             ["IMU lever arm (x, y, z) m", "horizontal position m", "height m", "velocity m/s",
              "attitude rad"],
             [(str(tuple(r[0])), f"{r[1]:.1e}", f"{r[2]:.1e}", f"{r[3]:.1e}", f"{r[4]:.1e}")
              for r in rows])
-        note = (f"Error-free IMU, 737, {a.sim_s:.0f} s (turns of 110-180°, climbs and descents "
-                "of 600-800 m, a speed change): the largest error of the mechanised increments "
-                "against JSBSim's trajectory, sampled every second.")
+        note = (f"Error-free IMU, 737, {a.sim_s:.0f} s ({flight_words(a.sim_s)}): the largest "
+                "error of the mechanised increments against JSBSim's trajectory, sampled every "
+                "second.")
         print(body)
         report.write("strapdown_exact.md" if a.md is None else a.md, body, note)
     else:
@@ -207,7 +234,8 @@ def _linear_md(rows: list[tuple], sim_s: float) -> str:
                     f"{max(rel) * 100:.2g})",
                     f"{statistics.median(0.5 * x[2] for x in r) * 100:.2g}",
                     f"{statistics.median(abs(x[6] - x[7]) for x in r):.2g}"))
-    return (f"737 flight of {sim_s:.0f} s (the strapdown tests' flight), one deterministic "
+    return (f"737 flight of {sim_s:.0f} s (the strapdown tests' flight: {flight_words(sim_s)}), "
+            "one deterministic "
             "realisation per seed (constant sensor errors: turn-on and in-run biases frozen, "
             "scale factors, misalignments; no noise) in both models, stationary alignment at the "
             "start; medians over the seeds.\n\n"

@@ -1,6 +1,7 @@
 """Envelope tuning of the coupled law for the 737 and the Global 5000: goals, margins, timing.
 
     python bench/bench_tune.py [--aircraft 737 global5000] [--workers 2] [--md tune_envelope.md]
+                               [--grid FILE.yaml] [--keep DIR] [--quick]
 
 Runs ``fms-testbed tune --aircraft NAME --envelope --workers N`` on the default grid of each
 aircraft (12 design points: 4 envelope points × 2 masses clean, 2 approach speeds × 2 masses),
@@ -10,34 +11,45 @@ gains, the robustness minima per member, the wall time) and the figures into
 ``docs/figures/tuning/`` (``<aircraft>-nichols.png``, ``-bode-worst.png``, ``-steps.png``,
 ``-schedule.png``) and ``linear-vs-jsbsim-<aircraft>.png`` (``analyse --plant jsbsim``, whose
 ``analysis.md`` is kept beside the runs). The tuned aircraft files are kept in ``--keep`` (default
-``results/bench-tune``) for ``bench_tune_campaign.py``.
+``results/bench-tune``) for ``bench_tune_campaign.py``. ``--grid``: ``tune --envelope --grid``'s
+design points instead of the default grid. ``--quick``: the 737 on the three points of
+:data:`QUICK_GRID`, kept in ``results/quick/bench-tune``.
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import platform
 import shutil
 import sys
 import time
 from pathlib import Path
 
 import pandas as pd
+import yaml
 
-ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+import report  # noqa: E402
+
+ROOT = report.REPO
+QUICK_GRID = [{"alt_m": 1000.0, "tas_mps": 105.0}, {"alt_m": 3000.0, "tas_mps": 111.1},
+              {"alt_m": 6000.0, "tas_mps": 150.0}]
+"""The design points of a quick run (m, m/s; the aircraft's loaded mass, clean): the fewest a
+schedule can be fitted to."""
 
 
-def machine() -> str:
-    import jsbsim
-    import numpy
+def write_quick_grid(folder: Path) -> Path:
+    """Write :data:`QUICK_GRID` as a ``tune --envelope --grid`` file into ``folder``; its path."""
+    folder.mkdir(parents=True, exist_ok=True)
+    path = folder / "quick-grid.yaml"
+    path.write_text(yaml.safe_dump({"points": QUICK_GRID}))
+    return path
 
-    return (f"{os.cpu_count()} cores, Python {platform.python_version()}, JSBSim "
-            f"{jsbsim.__version__}, numpy {numpy.__version__}")
 
-
-def one(name: str, workers: int, keep: Path) -> tuple[str, float, tuple]:
-    """Tune one aircraft; return its markdown section, wall time (s) and load average."""
+def one(name: str, workers: int, keep: Path, grid: str | None = None
+        ) -> tuple[str, float, tuple]:
+    """Tune one aircraft (on the design points of the file ``grid``, default grid if None);
+    return its markdown section, wall time (s) and load average."""
     from fms_testbed.cli import main
     from fms_testbed.cli.common import markdown_table
     from fms_testbed.cli.tune_envelope import goal_lines
@@ -45,7 +57,7 @@ def one(name: str, workers: int, keep: Path) -> tuple[str, float, tuple]:
     out = keep / name
     t0 = time.perf_counter()
     rc = main(["tune", "--aircraft", name, "--envelope", "--workers", str(workers), "--out",
-               str(out), "--overwrite"])
+               str(out), "--overwrite", *(["--grid", grid] if grid else [])])
     wall = time.perf_counter() - t0
     load = os.getloadavg()
     df = pd.read_csv(out / "points.csv")
@@ -54,11 +66,12 @@ def one(name: str, workers: int, keep: Path) -> tuple[str, float, tuple]:
             "max_dv_kmh", "max_dh_m", "old_max_dv_kmh", "old_max_dh_m", "robust_pm_mass_lo_deg",
             "robust_pm_mass_hi_deg", "robust_pm_cg_fwd_deg", "robust_pm_cg_aft_deg",
             "robust_pm_delay_deg"]
-    fig = ROOT / "docs" / "figures" / "tuning"
+    fig = report.FIGURES / "tuning"
     fig.mkdir(parents=True, exist_ok=True)
     for f in ("nichols", "bode-worst", "steps", "schedule"):
         shutil.copy(out / f"{f}.png", fig / f"{name}-{f}.png")
-    md = (f"### {name}\n\n`fms-testbed tune --aircraft {name} --envelope --workers {workers}`: "
+    on = f" --grid {Path(grid).name}" if grid else ""
+    md = (f"### {name}\n\n`fms-testbed tune --aircraft {name} --envelope{on} --workers {workers}`: "
           f"{wall:.0f} s wall (exit {rc}), load average at the end {load[0]:.1f} / {load[1]:.1f} "
           f"/ {load[2]:.1f}.\n\n{goals}\n\n{markdown_table(df[[c for c in cols if c in df]])}\n")
     return md, wall, load
@@ -69,34 +82,40 @@ def main() -> int:
     ap.add_argument("--aircraft", nargs="+", default=["737", "global5000"])
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--md", default="tune_envelope.md")
-    ap.add_argument("--keep", default=str(ROOT / "results" / "bench-tune"))
+    ap.add_argument("--keep", default=None,
+                    help="folder for the runs (default results/bench-tune, quick: "
+                         "results/quick/bench-tune)")
+    ap.add_argument("--grid", default=None, help="design points (tune --envelope --grid)")
+    report.add_quick(ap, "the 737 on three design points")
     args = ap.parse_args()
-    keep = Path(args.keep)
+    if args.quick:
+        args.aircraft = ["737"]
+    keep = Path(args.keep or ROOT / "results" / ("quick" if args.quick else "") / "bench-tune")
+    if args.quick and not args.grid:
+        args.grid = str(write_quick_grid(keep))
     from fms_testbed.cli import main as cli
 
     for name in args.aircraft:         # the linearisation checked against the nonlinear model
         cli(["analyse", "--aircraft", name, "--plant", "jsbsim", "--out",
              str(keep / f"analyse-{name}"), "--overwrite"])
-        fig = ROOT / "docs" / "figures" / "tuning"
+        fig = report.FIGURES / "tuning"
         fig.mkdir(parents=True, exist_ok=True)
         shutil.copy(keep / f"analyse-{name}" / "linear-vs-jsbsim.png",
                     fig / f"linear-vs-jsbsim-{name}.png")
     parts, total = [], 0.0
     for name in args.aircraft:
-        md, wall, _ = one(name, args.workers, keep)
+        md, wall, _ = one(name, args.workers, keep, args.grid)
         parts.append(md)
         total += wall
-    head = ("<!-- written by python bench/bench_tune.py; rerun it to refresh, do not edit by hand -->"
-            f"\n\nCommand: `python bench/bench_tune.py{' ' + ' '.join(sys.argv[1:]) if sys.argv[1:] else ''}`  \n"
-            f"Machine: {machine()}; other sessions were running on the same cores (load average "
-            f"in each section).\n\nColumns: margins are the smallest over the six broken loops "
+    head = ("The cores may be shared with other work: the load average is in each section."
+            "\n\nColumns: margins are the smallest over the six broken loops "
             "(dB, deg, disk margin α) with the scheduled gains; `max_dv_kmh`/`max_dh_m` are the "
             "nonlinear JSBSim cross deviations (+100 m step, +10 % TAS step) with the schedule, "
             "`old_*` with the aircraft file's gains; `robust_pm_*` the smallest phase margin "
             "under mass −10 %/+10 %, CG 0.2 m forward/aft, 0.1 s delay at every actuator.\n\n"
-            f"Both aircraft: {total:.0f} s wall.\n\n")
-    (ROOT / "docs" / "results" / args.md).write_text(head + "\n".join(parts))
+            f"{' and '.join(args.aircraft)}: {total:.0f} s wall.\n\n")
     print(head + "\n".join(parts))
+    report.write(args.md, "\n".join(parts), note=head)
     return 0
 
 

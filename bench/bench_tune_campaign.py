@@ -3,7 +3,8 @@ with the tuned aircraft file, in wind and turbulence, and the shift of the error
 
     python bench/bench_tune_campaign.py --new RUN/aircraft.yaml [--old 737]
         [--airports KBFI KDLS ...] [--types STAR,APPROACH] [--limit N] [--workers 2] [--wind 270/30]
-        [--turbulence moderate] --out DIR
+        [--turbulence moderate] --out DIR [--md]
+    python bench/bench_tune_campaign.py --quick
 
 Two ``fms-testbed regress run`` campaigns over the same cases (embedded excerpt, ``--airports``,
 one condition set: steady wind ``--wind`` and ``--turbulence``, truth navigation), one per
@@ -11,7 +12,10 @@ aircraft file; the flights are paired by (airport, type, procedure, runway, tran
 conditions). Written to ``DIR``: ``campaign-shift.md`` (per run: flights, status counts,
 median and 90th percentile of ``fte_p95_m``, ``vpe_p95_m``, ``spd_err_p95_kt``, constraints
 missed; per pair the median of the differences new − old) and ``campaign-shift.png`` (the
-empirical distributions).
+empirical distributions); ``--md`` also writes ``docs/results/tune_campaign.md`` and the figure
+into ``docs/figures/tuning/``. ``--quick`` (``--new`` not needed): tunes the 737 on
+``bench_tune.QUICK_GRID`` (no robustness set) into ``DIR/tune``, flies :data:`QUICK` with both
+files into ``results/quick/tune_campaign`` and writes the page and the figure.
 """
 
 from __future__ import annotations
@@ -24,9 +28,12 @@ import numpy as np
 import pandas as pd
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from report import machine  # noqa: E402
+import report  # noqa: E402
+from bench_tune import write_quick_grid  # noqa: E402
 
 PAGE = "tune_campaign.md"
+QUICK = {"airports": ["KBFI"], "limit": 2}
+"""The cases of a quick run: the first two of one airport's sample."""
 
 KEY = ["airport", "type", "procedure", "runway", "transition", "conditions"]
 METRICS = ("fte_p95_m", "vpe_p95_m", "spd_err_p95_kt")
@@ -62,9 +69,22 @@ def summary(df: pd.DataFrame) -> dict:
     return row
 
 
+def quick_schedule(folder: Path, workers: int) -> str:
+    """Tune the 737 on ``bench_tune.QUICK_GRID`` without the robustness set into
+    ``folder/tune``; the tuned aircraft file's path."""
+    from fms_testbed.cli import main
+
+    grid = write_quick_grid(folder)
+    rc = main(["tune", "--aircraft", "737", "--envelope", "--grid", str(grid), "--no-robust",
+               "--workers", str(workers), "--out", str(folder / "tune"), "--overwrite"])
+    if rc not in (0, 1):
+        raise SystemExit(f"tune --envelope for the quick schedule exited {rc}")
+    return str(folder / "tune" / "aircraft.yaml")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--new", required=True, help="tuned aircraft file (tune --envelope's aircraft.yaml)")
+    ap.add_argument("--new", help="tuned aircraft file (tune --envelope's aircraft.yaml)")
     ap.add_argument("--old", default="737", help="aircraft with the file gains (name or file)")
     ap.add_argument("--airports", nargs="*", default=None)
     ap.add_argument("--limit", type=int, default=None)
@@ -73,12 +93,21 @@ def main() -> int:
     ap.add_argument("--workers", type=int, default=2)
     ap.add_argument("--wind", default="270/30", help="FROM_DEG/SPEED_KT")
     ap.add_argument("--turbulence", default="moderate", choices=("light", "moderate", "severe"))
-    ap.add_argument("--out", required=True)
+    ap.add_argument("--out", help="output folder (quick: results/quick/tune_campaign)")
     ap.add_argument("--md", action="store_const", const=PAGE,
                     help=f"also write docs/results/{PAGE} and docs/figures/tuning/")
+    report.add_quick(ap, "a 737 schedule tuned on three points, two cases of one airport")
     args = ap.parse_args()
+    if args.quick:
+        args.out = args.out or str(report.REPO / "results" / "quick" / "tune_campaign")
+        args.airports, args.limit = args.airports or QUICK["airports"], QUICK["limit"]
+        args.md = PAGE
+    elif not (args.new and args.out):
+        ap.error("--new and --out are required (or --quick)")
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
+    if args.new is None:
+        args.new = quick_schedule(out, args.workers)
     frm, spd = (float(x) for x in args.wind.split("/"))
     cond = out / "conditions.yaml"
     cond.write_text(f"conditions:\n  - name: wind-{frm:.0f}-{spd:.0f}kt-{args.turbulence}\n"
@@ -88,23 +117,21 @@ def main() -> int:
             "tuned schedule": _run(args.new, cond, args, out / "new")}
     table = pd.DataFrame({k: summary(v) for k, v in runs.items()})
     a, b = (runs[k].set_index(KEY) for k in ("file gains", "tuned schedule"))
-    both = a.join(b, lsuffix="_old", rsuffix="_new", how="inner")
+    both = a.merge(b, left_index=True, right_index=True, suffixes=("_old", "_new"))
     diffs = {m: float((both[f"{m}_new"] - both[f"{m}_old"]).median()) for m in METRICS}
     from fms_testbed.cli.common import markdown_table
     from fms_testbed.viz.figure import save
     from fms_testbed.viz.tuning import plot_campaign_shift
 
-    md = ("<!-- written by python bench/bench_tune_campaign.py; rerun it to refresh, do not edit "
-          f"by hand -->\n\nCommand: `python bench/bench_tune_campaign.py {' '.join(sys.argv[1:])}`"
-          f"  \nMachine: {machine()}.\n\nAircraft: `{args.old}` (file gains) and `{args.new}` (tuned schedule). "
+    md = (f"Aircraft: `{args.old}` (file gains) and `{args.new}` (tuned schedule). "
           f"Conditions: wind {args.wind} kt, {args.turbulence} turbulence; "
           f"{len(both)} paired flights.\n\n{markdown_table(table.reset_index())}\n\n"
           "Median of the paired differences (tuned − file gains): "
           + ", ".join(f"{m} {v:+.3g}" for m, v in diffs.items()) + "\n")
-    (out / "campaign-shift.md").write_text(md)
+    report.write(out / "campaign-shift.md", md)
     if args.md:
-        (Path(__file__).resolve().parents[1] / "docs" / "results" / args.md).write_text(md)
-        fig = Path(__file__).resolve().parents[1] / "docs" / "figures" / "tuning"
+        report.write(args.md, md)
+        fig = report.FIGURES / "tuning"
         fig.mkdir(parents=True, exist_ok=True)
     save(plot_campaign_shift(runs, METRICS, f"{args.old}: file gains vs tuned schedule, wind "
                              f"{args.wind} kt, {args.turbulence} turbulence ({len(both)} paired "

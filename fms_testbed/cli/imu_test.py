@@ -5,7 +5,7 @@ of Vorobyov et al. (seed 000).
         [--stages none,temperature,run-to-run,slow-drift] [--seed N] [--allan] --out DIR
 
 Writes into ``--out``: ``accumulated_angle.csv`` (``t_s`` and ``angle_<stage>_<axis>_deg``, one
-row per second), ``summary.json`` (per stage and axis the residual zero signal and mean drift in
+row per second, or per ⌈duration / 360,000⌉ s beyond 100 h), ``summary.json`` (per stage and axis the residual zero signal and mean drift in
 °/s and the angle in °; the seed's figures next to the measured ones; the seed; with ``--allan``
 the fitted ARW °/√h and bias instability °/h vs the preset's) and the plots
 ``zero_signal_vs_temperature.png``, ``residual_after_run_to_run.png``, ``accumulated_angle.png``
@@ -26,9 +26,14 @@ from fms_testbed.data import results_dir
 DEFAULT_STAGES = "none,temperature,run-to-run,slow-drift"
 MIN_DURATION_S = 60.0
 """Shortest test, s (the run-to-run stage averages the first 60 s after switch-on)."""
-BYTES_PER_SAMPLE = 300
-"""Peak memory of the test per output sample of the triad, bytes, with the series of every
-stage held whole (an upper bound of the peak RSS over the interpreter's, ``--allan`` included)."""
+BYTES_PER_PROFILE_S = 120
+"""Memory of the test per second of its duration, bytes: the 1-s temperature grid, its
+hysteresis state and the play operator's working list (the samples are streamed in chunks and
+the kept series is bounded, so nothing else grows with the duration)."""
+FIXED_B = 512 * 2 ** 20
+"""Memory of the test that does not grow with the duration, bytes: the chunks of every stage,
+the kept series of :data:`~fms_testbed.sensors.mems.static_test.MAX_SERIES_ROWS` rows, the
+CSV and the plots (an upper bound of the peak RSS over the interpreter's)."""
 MEMORY_SHARE = 0.5
 """Share of the machine's available memory a test may take."""
 
@@ -45,9 +50,10 @@ def available_memory_b() -> int | None:
 
 
 def check_duration(duration_h: float, rate_hz: float, memory_b: int | None) -> float:
-    """The test length, s, after the bounds: at least :data:`MIN_DURATION_S`, and no more
-    samples than :data:`MEMORY_SHARE` of the available memory holds at
-    :data:`BYTES_PER_SAMPLE` (a one-line refusal naming the limit otherwise).
+    """The test length, s, after the bounds: at least :data:`MIN_DURATION_S`, and at most
+    T_max = (:data:`MEMORY_SHARE` · available − :data:`FIXED_B`) / :data:`BYTES_PER_PROFILE_S`
+    (a one-line refusal naming the limit otherwise). The samples are streamed, so the rate
+    does not enter the memory bound; it is named in the refusal.
 
     Parameters
     ----------
@@ -61,11 +67,12 @@ def check_duration(duration_h: float, rate_hz: float, memory_b: int | None) -> f
         raise UserError(f"--duration-h {duration_h:g}: must be a finite number of hours >= "
                         f"{MIN_DURATION_S / 3600.0:.4f} ({MIN_DURATION_S:.0f} s)")
     if memory_b is not None:
-        limit_h = MEMORY_SHARE * memory_b / BYTES_PER_SAMPLE / rate_hz / 3600.0
+        limit_h = max(0.0, MEMORY_SHARE * memory_b - FIXED_B) / BYTES_PER_PROFILE_S / 3600.0
         if duration_h > limit_h:
             raise UserError(f"--duration-h {duration_h:g}: longer than this machine can hold "
                             f"in memory: at most {limit_h:.0f} h at {rate_hz:g} Hz "
-                            f"({BYTES_PER_SAMPLE} B per sample, {MEMORY_SHARE:.0%} of "
+                            f"({BYTES_PER_PROFILE_S} B per second of test and "
+                            f"{FIXED_B / 2**20:.0f} MiB, {MEMORY_SHARE:.0%} of "
                             f"{memory_b / 2**30:.1f} GiB available)")
     return duration_h * 3600.0
 
@@ -134,8 +141,9 @@ def register(sub) -> None:
     p.add_argument("--imu", default="STIM210", help="MEMS gyro preset or YAML file "
                                                     "(default STIM210)")
     p.add_argument("--duration-h", type=float, default=2.0,
-                   help="test length, h (default 2; at least 60 s, at most what half the "
-                        "available memory holds: about 240 B per sample)")
+                   help="test length, h (default 2; at least 60 s; streamed in chunks, at "
+                        "most what half the available memory holds at 120 B per second of test "
+                        "plus 512 MiB)")
     p.add_argument("--temperature-profile", default="warmup",
                    help="warmup (switch-on self-heating, default), ramp (thermal cycle over the "
                         "operating range), constant, or a CSV file with t_s,temperature_degC")

@@ -208,10 +208,24 @@ _WORKER: dict = {}
 
 
 def _init_worker(db_path: str, perf: Performance, params: BuildParams) -> None:
+    """A pool worker's state: the database of ``db_path`` — inherited from the parent when the
+    worker is forked (:func:`_share_with_workers`), else loaded — the performance and the
+    build settings."""
     die_with_parent()                       # no orphan worker after a SIGKILL of the parent
-    _WORKER["db"] = _load(db_path)
+    if _WORKER.get("db_path") != db_path:
+        _WORKER["db"] = _load(db_path)
+        _WORKER["db_path"] = db_path
     _WORKER["perf"] = perf
     _WORKER["params"] = params
+
+
+def _share_with_workers(db: Database) -> None:
+    """Leave the parent's loaded database (and the compiled gravity kernel, called once) where
+    forked workers find them: they start without loading the index again, or the kernel's
+    cache. Spawned workers (another start method) load their own."""
+    gravity_mps2(45.0)
+    _WORKER["db"] = db
+    _WORKER["db_path"] = str(db.path)
 
 
 def _work(airport: str) -> tuple[list[dict], list]:
@@ -264,6 +278,7 @@ def run_check(db_path: str | None, perf: Performance, airports: list[str] | None
             if bar:
                 bar.update(1)
     else:
+        _share_with_workers(db)
         with ProcessPoolExecutor(workers, initializer=_init_worker,
                                  initargs=(str(db.path), perf, params)) as ex:
             for part, issues in ex.map(_work, todo,
@@ -272,6 +287,7 @@ def run_check(db_path: str | None, perf: Performance, airports: list[str] | None
                 db.issues.extend(issues)
                 if bar:
                     bar.update(1)
+        _WORKER.clear()
     if bar:
         bar.close()
     rows.sort(key=lambda r: (r["airport"], r["order"]))

@@ -52,6 +52,9 @@ class Leg:
     track_to_fix: ClassVar[bool] = False
     """A straight track into the fix from the previous one (TF/CF/DF): the same fix-to-fix track
     flown twice is a loop in the coding (Danilin 2017, Fig. 4)."""
+    course_to_fix: ClassVar[bool] = False
+    """CF: the leg's path is its coded course into the fix — joined before the fix or, where
+    that cannot be flown, the leg is impossible (never flown direct to the fix)."""
     direct_to: ClassVar[bool] = False
     """DF: flown from wherever the aircraft is; on a rebuild a fix already behind is passed."""
     initial: ClassVar[bool] = False

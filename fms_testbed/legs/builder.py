@@ -34,6 +34,11 @@ CF_FROM_FIX_TURN_MAX_DEG = 120.0
 """:data:`CF_FROM_FIX_DEG` applies to a fly-by turn onto the course; a sharper one (a course
 reversal over the fix, e.g. a missed approach coded back along the final) keeps the course
 join, so the monitor still sees the reversal."""
+CF_OFF_COURSE_DEG = 20.0
+"""A CF's own straight more than this off its coded course is not the coded leg, deg."""
+DECEL_PLAN_MPS2 = 0.3
+"""Deceleration a plan may count on to slow down for a turn, m/s² (the speed guidance slows
+for an arc ahead at this rate)."""
 PARALLEL_TOL_M = 30.0
 """A turn from over a fix that ends closer than this to the coded course line out of the fix
 is left parallel to it; beyond, the line is rejoined with a 45° intercept, m."""
@@ -103,6 +108,9 @@ class LegBuilder:
         """The highest altitude the climb of the current leg may reach, m (the climb planner's
         :func:`~fms_testbed.path.profile.climb_caps_m` at the leg's end)."""
         self._corner_pending = False
+        self.flown_before_m = 0.0
+        """Path length built before this builder's first segment, m (the builder of a
+        fly-over rejoin starts mid-path)."""
         self.params0 = params
         self.leg_params: dict[int, BuildParams] = {}
         """The settings each leg was built with (the wind at its planned altitude)."""

@@ -98,6 +98,7 @@ class CF(Leg):
     code = "CF"
     ends_at_fix = True
     track_to_fix = True
+    course_to_fix = True
     pde_reference = "the geodesic into the fix on the coded course"
 
     @classmethod
@@ -105,7 +106,7 @@ class CF(Leg):
         f, c = fix_of(b), course_of(b)
         if s.track_deg is None:
             s = replace(s, track_deg=c)
-        s = join_course(b, s, f, c, turn_dir(b), not b.leg.rec.fly_over)
+        s = join_course(b, s, f, c, turn_dir(b), not b.leg.rec.fly_over, course_leg=True)
         return fix_state(b, s, f), fix_termination(f)
 
     @classmethod

@@ -20,13 +20,14 @@ from dataclasses import replace
 
 from fms_testbed.core.geodesy import direct, inverse, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line, turn_angle_deg
-from fms_testbed.core.units import NM_M
-from fms_testbed.legs.builder import (CF_FROM_FIX_DEG, CF_FROM_FIX_TURN_MAX_DEG, CLOSE_S,
+from fms_testbed.core.units import KT_MPS, NM_M
+from fms_testbed.legs.builder import (CF_FROM_FIX_DEG, CF_FROM_FIX_TURN_MAX_DEG, CF_OFF_COURSE_DEG,
+                                      CLOSE_S, DECEL_PLAN_MPS2,
                                       DIRECT_XTK_M, PARALLEL_TOL_M, LegBuilder,
                                       intercept_angle_deg)
 from fms_testbed.legs.construct import (_foot, direct_to_arc, ray_geodesic_intersection,
                                         turn_to_course)
-from fms_testbed.legs.model import FlightState
+from fms_testbed.legs.model import FlightState, isa_tas_mps, turn_radius_m
 from fms_testbed.procedures.records import Fix
 
 _STATE = ("i", "speed_mps", "radius_m", "climbing", "gradient", "alt_cap_m", "params",
@@ -186,8 +187,8 @@ def _intercept(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float, x
 
 
 def join_course(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float,
-                direction: str | None, flyby_end: bool, upstream: bool = True
-                ) -> FlightState:
+                direction: str | None, flyby_end: bool, upstream: bool = True,
+                course_leg: bool = False) -> FlightState:
     """Join the course line into ``fix`` (course ``course_deg`` deg true at the fix), then
     fly it.
 
@@ -197,10 +198,12 @@ def join_course(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float,
     beyond the fix (or leave no room for the turn onto the course), the line is joined
     upstream instead (:func:`join_upstream`; ``upstream`` False — a join made from an
     upstream reversal — flies direct instead): so the leg's straight lies on its coded
-    course.
+    course. ``course_leg``: the course is the leg's own path (CF), so no room to join it is
+    not flown direct (:func:`direct_no_room`).
     """
     along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
                              state.lon_deg)
+    own = course_deg if course_leg else None
     if along < 0 and at_previous_fix(b, state) and \
             math.degrees(math.atan2(abs(xtk), -along)) <= CF_FROM_FIX_DEG and \
             (state.track_deg is None or
@@ -214,13 +217,13 @@ def join_course(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float,
         if got is not None:
             return got
         if abs(wrap180(state.track_deg - fcrs)) < 90.0:
-            return direct_no_room(b, state, fix, direction, flyby_end)
+            return direct_no_room(b, state, fix, direction, flyby_end, own)
     got = _intercept(b, state, fix, course_deg, xtk, fcrs, direction, flyby_end)
     if got is not None:
         return got
     if not upstream:
         return direct_to(b, state, fix, direction, flyby_end)
-    return join_upstream(b, state, fix, course_deg, direction, flyby_end)
+    return join_upstream(b, state, fix, course_deg, direction, flyby_end, course_leg)
 
 
 def _upstream_point(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float,
@@ -252,7 +255,8 @@ def _upstream_point(b: LegBuilder, state: FlightState, fix: Fix, course_deg: flo
 
 
 def join_upstream(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float,
-                  direction: str | None, flyby_end: bool) -> FlightState:
+                  direction: str | None, flyby_end: bool, course_leg: bool = False
+                  ) -> FlightState:
     """Join the course into ``fix`` upstream of the fix, where no intercept reaches it in
     time (the aircraft abeam or past the fix, or too close to it). Heading toward the fix
     (within 90° of the course) with less than two turn radii of course ahead, or with no
@@ -260,7 +264,9 @@ def join_upstream(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float
     flies direct to the fix (:func:`direct_no_room`). Heading away, the course is reversed
     onto: direct to Q, two radii beside P on the aircraft's side (P two radii upstream of the
     aircraft's abeam point), a 180° turn toward the course there, then the course joined
-    (:func:`join_course`, no further upstream join) from where the turn ends."""
+    (:func:`join_course`, no further upstream join) from where the turn ends.
+    ``course_leg``: the course is the leg's own path (:func:`join_course`)."""
+    own = course_deg if course_leg else None
     along, xtk, fcrs = _foot(fix.lat_deg, fix.lon_deg, course_deg, state.lat_deg,
                              state.lon_deg)
     away = state.track_deg is not None and abs(wrap180(state.track_deg - fcrs)) >= 90.0
@@ -270,12 +276,12 @@ def join_upstream(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float
         brg = inverse(state.lat_deg, state.lon_deg, fix.lat_deg, fix.lon_deg)[1]
         away = away or abs(wrap180(brg - state.track_deg)) > 90.0
     if not away and -along < 2.0 * b.radius_m:
-        return direct_no_room(b, state, fix, direction, flyby_end)
+        return direct_no_room(b, state, fix, direction, flyby_end, own)
     got = _upstream_point(b, state, fix, course_deg, direction, flyby_end)
     if got is not None:
         return got
     if not away:
-        return direct_no_room(b, state, fix, direction, flyby_end)
+        return direct_no_room(b, state, fix, direction, flyby_end, own)
     side = 1.0 if xtk >= 0 else -1.0
     n0 = len(b.segments)
     # P beyond the aircraft when it flies away from the fix, so that Q lies ahead of it
@@ -298,23 +304,86 @@ def join_upstream(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float
                        upstream=False)
 
 
+def min_speed_radius(b: LegBuilder, alt_m: float) -> tuple[float, float]:
+    """(TAS m/s, radius m) of a turn at the aircraft's minimum speed at the bank limit:
+    V = TAS of the minimum CAS at ``alt_m`` (m), R = (V + W)² / (g tan γ_max), W the planned
+    wind speed."""
+    v = isa_tas_mps(b.perf.tas_min_mps, alt_m, b.params.isa_dev_c)
+    gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
+    return v, turn_radius_m(v + b.wind_mps, gmax, b.g)
+
+
 def direct_no_room(b: LegBuilder, state: FlightState, fix: Fix, direction: str | None,
-                   flyby_end: bool) -> FlightState:
-    """Heading toward ``fix`` with no room to get onto its course without a loop (at the
-    planned radius: Danilin's class 1, the conditions): fly direct to it; a finding says
-    the coded course is not flown."""
-    b.finding("info", f"no room to join the course into {fix.ident} at the planned "
-              f"radius {b.radius_m:.0f} m: flown direct to the fix")
+                   flyby_end: bool, course_deg: float | None = None) -> FlightState:
+    """Heading toward ``fix`` with no room to get onto its course without a loop at the
+    planned radius (Danilin's class 1, the conditions).
+
+    Any leg but a CF (a TF joined away from its first fix) flies direct to the fix, and an
+    'info' finding says its track is not flown. A leg whose path is the course (CF:
+    ``course_deg`` given, deg true) flies direct when the direct line's straight is within
+    :data:`~.builder.CF_OFF_COURSE_DEG` of the course, or when the path behind is shorter than
+    the distance to slow to the minimum speed, (V² − V_min²) / (2 a) with a
+    :data:`~.builder.DECEL_PLAN_MPS2` (the monitor then reports the course not flown); else
+    it joins the course at the aircraft's minimum speed at the bank limit
+    (:func:`min_speed_radius`; branch V,γ, a correction) when that radius leaves room; else
+    the coded course cannot be flown before the fix and the leg is 'impossible' with the
+    reason (the direct line to the fix is kept as its geometry)."""
+    why = (f"no room to join the course into {fix.ident} at the planned radius "
+           f"{b.radius_m:.0f} m: flown direct to the fix")
+    if course_deg is None:
+        b.finding("info", why)
+        return direct_to(b, state, fix, direction, flyby_end)
+    t = trial(b)
+    n0 = len(t.segments)
+    st = direct_to(t, state, fix, direction, flyby_end)
+    lines = [sg.geom for sg in t.segments[n0:] if isinstance(sg.geom, Line)]
+    if not lines or abs(wrap180(lines[-1].end_course_deg - course_deg)) <= CF_OFF_COURSE_DEG:
+        # at the fix already (a zero-length leg), or the direct line lies along the course
+        commit(b, t)
+        b.finding("info", why)
+        return st
+    v_min, r_min = min_speed_radius(b, state.alt_m)
+    flown = b.flown_before_m + sum(sg.geom.length_m() for sg in b.segments)
+    slow_m = max(b.speed_mps ** 2 - v_min ** 2, 0.0) / (2.0 * DECEL_PLAN_MPS2)
+    if flown < slow_m:
+        # no distance behind to slow down in (a SID just after the runway): flown direct,
+        # the monitor reports the coded course not flown
+        commit(b, t)
+        b.finding("info", f"{why} (no room to slow to the minimum speed "
+                  f"{v_min / KT_MPS:.0f} kt: {slow_m / NM_M:.1f} NM needed, "
+                  f"{flown / NM_M:.1f} NM flown)")
+        return st
+    if r_min < 0.99 * b.radius_m:
+        t = trial(b)
+        t.speed_mps, t.radius_m = min(t.speed_mps, v_min), r_min
+        st = join_course(t, state, fix, course_deg, direction, flyby_end, course_leg=True)
+        if not any(f.category == "impossible" for f in t.findings):
+            commit(b, t)
+            b.finding("correction", f"course into {fix.ident} joined at the minimum speed "
+                      f"{t.speed_mps / KT_MPS:.0f} kt, radius {r_min:.0f} m (no room at the "
+                      f"planned radius {b.radius_m:.0f} m)", "V,γ")
+            return st
+    b.finding("impossible", f"no room to join the course {course_deg:.1f}° into {fix.ident} "
+              f"before the fix even at the minimum speed (radius {min(r_min, b.radius_m):.0f} "
+              f"m at the bank limit): the coded course cannot be flown (line {b.leg.rec.line})")
     return direct_to(b, state, fix, direction, flyby_end)
 
 
+REJOIN_ANGLES_DEG = (45.0, 35.0, 25.0, 15.0, 60.0, 75.0, 90.0)
+"""Intercept angles a turn from over a fix tries, in order, to rejoin the course out of it:
+the standard 45° first, shallower ones where its intercept leaves no room for the fly-by,
+steeper ones where it falls beyond the end of the leg, deg."""
+
+
 def _rejoin_intercept(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float,
-                      sweep: float) -> tuple[LegBuilder, FlightState, tuple, float] | None:
-    """The candidate turn from over ``fix`` continued α past the course (45°, else 35, 25,
-    15° — the first whose intercept leaves room for its fly-by): (trial builder, state at
-    the end of the turn, the intercept (distance, along), lead m), or None."""
+                      sweep: float, max_along_m: float = math.inf
+                      ) -> tuple[LegBuilder, FlightState, tuple, float] | None:
+    """The candidate turn from over ``fix`` continued α past the course
+    (:data:`REJOIN_ANGLES_DEG`: the first whose intercept leaves room for its fly-by, and
+    whose fly-by ends within ``max_along_m`` of the fix along the course): (trial builder, state at the end of the
+    turn, the intercept (distance, along), lead m), or None."""
     turn = "R" if sweep > 0 else "L"
-    for alpha in (45.0, 35.0, 25.0, 15.0):
+    for alpha in REJOIN_ANGLES_DEG:
         t = trial(b)
         over = wrap360(course_deg + math.copysign(alpha, sweep))
         arc = turn_to_course(state.lat_deg, state.lon_deg, state.track_deg, over, turn,
@@ -323,7 +392,7 @@ def _rejoin_intercept(b: LegBuilder, state: FlightState, fix: Fix, course_deg: f
         hit = ray_geodesic_intersection(st.lat_deg, st.lon_deg, st.track_deg, fix.lat_deg,
                                         fix.lon_deg, course_deg)
         lead = t.radius_m * math.tan(math.radians(alpha) / 2.0)
-        if hit is not None and hit[0] >= lead:
+        if hit is not None and hit[0] >= lead and hit[1] + lead <= max_along_m:
             return t, st, hit, lead
     return None
 
@@ -356,12 +425,13 @@ def join_from_fix(b: LegBuilder, state: FlightState, fix: Fix, course_deg: float
         return replace(state, track_deg=course_deg)
     if b.radius_m * (1.0 - math.cos(math.radians(min(abs(sweep), 180.0)))) < PARALLEL_TOL_M:
         return start_course(b, state, course_deg, direction)
-    got = _rejoin_intercept(b, state, fix, course_deg, sweep)
-    if got is None:   # no room for the intercept: back to the plain turn onto the course
+    got = _rejoin_intercept(b, state, fix, course_deg, sweep, max_along_m)
+    if got is None:
+        if _rejoin_intercept(b, state, fix, course_deg, sweep) is not None:
+            return None   # the intercept falls beyond max_along_m: nothing built
+        # no room for the intercept: back to the plain turn onto the course
         return start_course(b, state, course_deg, direction)
     t, st, hit, lead = got
-    if hit[1] + lead > max_along_m:
-        return None
     st = t.straight(st, st.track_deg, hit[0], role="turn")
     t._corner_pending = True
     commit(b, t)

@@ -18,6 +18,7 @@ from dataclasses import dataclass, replace
 from fms_testbed.core.geodesy import inverse, wrap180
 from fms_testbed.core.segments import Arc, project
 from fms_testbed.core.units import FT_M, G0_MPS2, KT_MPS, NM_M
+from fms_testbed.legs.builder import CF_OFF_COURSE_DEG
 from fms_testbed.legs.model import BuildParams, Finding, Performance, ProcedurePath
 from fms_testbed.legs.types import LEG_TYPES
 from fms_testbed.path.coding import hold_checks, record_checks
@@ -367,9 +368,6 @@ def _topology_checks(path: ProcedurePath) -> list[Finding]:
     return out
 
 
-CF_OFF_COURSE_DEG = 20.0
-"""A CF's own straight (role 'leg') more than this off its coded course is not the coded leg,
-deg."""
 CF_AGAINST_COURSE_DEG = 90.0
 """A CF's own straight more than this off its coded course is flown against it, deg."""
 
@@ -383,10 +381,13 @@ def cf_course_checks(path: ProcedurePath) -> list[Finding]:
     direct where the course cannot be joined at the planned radius, the corner flown over
     and the fix rejoined): a correction of branch V,γ,φ,λ (the position changed, class 1)
     that says the coded course is not flown. The turns and intercepts onto the course (roles
-    'turn', 'flyby') are transitions and not checked."""
+    'turn', 'flyby') are transitions and not checked, nor is a CF the builder found
+    impossible already (its finding gives the reason)."""
     out = []
+    done = {f.leg_index for f in path.findings if f.category == "impossible"}
     for lg in path.legs:
-        if lg.path_term != "CF" or lg.resolved is None or lg.resolved.course_true_deg is None:
+        if not LEG_TYPES[lg.path_term].course_to_fix or lg.resolved is None \
+                or lg.resolved.course_true_deg is None or lg.index in done:
             continue
         crs = lg.resolved.course_true_deg
         offs = [max(abs(wrap180(s.geom.start_course_deg - crs)),

@@ -567,9 +567,12 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
                  math.sqrt(r * b.g * math.tan(math.radians(gmax))) - b.wind_mps)
     tmp.i, tmp.speed_mps, tmp.radius_m = seg.leg_index, v_turn, r
     tmp.climbing = False
+    tmp.flown_before_m = b.flown_before_m + sum(
+        x.geom.length_m() for x in b.segments if x.leg_index < seg.leg_index)
     target = Fix(ident=seg.fix_ident, region="", section="", lat_deg=end[0], lon_deg=end[1])
     state = FlightState(lat, lon, a.geom.end_course_deg, 0.0, flyby=False)
-    join_course(tmp, state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False)
+    join_course(tmp, state, target, seg.geom.end_course_deg, "R" if omega > 0 else "L", False,
+                course_leg=LEG_TYPES[seg.path_term].course_to_fix)
     if depth == 0:
         segs = round_corners(tmp, b.perf, b.params, math.degrees(math.atan(
             (v_turn + b.wind_mps) ** 2 / (r * b.g))), depth=1)

@@ -9,7 +9,7 @@ import json
 import pytest
 
 from fms_testbed.cli import main
-from fms_testbed.cli.imu_test import BYTES_PER_SAMPLE, MEMORY_SHARE, check_duration
+from fms_testbed.cli.imu_test import BYTES_PER_PROFILE_S, FIXED_B, MEMORY_SHARE, check_duration
 from fms_testbed.cli.montecarlo import estimate_wall_s
 from fms_testbed.core.errors import UserError
 
@@ -49,8 +49,8 @@ def test_out_of_bounds_is_one_line(argv, says, tmp_path, capsys):
 
 def test_imu_test_limit_follows_the_memory():
     gib = 2 ** 30
-    # 100 Hz: one hour is 360,000 samples of BYTES_PER_SAMPLE
-    limit_h = MEMORY_SHARE * 16 * gib / BYTES_PER_SAMPLE / 100.0 / 3600.0
+    # streamed: one hour is 3,600 s of the temperature grid at BYTES_PER_PROFILE_S, any rate
+    limit_h = (MEMORY_SHARE * 16 * gib - FIXED_B) / BYTES_PER_PROFILE_S / 3600.0
     assert check_duration(limit_h * 0.99, 100.0, 16 * gib) == pytest.approx(limit_h * 0.99 * 3600)
     with pytest.raises(UserError, match=f"at most {limit_h:.0f} h at 100 Hz"):
         check_duration(limit_h * 1.01, 100.0, 16 * gib)

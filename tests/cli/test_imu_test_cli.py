@@ -94,3 +94,24 @@ def test_procedure_flight_on_the_compensated_stim210_has_a_smaller_nse(tmp_path)
               "--nav", "sins", "--imu", imu, "--no-plots", "--out", str(out)])
         nse[imu] = json.loads((out / "summary.json").read_text())["errors"]["nse"]["all"]["p95_m"]
     assert nse["STIM210+compensated"] * 4 < nse["STIM210"], nse
+
+
+def _peak_rss_kb(tmp_path, duration_h: str) -> int:
+    import subprocess
+    import sys
+
+    code = ("import resource, sys; from fms_testbed.cli import main; "
+            f"rc = main(['imu-test', '--duration-h', '{duration_h}', '--allan', '--out', "
+            f"sys.argv[1]]); print(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss); "
+            "sys.exit(rc)")
+    res = subprocess.run([sys.executable, "-c", code, str(tmp_path / f"h{duration_h}")],
+                         capture_output=True, text=True, check=True)
+    return int(res.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.slow
+def test_peak_memory_does_not_grow_with_the_duration(tmp_path):
+    # streamed in chunks: 10 h holds 3.6 M samples x 3 axes x 4 stages (1.4 GB as whole float64
+    # arrays) but only the chunks, the 1-s grid and 36,000 series rows more than 1 h
+    one, ten = _peak_rss_kb(tmp_path, "1"), _peak_rss_kb(tmp_path, "10")
+    assert ten < 1.25 * one, (one, ten)

@@ -62,3 +62,49 @@ def test_summary_is_strict_json_with_every_stage_and_the_seed_figures():
     assert list(df.columns[:4]) == ["t_s", "angle_none_x_deg", "angle_none_y_deg",
                                     "angle_none_z_deg"]
     assert df["t_s"].iloc[-1] == 1800.0 and len(df) == 1801
+
+
+def test_same_seed_same_numbers_whatever_the_chunk_size():
+    runs = [run_static_test("STIM210", 1500.0, "ramp", STAGES, seed=5, allan=True,
+                            chunk_samples=k) for k in (6_000, 37_337, 150_000)]
+    ref = runs[0].summary()
+    ref.pop("wall_time_s")
+    for r in runs[1:]:
+        s = r.summary()
+        s.pop("wall_time_s")
+        assert s == ref
+        np.testing.assert_array_equal(r.allan.adev_rps, runs[0].allan.adev_rps)
+        np.testing.assert_array_equal(r.window_temp_degC, runs[0].window_temp_degC)
+        for st in STAGES:
+            np.testing.assert_array_equal(r.angle_series_deg[st], runs[0].angle_series_deg[st])
+            np.testing.assert_array_equal(r.window_error_deg_per_s[st],
+                                          runs[0].window_error_deg_per_s[st])
+
+
+def test_streamed_stages_equal_the_whole_record_compensation():
+    from fms_testbed.sensors.mems.compensation import compensate, factory_calibration
+    from fms_testbed.sensors.mems.model import simulate_gyro
+    from fms_testbed.sensors.mems.preset import gyro_model, load_mems
+    from fms_testbed.sensors.mems.temperature import profile_for
+
+    spec = load_mems("STIM210")
+    cal_seq, run_seq = np.random.SeedSequence(2).spawn(2)
+    cal = factory_calibration(spec, np.random.default_rng(cal_seq))
+    rec = simulate_gyro(gyro_model(spec), profile_for("warmup", spec, 1200.0), 1200.0, 100.0,
+                        np.random.default_rng(run_seq))
+    whole = compensate(rec, STAGES, spec, cal)
+    res = run_static_test("STIM210", 1200.0, "warmup", STAGES, seed=2, chunk_samples=10_000)
+    rad2deg = 180.0 / np.pi
+    for st in STAGES:
+        angle = np.cumsum(whole.outputs[st], axis=0)[-1] * (rad2deg / 100.0)
+        np.testing.assert_array_equal(res.stage[st].angle_deg, angle)
+    np.testing.assert_array_equal(res.switch_on_offset_estimated_rps, whole.switch_on_offset_rps)
+
+
+def test_kept_series_is_one_second_up_to_100_h_and_bounded_beyond():
+    from fms_testbed.sensors.mems.static_test import MAX_SERIES_ROWS, series_step_s
+
+    assert series_step_s(7200.0) == 1.0 and series_step_s(100 * 3600.0) == 1.0
+    assert series_step_s(1000 * 3600.0) == 10.0
+    for h in (100.5, 333.3, 1000.0, 9999.0):
+        assert h * 3600.0 / series_step_s(h * 3600.0) <= MAX_SERIES_ROWS

@@ -172,15 +172,54 @@ def estimate_switch_on_offset(rate_rps: np.ndarray, rate_hz: float, interval_s: 
     return rate_rps[:n].mean(axis=0)
 
 
-def extract_slow_drift(rate_rps: np.ndarray, rate_hz: float, threshold_rps: float,
-                       cutoff_hz: float) -> np.ndarray:
-    """Stage 3: the slowly varying drift (n, 3), rad/s, to subtract from ``rate_rps``.
+class SlowDriftFilter:
+    """Stage 3 over a record given in chunks: the slowly varying drift (n, 3), rad/s.
 
     Samples with |ω| < threshold are error (mask m = 1), the others useful signal (m = 0). The
     drift is the normalised first-order low-pass of the error samples,
     d_k = LP(m ω)_k / LP(m)_k with LP: y_k = y_{k-1} + α (u_k - y_{k-1}), α = 1 - exp(-2π f_c Δt),
     which holds its last value while the signal stays above the threshold (both filters decay
-    alike) and is 0 before the first error sample. Causal: usable in real time.
+    alike) and is 0 before the first error sample. Causal: usable in real time; the filter
+    states are carried from chunk to chunk, so the drift does not depend on the chunk sizes.
+
+    Parameters
+    ----------
+    rate_hz : sample rate, Hz
+    threshold_rps : sensitivity threshold, rad/s
+    cutoff_hz : low-pass -3 dB frequency, Hz (the seed: below 0.1 Hz)
+    """
+
+    def __init__(self, rate_hz: float, threshold_rps: float, cutoff_hz: float):
+        alpha = -math.expm1(-2.0 * math.pi * cutoff_hz / rate_hz)
+        self.b, self.a = [alpha], [1.0, alpha - 1.0]
+        self.threshold_rps = float(threshold_rps)
+        self._zi_num = np.zeros((1, 3))
+        self._zi_den = np.zeros((1, 3))
+        self._last = np.zeros(3)          # drift held from the chunks before (0: none yet)
+
+    def drift(self, rate_rps: np.ndarray) -> np.ndarray:
+        """The drift (k, 3), rad/s, of the next chunk ``rate_rps`` (k, 3) of the output after the
+        earlier stages, rad/s."""
+        x = np.asarray(rate_rps, float)
+        mask = (np.abs(x) < self.threshold_rps).astype(float)
+        num, self._zi_num = lfilter(self.b, self.a, x * mask, axis=0, zi=self._zi_num)
+        den, self._zi_den = lfilter(self.b, self.a, mask, axis=0, zi=self._zi_den)
+        valid = den > 1e-12
+        ratio = np.divide(num, den, out=np.zeros_like(num), where=valid)
+        ratio = np.vstack([self._last, ratio])
+        idx = np.where(np.vstack([np.ones((1, 3), bool), valid]),
+                       np.arange(x.shape[0] + 1)[:, None], 0)
+        np.maximum.accumulate(idx, axis=0, out=idx)
+        out = np.take_along_axis(ratio, idx, axis=0)[1:]
+        if out.shape[0]:
+            self._last = out[-1].copy()
+        return out
+
+
+def extract_slow_drift(rate_rps: np.ndarray, rate_hz: float, threshold_rps: float,
+                       cutoff_hz: float) -> np.ndarray:
+    """Stage 3 on a whole record: the drift (n, 3), rad/s, to subtract from ``rate_rps``
+    (:class:`SlowDriftFilter`, the equation there).
 
     Parameters
     ----------
@@ -189,19 +228,7 @@ def extract_slow_drift(rate_rps: np.ndarray, rate_hz: float, threshold_rps: floa
     threshold_rps : sensitivity threshold, rad/s
     cutoff_hz : low-pass -3 dB frequency, Hz (the seed: below 0.1 Hz)
     """
-    x = np.asarray(rate_rps, float)
-    mask = (np.abs(x) < threshold_rps).astype(float)
-    alpha = -math.expm1(-2.0 * math.pi * cutoff_hz / rate_hz)
-    b, a = [alpha], [1.0, alpha - 1.0]
-    num = lfilter(b, a, x * mask, axis=0)
-    den = lfilter(b, a, mask, axis=0)
-    valid = den > 1e-12
-    idx = np.where(valid, np.arange(x.shape[0])[:, None], 0)
-    np.maximum.accumulate(idx, axis=0, out=idx)
-    ratio = np.divide(num, den, out=np.zeros_like(num), where=valid)
-    drift = np.take_along_axis(ratio, idx, axis=0)
-    seen = np.maximum.accumulate(valid, axis=0)
-    return np.where(seen, drift, 0.0)
+    return SlowDriftFilter(rate_hz, threshold_rps, cutoff_hz).drift(rate_rps)
 
 
 @dataclass(frozen=True)
@@ -218,9 +245,62 @@ class Compensated:
     slow_drift_rps: np.ndarray | None
 
 
+class Compensator:
+    """The stages applied to a run given in chunks (the first chunk must hold the run-to-run
+    interval); each chunk's outputs are those of :func:`compensate` on the whole run.
+
+    Parameters
+    ----------
+    stages : stages in canonical order (:func:`parse_stages`)
+    spec : the preset (run-to-run interval, slow-drift threshold and cut-off)
+    calibration : stage-1 fit, needed when ``temperature`` is among the stages
+    rate_hz : sample rate, Hz
+
+    Attributes
+    ----------
+    switch_on_offset_rps : (3,) stage-2 estimate after the first chunk, rad/s (None without
+        stage 2)
+    """
+
+    def __init__(self, stages: tuple[str, ...], spec: MemsSpec,
+                 calibration: TemperatureCalibration | None, rate_hz: float):
+        if "temperature" in stages and calibration is None:
+            raise ValueError("compensate: the temperature stage needs a calibration")
+        self.stages, self.spec, self.calibration = tuple(stages), spec, calibration
+        self.rate_hz = float(rate_hz)
+        self.switch_on_offset_rps = None
+        s = spec.slow_drift
+        self._drift = SlowDriftFilter(rate_hz, s.threshold_deg_per_s * DEG_RAD, s.cutoff_hz) \
+            if "slow-drift" in stages else None
+
+    def step(self, rate_rps: np.ndarray, temp_degC: np.ndarray
+             ) -> tuple[dict[str, np.ndarray], np.ndarray | None]:
+        """(stage → (k, 3) output after that stage and the ones before it, rad/s; the stage-3
+        drift (k, 3) rad/s or None) of the next chunk (output (k, 3) rad/s, temperature (k,) °C)."""
+        x = rate_rps
+        outputs: dict[str, np.ndarray] = {}
+        drift = None
+        if "none" in self.stages:
+            outputs["none"] = x
+        if "temperature" in self.stages:
+            x = self.calibration.apply(x, temp_degC)
+            outputs["temperature"] = x
+        if "run-to-run" in self.stages:
+            if self.switch_on_offset_rps is None:
+                self.switch_on_offset_rps = estimate_switch_on_offset(
+                    x, self.rate_hz, self.spec.run_to_run.initial_interval_s)
+            x = x - self.switch_on_offset_rps
+            outputs["run-to-run"] = x
+        if self._drift is not None:
+            drift = self._drift.drift(x)
+            x = x - drift
+            outputs["slow-drift"] = x
+        return outputs, drift
+
+
 def compensate(record: GyroRecord, stages: tuple[str, ...], spec: MemsSpec,
                calibration: TemperatureCalibration | None) -> Compensated:
-    """Apply the stages to a run.
+    """Apply the stages to a whole run (:class:`Compensator` with one chunk).
 
     Parameters
     ----------
@@ -229,24 +309,6 @@ def compensate(record: GyroRecord, stages: tuple[str, ...], spec: MemsSpec,
     spec : the preset (run-to-run interval, slow-drift threshold and cut-off)
     calibration : stage-1 fit, needed when ``temperature`` is among the stages
     """
-    x = record.rate_rps
-    outputs: dict[str, np.ndarray] = {}
-    offset = drift = None
-    if "none" in stages:
-        outputs["none"] = x
-    if "temperature" in stages:
-        if calibration is None:
-            raise ValueError("compensate: the temperature stage needs a calibration")
-        x = calibration.apply(x, record.temp_degC)
-        outputs["temperature"] = x
-    if "run-to-run" in stages:
-        offset = estimate_switch_on_offset(x, record.rate_hz, spec.run_to_run.initial_interval_s)
-        x = x - offset
-        outputs["run-to-run"] = x
-    if "slow-drift" in stages:
-        s = spec.slow_drift
-        drift = extract_slow_drift(x, record.rate_hz, s.threshold_deg_per_s * DEG_RAD,
-                                   s.cutoff_hz)
-        x = x - drift
-        outputs["slow-drift"] = x
-    return Compensated(outputs, offset, drift)
+    comp = Compensator(stages, spec, calibration, record.rate_hz)
+    outputs, drift = comp.step(record.rate_rps, record.temp_degC)
+    return Compensated(outputs, comp.switch_on_offset_rps, drift)

@@ -1,12 +1,18 @@
 """The static ``imu-test``: one switch-on of a MEMS gyro at rest, compensated stage by stage.
 
 :func:`run_static_test` simulates the factory calibration run (when the temperature stage is
-applied) and the test run, applies the chosen stages (:func:`~.compensation.compensate`) and
+applied) and the test run, applies the chosen stages (:class:`~.compensation.Compensator`) and
 measures, per stage and axis: the residual zero signal (the largest |mean| of consecutive
 ``evaluation.zero_signal_window_s`` windows, as the seed's "maximum undercompensated zero
 signal"), the mean drift (angle / duration) and the angle accumulated over the run. The result
-object carries the series the plots draw (decimated to 1 s) and a JSON summary with the seed's
-figures next to the measured ones.
+object carries the series the plots draw (one sample per :func:`series_step_s`) and a JSON
+summary with the seed's figures next to the measured ones.
+
+The test run is generated, compensated and reduced in chunks of ``chunk_samples``
+(:class:`~.model.GyroStream`, :class:`~.allan.OctaveAllan`), so its memory is bounded by the
+chunk, the kept series (at most :data:`MAX_SERIES_ROWS` rows) and the 1-s temperature grid,
+whatever the duration; every reduction carries its state or works on blocks aligned on the run,
+so the numbers do not depend on the chunk size.
 
 Seeds: ``numpy.random.SeedSequence(seed).spawn(2)`` gives the calibration run's and the test
 run's generators, so the same seed gives the same numbers whatever the stages.
@@ -21,16 +27,31 @@ import numpy as np
 import pandas as pd
 
 from fms_testbed.core.units import DEG_RAD
-from fms_testbed.sensors.mems.allan import AllanFit, fit_allan
-from fms_testbed.sensors.mems.compensation import (STAGES, TemperatureCalibration, compensate,
-                                                   factory_calibration, window_means)
-from fms_testbed.sensors.mems.model import simulate_gyro
+from fms_testbed.sensors.mems.allan import AllanFit, BlockReducer, OctaveAllan
+from fms_testbed.sensors.mems.compensation import (STAGES, Compensator, TemperatureCalibration,
+                                                   factory_calibration)
+from fms_testbed.sensors.mems.model import GyroStream
 from fms_testbed.sensors.mems.preset import MemsSpec, gyro_model, load_mems
 from fms_testbed.sensors.mems.temperature import TemperatureProfile, profile_for
 
 RAD2DEG = 1.0 / DEG_RAD
 SERIES_STEP_S = 1.0
-"""Step of the angle series kept for the CSV and the plots, s."""
+"""Step of the angle series kept for the CSV and the plots, s (longer runs: :func:`series_step_s`)."""
+MAX_SERIES_ROWS = 360_000
+"""Most steps of the kept angle series (100 h at 1 s)."""
+CHUNK_SAMPLES = 2 ** 17
+"""Samples of the test run generated and reduced at a time (22 min at 100 Hz)."""
+
+
+def series_step_s(duration_s: float) -> float:
+    """Step of the kept angle series, s: :data:`SERIES_STEP_S`, or the whole number of seconds
+    that keeps at most :data:`MAX_SERIES_ROWS` steps, Δ = max(1 s, ⌈duration / rows⌉).
+
+    Parameters
+    ----------
+    duration_s : length of the test, s
+    """
+    return max(SERIES_STEP_S, float(np.ceil(duration_s / MAX_SERIES_ROWS - 1e-9)))
 
 
 @dataclass(frozen=True)
@@ -150,21 +171,37 @@ def _r(a) -> list[float]:
     return [float(f"{v:.5g}") for v in np.asarray(a, float)]
 
 
-def _stage_result(err_rps: np.ndarray, rate_hz: float, window_n: int, keep_every: int
-                  ) -> tuple[StageResult, np.ndarray, np.ndarray]:
-    """(stage result, angle series (m, 3) °, window means (k, 3) °/s) of one output error."""
-    angle = np.cumsum(err_rps, axis=0) * (RAD2DEG / rate_hz)
-    win = window_means(err_rps, window_n) * RAD2DEG
-    duration = err_rps.shape[0] / rate_hz
-    res = StageResult(np.abs(win).max(axis=0), angle[-1] / duration, angle[-1].copy())
-    series = np.vstack([np.zeros((1, 3)), angle[keep_every - 1::keep_every]])
-    return res, series, win
+class _StageReducer:
+    """Angle, window means and kept angle series of one stage's output error, chunk by chunk."""
+
+    def __init__(self, rate_hz: float, window_n: int, keep_every: int):
+        self.rate_hz, self.keep = rate_hz, keep_every
+        self._windows = BlockReducer(window_n, 3)
+        self._sum = np.zeros(3)              # Σ error so far, rad/s (angle · rate)
+        self.i = 0
+        self.series = [np.zeros((1, 3))]
+        self.window = []
+
+    def update(self, err_rps: np.ndarray) -> None:
+        c = np.cumsum(np.vstack([self._sum, err_rps]), axis=0)[1:]
+        self._sum = c[-1].copy()
+        first = (-(self.i + 1)) % self.keep          # first row whose sample number is kept
+        self.series.append(c[first::self.keep] * (RAD2DEG / self.rate_hz))
+        self.window.append(self._windows.means(err_rps) * RAD2DEG)
+        self.i += err_rps.shape[0]
+
+    def result(self) -> tuple[StageResult, np.ndarray, np.ndarray]:
+        angle = self._sum * (RAD2DEG / self.rate_hz)
+        win = np.vstack(self.window)
+        res = StageResult(np.abs(win).max(axis=0), angle / (self.i / self.rate_hz), angle)
+        return res, np.vstack(self.series), win
 
 
 def run_static_test(imu: str | MemsSpec = "STIM210", duration_s: float = 7200.0,
                     profile: str = "warmup", stages: tuple[str, ...] = STAGES, seed: int = 0,
-                    allan: bool = False, rate_hz: float | None = None) -> StaticTestResult:
-    """Simulate and compensate one static switch-on (module docstring).
+                    allan: bool = False, rate_hz: float | None = None,
+                    chunk_samples: int = CHUNK_SAMPLES) -> StaticTestResult:
+    """Simulate and compensate one static switch-on, in chunks (module docstring).
 
     Parameters
     ----------
@@ -173,8 +210,11 @@ def run_static_test(imu: str | MemsSpec = "STIM210", duration_s: float = 7200.0,
     profile : ``warmup`` | ``ramp`` | ``constant`` | path of a CSV profile
     stages : stages in canonical order (:func:`~.compensation.parse_stages`)
     seed : seed of the calibration and test runs
-    allan : also fit the Allan deviation of the output of the last stage before slow drift
+    allan : also fit the octave Allan deviation of the output of the last stage before slow
+        drift
     rate_hz : output rate, Hz (default: the preset's ``sample_rate_hz``)
+    chunk_samples : samples generated and reduced at a time (at least the run-to-run interval;
+        the numbers do not depend on it)
     """
     t0 = time.perf_counter()
     spec = load_mems(imu)
@@ -183,24 +223,33 @@ def run_static_test(imu: str | MemsSpec = "STIM210", duration_s: float = 7200.0,
     cal_seq, run_seq = np.random.SeedSequence(int(seed)).spawn(2)
     cal = factory_calibration(spec, np.random.default_rng(cal_seq)) \
         if "temperature" in stages else None
-    rec = simulate_gyro(gyro_model(spec), prof, duration_s, rate, np.random.default_rng(run_seq))
-    comp = compensate(rec, stages, spec, cal)
+    src = GyroStream(gyro_model(spec), prof, duration_s, rate, np.random.default_rng(run_seq))
+    comp = Compensator(stages, spec, cal, rate)
     # a test shorter than one evaluation window is evaluated as one window
-    window_n = min(max(1, int(round(spec.evaluation.zero_signal_window_s * rate))),
-                   rec.rate_rps.shape[0])
-    keep = max(1, int(round(SERIES_STEP_S * rate)))
+    window_n = min(max(1, int(round(spec.evaluation.zero_signal_window_s * rate))), src.n)
+    keep = max(1, int(round(series_step_s(duration_s) * rate)))
+    chunk = max(int(chunk_samples), int(round(spec.run_to_run.initial_interval_s * rate)))
+    reducers = {st: _StageReducer(rate, window_n, keep) for st in stages}
+    temp_windows, temp_means = BlockReducer(window_n), []
+    sig = [s for s in stages if s != "slow-drift"]
+    sig_name = sig[-1] if sig else "slow-drift"
+    octave = OctaveAllan(src.n, rate) if allan else None
+    while src.i < src.n:
+        _, temp, out = src.next(chunk)
+        outputs, _ = comp.step(out, temp)
+        for st, y in outputs.items():            # static: the output is the error
+            reducers[st].update(y)
+        temp_means.append(temp_windows.means(temp))
+        if octave is not None:
+            octave.update(outputs[sig_name])
     stage, series, windows = {}, {}, {}
-    for st, out in comp.outputs.items():
-        stage[st], series[st], windows[st] = _stage_result(out - rec.true_rate_rps, rate,
-                                                           window_n, keep)
+    for st, red in reducers.items():
+        stage[st], series[st], windows[st] = red.result()
     n_series = next(iter(series.values())).shape[0]
     kw = {}
     if allan:
-        sig = [s for s in comp.outputs if s != "slow-drift"]
-        sig_name = sig[-1] if sig else "slow-drift"
         g = spec.gyro
-        kw = dict(allan=fit_allan(comp.outputs[sig_name] - rec.true_rate_rps, rate),
-                  allan_signal=sig_name,
+        kw = dict(allan=octave.fit(), allan_signal=sig_name,
                   preset_allan={"arw_deg_per_sqrt_h": g.arw_deg_per_sqrt_h,
                                 "bias_instability_deg_per_h": g.bias_instability_deg_per_h,
                                 "rrw_deg_per_h_per_sqrt_h":
@@ -210,8 +259,7 @@ def run_static_test(imu: str | MemsSpec = "STIM210", duration_s: float = 7200.0,
         imu=spec.name, seed=int(seed), duration_s=float(duration_s), rate_hz=rate, profile=prof,
         stages=tuple(stages), stage=stage, series_t_s=np.arange(n_series) * keep / rate,
         angle_series_deg=series, window_t_s=win_t,
-        window_temp_degC=window_means(rec.temp_degC, window_n), window_error_deg_per_s=windows,
-        calibration=cal, switch_on_offset_true_rps=rec.switch_on_offset_rps,
+        window_temp_degC=np.concatenate(temp_means), window_error_deg_per_s=windows,
+        calibration=cal, switch_on_offset_true_rps=src.switch_on_offset_rps,
         switch_on_offset_estimated_rps=comp.switch_on_offset_rps,
         reference=spec.reference.model_dump(), wall_time_s=time.perf_counter() - t0, **kw)
-
