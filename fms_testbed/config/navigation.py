@@ -243,6 +243,10 @@ class AttitudeReferenceBlock(BaseModel):
         0.05, description="σ of the computer's initial velocity error per axis, m/s")
     gate_sigma: Annotated[float, Field(gt=0, le=100)] = Field(
         5.0, description="innovation gate per component, σ")
+    truth_model: Literal["strapdown", "linear"] = Field(
+        "strapdown", description="truth side: the accelerometers' measured increments resolved "
+                                 "with the reference's angles by a strapdown computer, or "
+                                 "truth ⊕ the computer's linear 15-state error model")
 
 
 NavigationBlock = Annotated[Union[TruthBlock, SinsBlock, InsGnssBlock, AttitudeReferenceBlock],

@@ -2,14 +2,17 @@
 roll and pitch errors of an attitude reference in flight from GNSS position and velocity.
 
 The reference's angles resolve an accurate accelerometer block in a strapdown computer
-(:mod:`fms_testbed.sensors.attitude_reference`, truth side); the differences between the
+(:class:`FlightTestComputer` on the sensors' measurements, ``truth_model: strapdown``; or truth ⊕
+the computer's linear error model, ``truth_model: linear``,
+:mod:`fms_testbed.sensors.attitude_reference`); the differences between the
 computer's and the GNSS receiver's position and velocity feed a discrete Kalman filter over
 seed 004's state vector — 15 computer/reference errors (δp, δV, the reference's δγ, δϑ, δψ, their
 drifts, accelerometer biases) plus 6 GNSS Markov errors (position, velocity)::
 
     z_p = p_comp - p_GNSS = δp - m_p - w_p      z_v = V_comp - V_GNSS = δV - m_v - w_v
 
-Φ_k and Q_k come from the Picard series over F at the computer's indicated state
+Φ_k and Q_k come from the Picard series over F at the computer's indicated state and the
+accelerometers' measured specific force
 (:func:`~fms_testbed.sensors.attitude_reference.system_matrix`, at the angles the computer
 resolves with); prediction and the Joseph-form correction (delayed for a late fix) are
 :mod:`.kalman`'s. After a used fix the estimate of (δp, δV, angle and drift residuals) is fed
@@ -30,6 +33,7 @@ Scenario block (``navigation:``, validated by
     init_pos_sigma_m: 1.0
     init_vel_sigma_mps: 0.05
     gate_sigma: 5
+    truth_model: strapdown            # strapdown (measured increments) | linear (fast mode)
 
 Logged columns (``NavSolution.errors``), per angle in (roll, pitch, heading):
 ``att_ref_err_<a>_deg`` (injected: the reference's error, indicated minus true),
@@ -56,20 +60,24 @@ from pydantic import ValidationError
 from fms_testbed.config.navigation import AttitudeReferenceBlock
 from fms_testbed.config.yamlfile import validation_message
 from fms_testbed.core.contracts import NavigationSourceBase
-from fms_testbed.core.earth import radii_m
+from fms_testbed.core.earth import radii_m, sea_level_height_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState, NavSolution
-from fms_testbed.core.units import DEG_RAD, DPH_RPS
+from fms_testbed.core.units import DEG_RAD, DPH_RPS, G0_MPS2
+from fms_testbed.navigation.fdi import unmodelled_variances
 from fms_testbed.navigation.ins_bank import derive_seeds
 from fms_testbed.navigation.measurements import enu_difference_m
 from fms_testbed.navigation.ins_gnss import gnss_spec
+from fms_testbed.navigation.inertial.strapdown import correct_row
 from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed, innovation,
                                           predict)
 from fms_testbed.sensors.attitude_reference import (ANGLES, N_STATES, AttitudeReferenceSpec,
-                                                    FlightTestErrors, initial_variance,
+                                                    FlightTestErrors, FlightTestSensors,
+                                                    initial_variance,
                                                     noise_density, system_matrix)
 from fms_testbed.sensors.gnss import GnssFix, GnssReceiver, GnssSpec
 from fms_testbed.sensors.sins.analysis import horizontal_radius
+from fms_testbed.sensors.imu.kinematics import euler_to_quat, forward_step, inverse_step
 from fms_testbed.sensors.sins.discretize import discretize
 from fms_testbed.sensors.sins.presets import ImuModel, load_imu
 
@@ -91,11 +99,23 @@ class AttitudeReferenceFilter:
     gnss : the GNSS receiver's declared error model
     p0 : (15,) prior variance of the computer/reference states (GNSS states: stationary)
     gate_sigma : innovation gate per component, σ
+    unmodelled_tau_s : correlation time τ_u of the process noise standing in for the
+        accelerometers' scale-factor and misalignment errors the filter does not carry, s
+
+    The accelerometers' scale factor k and misalignment β (declared in ``imu``, not states
+    here) are covered as in the INS/GNSS filter: their 1 g equivalent bias (β_xz g, β_yz g,
+    k_z g) widens the bias prior, and white noise of density 2 σ² |Δf|² τ_u (σ² the declared
+    scale-factor + misalignment variance, Δf the specific force's departure from 1 g) is added
+    on δV; both vanish for a block without those errors.
     """
 
     def __init__(self, spec: AttitudeReferenceSpec, imu: ImuModel, gnss: GnssSpec,
-                 p0: np.ndarray, gate_sigma: float = 5.0):
+                 p0: np.ndarray, gate_sigma: float = 5.0, unmodelled_tau_s: float = 20.0):
         n = N_FILTER
+        self._var_acc = unmodelled_variances(imu)[0]
+        self._tau_u = float(unmodelled_tau_s)
+        p0 = np.array(p0, float)
+        p0[12:15] += np.array([imu.p0_var[22], imu.p0_var[24], imu.p0_var[17]]) * G0_MPS2 ** 2
         self.gnss, self.gate_sigma = gnss, float(gate_sigma)
         self.q = np.zeros(n)
         self.q[:N_STATES] = noise_density(spec, imu)
@@ -118,12 +138,20 @@ class AttitudeReferenceFilter:
                 dt_s: float) -> None:
         """Propagate over ``dt_s`` (s) from ``t_s`` with F at the computer's indicated state
         (latitude rad, height m, velocity m/s, the reference's angles rad) and the specific
-        force (body, m/s²): x⁻ = Φ x, P⁻ = Φ P Φᵀ + Q_k (Picard, Babich eq. 2.9, 4.5)."""
+        force (body, m/s², the accelerometers' measured mean over the step): x⁻ = Φ x,
+        P⁻ = Φ P Φᵀ + Q_k (Picard, Babich eq. 2.9, 4.5), Q with the unmodelled term (class
+        docstring)."""
         F = np.zeros((N_FILTER, N_FILTER))
         F[:N_STATES, :N_STATES] = system_matrix(lat_rad, alt_m, v_enu_mps, f_b_mps2, rpy_rad,
                                                 self._ba_decay)
         F[np.arange(15, 21), np.arange(15, 21)] = -self._decay[15:21]
-        phi, qk = discretize(F, np.diag(self.q), dt_s, method="picard")
+        q = self.q
+        if self._var_acc > 0 and self._tau_u > 0:
+            f = np.asarray(f_b_mps2, float)
+            df2 = max(float(f @ f) - 2.0 * G0_MPS2 * abs(float(f[2])) + G0_MPS2 ** 2, 0.0)
+            q = q.copy()
+            q[3:6] += 2.0 * self._var_acc * df2 * self._tau_u
+        phi, qk = discretize(F, np.diag(q), dt_s, method="picard")
         self.x, self.P = predict(self.x, self.P, phi, qk)
         self._lag.append(t_s, phi, qk)
 
@@ -167,6 +195,112 @@ class AttitudeReferenceFilter:
         return dx
 
 
+class FlightTestComputer:
+    """The flight-test strapdown computer on measured data (``truth_model: strapdown``).
+
+    Per frame it resolves the accelerometers' measured Δv with the attitude the reference's
+    output angles minus its correction c give, q_k = q(γ̃ - c_γ, ϑ̃ - c_ϑ, ψ̃ - c_ψ), and advances
+    position and velocity with the project's strapdown step
+    (:func:`~fms_testbed.sensors.imu.kinematics.forward_step`: WGS-84, Earth and transport rate,
+    rotation and sculling terms, gravity, Coriolis). The body rotation those terms need is the
+    one the angle samples imply, Δθ with q_k = q(-ζ) ⊗ q_{k-1} ⊗ q(Δθ + Δθ' × Δθ/12)
+    (:func:`~fms_testbed.sensors.imu.kinematics.inverse_step` of the attitude at the frame's
+    start velocity); the attitude is then set to q_k. Nothing here reads the true state: the
+    sensors (:class:`~fms_testbed.sensors.attitude_reference.FlightTestSensors`) make the only
+    reads, and the output of :meth:`computer_position` is the computer's own.
+
+    Parameters
+    ----------
+    sensors : the flight-test sensors (accelerometer block, attitude reference)
+    seed : seed of the computer's initial position and velocity error
+    pos_sigma_m, vel_sigma_mps : σ of that error per ENU axis (the initialising fix), m, m/s
+    """
+
+    truth_model = "strapdown"
+
+    def __init__(self, sensors: FlightTestSensors, seed: int, pos_sigma_m: float = 1.0,
+                 vel_sigma_mps: float = 0.05):
+        self.sensors = sensors
+        self.spec = sensors.spec
+        self._rng = np.random.default_rng(seed)
+        self._sig = (float(pos_sigma_m), float(vel_sigma_mps))
+        self.row: np.ndarray | None = None
+        self.ref_out = np.zeros(3)          # the reference's last output angles, rad
+        self.c_rad = np.zeros(3)            # the computer's angle correction c, rad
+        self.c_rps = np.zeros(3)            # and its drift correction c_d, rad/s
+        self._f = np.zeros(3)
+        self._scratch = np.zeros(22)
+        self._zero3 = np.zeros(3)
+
+    @property
+    def frame_properties(self):
+        """The JSBSim samples the sensors need per frame."""
+        return self.sensors.frame_properties
+
+    def _set_attitude(self) -> None:
+        a = self.ref_out - self.c_rad
+        self.row[6:10] = euler_to_quat(a[0], a[1], a[2])
+
+    def update(self, truth: AircraftState, frames=None) -> None:
+        """Take the sensors' measurements up to ``truth.t_s`` and mechanise them (the first
+        call initialises on the sensors' first sample and an initial fix error)."""
+        if self.row is None:
+            self.ref_out = self.sensors.start(truth)
+            self.row = self.sensors.T.copy()
+            self.row[10:] = 0.0
+            p, v = self._sig
+            self.reset(np.r_[-p * self._rng.standard_normal(3), -v * self._rng.standard_normal(3),
+                             np.zeros(6)])
+            return
+        dt, dv, ang = self.sensors.step(truth, frames)
+        row, scr = self.row, self._scratch
+        c0 = self.c_rad
+        for j in range(dv.shape[0]):
+            c = c0 + self.c_rps * (dt * (j + 1))
+            a = ang[j] - c
+            q1 = euler_to_quat(a[0], a[1], a[2])
+            scr[:] = row
+            dth, _ = inverse_step(scr, (row[3], row[4], row[5]), q1, dt)
+            forward_step(row, dth, (dv[j, 0], dv[j, 1], dv[j, 2]), dt)
+            row[6:10] = q1
+        self.c_rad = c0 + self.c_rps * (dt * dv.shape[0])
+        self.ref_out = ang[-1].copy()
+        self._f = dv.sum(axis=0) / (dt * dv.shape[0])
+
+    def specific_force_mps2(self) -> np.ndarray:
+        """(3,) the accelerometers' mean measured specific force over the last step, m/s²."""
+        return self._f.copy()
+
+    def angle_errors_rad(self) -> np.ndarray:
+        """(3,) the reference's current errors, indicated minus true, rad (truth side: logged,
+        not used by the computer or the filter)."""
+        return self.sensors.angle_errors_rad()
+
+    def computer_angles(self, truth=None) -> tuple[float, float, float]:
+        """(roll, pitch, heading) the computer resolves with: the reference's minus c, rad."""
+        a = self.ref_out - self.c_rad
+        return float(a[0]), float(a[1]), float(a[2]) % (2 * math.pi)
+
+    def computer_position(self, truth=None) -> tuple[float, float, float, np.ndarray]:
+        """(lat rad, lon rad, alt m (sea-level datum), V ENU (3,) m/s) of the computer."""
+        r = self.row
+        return (float(r[0]), float(r[1]), float(sea_level_height_m(r[0], r[2])),
+                np.array([r[4], r[3], -r[5]]))
+
+    def reset(self, dx: np.ndarray) -> None:
+        """Feedback of an estimate (12,) of (δp ENU m, δV ENU m/s, angle and drift residuals
+        rad, rad/s; indicated minus true): position and velocity corrected
+        (:func:`~fms_testbed.navigation.inertial.strapdown.correct_row`, no attitude part), the
+        angle and drift parts added to c, c_d and the attitude re-resolved."""
+        dx = np.asarray(dx, float)
+        d9 = np.zeros(9)
+        d9[:6] = dx[:6]
+        correct_row(self.row, d9, self._zero3, self._zero3)
+        self.c_rad = self.c_rad + dx[6:9]
+        self.c_rps = self.c_rps + dx[9:12]
+        self._set_attitude()
+
+
 def reference_spec(block) -> AttitudeReferenceSpec:
     """:class:`AttitudeReferenceSpec` (SI) from a validated ``navigation.reference`` block."""
     def rad(v):
@@ -198,8 +332,10 @@ class AttitudeReferenceNavigation(NavigationSourceBase):
     def __init__(self, errors: FlightTestErrors, receiver: GnssReceiver,
                  flt: AttitudeReferenceFilter):
         self.errors, self.receiver, self.filter = errors, receiver, flt
+        self.truth_model = errors.truth_model
+        self.frame_properties = tuple(getattr(errors, "frame_properties", ()))
         self.events: list[dict] = []
-        self._prev: tuple | None = None        # (truth, computer output, reference angles)
+        self._prev: tuple | None = None        # (t_s, computer output, angles it resolves with)
         self._buffer: list[tuple[float, tuple]] = []
         self._gate_open = {"gnss_pos": True, "gnss_vel": True}
         self.nis_log: list[tuple[float, str, float]] = []
@@ -221,7 +357,12 @@ class AttitudeReferenceNavigation(NavigationSourceBase):
         sd = b.seed if b.seed is not None else (0 if seed is None else int(seed))
         s_gnss, s_ref = derive_seeds(sd, 2)
         ref, g = reference_spec(b.reference), gnss_spec(b.gnss)
-        errs = FlightTestErrors(ref, imu, s_ref, b.init_pos_sigma_m, b.init_vel_sigma_mps)
+        if b.truth_model == "strapdown":
+            s_sens, s_comp = derive_seeds(s_ref, 2)
+            errs = FlightTestComputer(FlightTestSensors(ref, b.imu, s_sens), s_comp,
+                                      b.init_pos_sigma_m, b.init_vel_sigma_mps)
+        else:
+            errs = FlightTestErrors(ref, imu, s_ref, b.init_pos_sigma_m, b.init_vel_sigma_mps)
         p0 = initial_variance(ref, imu, b.init_pos_sigma_m, b.init_vel_sigma_mps)
         src = cls(errs, GnssReceiver(g, s_gnss), AttitudeReferenceFilter(ref, imu, g, p0,
                                                                          b.gate_sigma))
@@ -238,13 +379,13 @@ class AttitudeReferenceNavigation(NavigationSourceBase):
         """Advance to ``truth.t_s``: truth-side errors, prediction, any delivered GNSS fix
         (gated; then the computer's reset); return the corrected solution."""
         errs, flt = self.errors, self.filter
-        errs.update(truth)
+        errs.update(truth, frames)
         comp = errs.computer_position(truth)
         ref = errs.computer_angles(truth)
         prev = self._prev
-        if prev is not None and truth.t_s > prev[0].t_s:
+        if prev is not None and truth.t_s > prev[0]:
             pt, pc, pr = prev
-            flt.predict(pt.t_s, pc[0], pc[2], pc[3], pr, pt.f_body_mps2, truth.t_s - pt.t_s)
+            flt.predict(pt, pc[0], pc[2], pc[3], pr, errs.specific_force_mps2(), truth.t_s - pt)
         self._buffer.append((truth.t_s, comp))
         while self._buffer and self._buffer[0][0] < truth.t_s - _BUFFER_S:
             self._buffer.pop(0)
@@ -266,7 +407,7 @@ class AttitudeReferenceNavigation(NavigationSourceBase):
                 comp = errs.computer_position(truth)
                 ref = errs.computer_angles(truth)
                 self._buffer[-1] = (truth.t_s, comp)
-        self._prev = (truth, comp, ref)
+        self._prev = (truth.t_s, comp, ref)
         return self.solution(truth, comp, ref)
 
     def solution(self, truth: AircraftState, comp: tuple, ref: tuple) -> NavSolution:

@@ -21,9 +21,18 @@ seed 004's order with the attitude errors as Euler angles)::
 
 obeys ẋ = F x + w with the position/velocity rows of the project's SINS model
 (:func:`~fms_testbed.sensors.sins.model.build_F`, free vertical channel) and
-δV̇ = … + [f^N ×] M (δγ, δϑ, δψ) + C b_a. The truth side propagates this linear model at the true
-state (the project's convention for INS errors: truth ⊕ an error realisation), discretised by the
-Picard series (:func:`~fms_testbed.sensors.sins.discretize.discretize`).
+δV̇ = … + [f^N ×] M (δγ, δϑ, δψ) + C b_a. This is the filter's model; the truth side is one of:
+
+* ``truth_model: strapdown`` (default): :class:`FlightTestSensors` — the accelerometer block's
+  measured increments (error-free increments of the sampled motion plus the preset's errors)
+  and the reference's output angles (the sampled attitude plus :class:`ReferenceAngleErrors`);
+  the computer that mechanises them is navigation's
+  (:class:`fms_testbed.navigation.attitude_reference.FlightTestComputer`), so its errors are
+  whatever the nonlinear mechanisation makes of the sensors' errors;
+* ``truth_model: linear`` (the fast mode): :class:`FlightTestErrors` propagates this linear
+  model at the true state (the project's convention for INS errors: truth ⊕ an error
+  realisation), discretised by the Picard series
+  (:func:`~fms_testbed.sensors.sins.discretize.discretize`).
 
 Closed loop: the computer resolves the accelerometers with the reference's angles minus its
 current estimate of their errors, c(t) (ċ = c_d, both updated by the filter's feedback,
@@ -44,6 +53,10 @@ import numpy as np
 from fms_testbed.core.earth import radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState
+from fms_testbed.sensors.imu.errors import (N_ROW, ROW_A, ROW_LSB, ROW_RES, ROW_S, ROW_WSD,
+                                            ImuErrors, advance_slow, imu_error_params,
+                                            measure_row)
+from fms_testbed.sensors.imu.synthesis import FRAME_PROPERTIES, sample_of, start_row, synthesize
 from fms_testbed.sensors.sins.discretize import discretize
 from fms_testbed.sensors.sins.euler import euler_errors_to_eps
 from fms_testbed.sensors.sins.model import build_F, dcm_body_to_enu
@@ -178,14 +191,19 @@ class FlightTestErrors:
         self._prev: AircraftState | None = None
         self.c_rad = np.zeros(3)            # the computer's angle correction c, rad
         self.c_rps = np.zeros(3)            # and its drift correction c_d, rad/s
+        self._f_meas: np.ndarray | None = None
 
-    def update(self, truth: AircraftState) -> None:
+    truth_model = "linear"
+
+    def update(self, truth: AircraftState, frames=None) -> None:
         """Propagate the errors from the previous true state to ``truth.t_s`` (F at the previous
-        true state, Picard Φ_k and Q_k, one Gaussian draw of the discrete noise)."""
+        true state, Picard Φ_k and Q_k, one Gaussian draw of the discrete noise; ``frames`` are
+        not used)."""
         prev = self._prev
         self._prev = truth
         if prev is None or truth.t_s <= prev.t_s:
             return
+        self._f_meas = np.asarray(prev.f_body_mps2, float) + self.x[BA]
         F = system_matrix(prev.lat_rad, prev.alt_m, prev.v_enu_mps, prev.f_body_mps2,
                           (prev.roll_rad, prev.pitch_rad, prev.heading_rad), self._ba_decay)
         dt = truth.t_s - prev.t_s
@@ -196,6 +214,11 @@ class FlightTestErrors:
     def angle_errors_rad(self) -> np.ndarray:
         """(3,) the reference's current errors (δγ, δϑ, δψ), indicated minus true, rad."""
         return self.x[ANG] + self.c_rad
+
+    def specific_force_mps2(self) -> np.ndarray:
+        """(3,) the accelerometers' output over the last step in this model, m/s² (body): the
+        true specific force at the step's start plus the block's bias realisation, f + b_a."""
+        return self._f_meas.copy()
 
     def reference_angles(self, truth: AircraftState) -> tuple[float, float, float]:
         """(roll, pitch, heading) the reference outputs, rad (heading in [0, 2π))."""
@@ -228,5 +251,144 @@ class FlightTestErrors:
         self.c_rps = self.c_rps + dx[9:12]
 
 
-__all__ = ["ANGLES", "AttitudeReferenceSpec", "FlightTestErrors", "N_STATES", "euler_to_eps_matrix",
+class ReferenceAngleErrors:
+    """The attitude reference's own angle errors, indicated minus true (rad): constant + drift
+    + random walks (module docstring), advanced by their exact discretisation over Δt::
+
+        θ ← θ + d Δt + w_θ,  d ← d + w_d,   w_θ ~ N(0, N_θ² Δt + N_d² Δt³/3),
+        w_d ~ N(0, N_d² Δt),  cov(w_θ, w_d) = N_d² Δt²/2
+
+    (N_θ the angle random walk, N_d the drift random walk, per angle). The constant errors and
+    drifts are drawn from the spec's σ (or are its injected values).
+
+    Parameters
+    ----------
+    spec : the reference's error model;  rng : its random stream
+    """
+
+    def __init__(self, spec: AttitudeReferenceSpec, rng: np.random.Generator):
+        self.rng = rng
+        self.theta_rad = np.asarray(spec.bias_sigma_rad, float) * rng.standard_normal(3)
+        self.drift_rps = np.asarray(spec.drift_sigma_rps, float) * rng.standard_normal(3)
+        if spec.bias_rad is not None:
+            self.theta_rad = np.asarray(spec.bias_rad, float).copy()
+        if spec.drift_rps is not None:
+            self.drift_rps = np.asarray(spec.drift_rps, float).copy()
+        self._qa = np.square(spec.arw_rad_rs)
+        self._qd = np.square(spec.drift_rw_rps_rs)
+
+    def advance(self, dt_s: float) -> None:
+        """Advance θ and d over ``dt_s`` (s), one Gaussian draw per angle (class docstring)."""
+        dt = float(dt_s)
+        self.theta_rad = self.theta_rad + self.drift_rps * dt
+        if np.any(self._qa > 0) or np.any(self._qd > 0):
+            z = self.rng.standard_normal((2, 3))
+            v_t = self._qa * dt + self._qd * dt ** 3 / 3.0
+            c = self._qd * dt ** 2 / 2.0
+            v_d = self._qd * dt
+            s_t = np.sqrt(v_t)
+            k = np.divide(c, s_t, out=np.zeros(3), where=s_t > 0)
+            self.theta_rad = self.theta_rad + s_t * z[0]
+            self.drift_rps = self.drift_rps + k * z[0] + np.sqrt(np.clip(v_d - k * k, 0, None)) * z[1]
+
+
+class FlightTestSensors:
+    """The flight-test sensors on the strapdown truth: an accelerometer block at the centre of
+    gravity with its preset's errors, and the attitude reference's angles.
+
+    Per JSBSim frame (``FRAME_PROPERTIES`` samples, at least the navigation step) the error-free
+    increments are those of :func:`~fms_testbed.sensors.imu.synthesis.synthesize` (exact for the
+    sampled motion); the accelerometers' outputs are
+    :func:`~fms_testbed.sensors.imu.errors.measure_row` of them (turn-on bias, bias instability,
+    random walk, scale factor, misalignment, VRW, quantisation; the block's gyros are not used);
+    the reference outputs the sampled Euler angles plus its errors
+    (:class:`ReferenceAngleErrors`, advanced once per step and interpolated linearly across its
+    frames).
+
+    Parameters
+    ----------
+    spec : the reference's error model
+    imu : the accelerometer block: preset name, YAML path, mapping, spec or model
+    seed : seed of this realisation (the reference's errors, the accelerometers' turn-on,
+        slow and white noise, each from its own stream)
+    """
+
+    frame_properties = FRAME_PROPERTIES
+
+    def __init__(self, spec: AttitudeReferenceSpec, imu, seed: int):
+        self.spec = spec
+        s_ref, s_acc = np.random.SeedSequence(int(seed)).spawn(2)
+        self.reference = ReferenceAngleErrors(spec, np.random.default_rng(s_ref))
+        self.accel = ImuErrors([imu_error_params(imu)], [int(s_acc.generate_state(1)[0])])
+        self.U = np.zeros((1, N_ROW))
+        self.U[:, :36] = self.accel.E
+        self.accel.E = self.U[:, :36]
+        self.accel.res = self.U[:, ROW_RES:N_ROW]
+        self.T: np.ndarray | None = None           # the IMU's error-free state row
+        self.t_s: float | None = None
+        self._key: tuple | None = None
+        self._lever = np.zeros(3)
+
+    def start(self, truth: AircraftState) -> np.ndarray:
+        """Start at ``truth``; returns the reference's first output angles (roll, pitch,
+        heading), rad."""
+        self.T = start_row(truth, self._lever)
+        self.t_s = truth.t_s
+        return np.array([truth.roll_rad, truth.pitch_rad, truth.heading_rad]) + \
+            self.reference.theta_rad
+
+    def _coefficients(self, step_s: float, frame_s: float) -> None:
+        key = (step_s, frame_s)
+        if key != self._key:
+            a, s = self.accel.coefficients(step_s)
+            self.U[:, ROW_A:ROW_S] = a
+            self.U[:, ROW_S:ROW_WSD] = s
+            self.U[:, ROW_WSD:ROW_LSB] = self.accel.white_sd(frame_s)
+            self.U[:, ROW_LSB:ROW_RES] = self.accel.lsb
+            self._key = key
+
+    def step(self, truth: AircraftState, frames: np.ndarray | None = None
+             ) -> tuple[float, np.ndarray, np.ndarray]:
+        """The measurements from the last call to ``truth.t_s``: (frame time s, measured Δv
+        (n, 3) m/s body, the reference's output angles (n, 3) rad at each frame's end).
+
+        Raises
+        ------
+        ValueError : time did not advance;  RuntimeError : not started
+        """
+        if self.T is None:
+            raise RuntimeError("FlightTestSensors.step before start()")
+        if frames is None:
+            frames = sample_of(truth)[None, :]
+        n_f = frames.shape[0]
+        dt = (truth.t_s - self.t_s) / n_f
+        if dt <= 0.0:
+            raise ValueError(f"FlightTestSensors.step: time did not advance ({truth.t_s} s)")
+        self._coefficients(n_f * dt, dt)
+        acc = self.accel
+        advance_slow(self.U, self.U[:, ROW_A:ROW_S], self.U[:, ROW_S:ROW_WSD],
+                     acc.rng_slow[0].standard_normal((1, 30)))
+        inc = np.empty((n_f, 6))
+        synthesize(self.T, np.ascontiguousarray(frames), dt, self._lever, False, inc)
+        z = acc.rng_white[0].standard_normal((n_f, 6))
+        u = self.U[0]
+        dv = np.empty((n_f, 3))
+        for j in range(n_f):
+            _, mv = measure_row(u, (inc[j, 0], inc[j, 1], inc[j, 2]),
+                                (inc[j, 3], inc[j, 4], inc[j, 5]), dt, z, j)
+            dv[j] = mv
+        th0 = self.reference.theta_rad
+        self.reference.advance(n_f * dt)
+        s = (np.arange(1, n_f + 1) / n_f)[:, None]
+        angles = frames[:, 3:6] + th0 + s * (self.reference.theta_rad - th0)
+        self.t_s = truth.t_s
+        return dt, dv, angles
+
+    def angle_errors_rad(self) -> np.ndarray:
+        """(3,) the reference's current errors (δγ, δϑ, δψ), indicated minus true, rad."""
+        return self.reference.theta_rad.copy()
+
+
+__all__ = ["ANGLES", "AttitudeReferenceSpec", "FlightTestErrors", "FlightTestSensors",
+           "ReferenceAngleErrors", "N_STATES", "euler_to_eps_matrix",
            "initial_variance", "noise_density", "system_matrix"]

@@ -69,9 +69,10 @@ def test_same_seed_same_numbers_other_seed_other_errors():
 TURNS = [Segment(5), Segment(40, 3.0), Segment(40, -3.0), Segment(40, 3.0), Segment(35)]
 
 
+@pytest.mark.parametrize("truth_model", ["strapdown", "linear"])
 @pytest.mark.parametrize("seed", [0, 1, 2])
-def test_filter_is_consistent_and_resolves_heading_in_turns(seed):
-    _, df = _run(TURNS, seed)
+def test_filter_is_consistent_and_resolves_heading_in_turns(seed, truth_model):
+    _, df = _run(TURNS, seed, {"truth_model": truth_model})
     late = df["t_s"] >= 60
     for a in ANGLES:
         e, s = _err(df, a), df[f"att_ref_sigma_{a}_deg"].to_numpy()
