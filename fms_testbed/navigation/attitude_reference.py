@@ -93,6 +93,12 @@ _BUFFER_S = 2.0
 class AttitudeReferenceFilter:
     """The 21-state Kalman filter of the flight-test mode (module docstring).
 
+    The accelerometers' scale factor k and misalignment β (declared in ``imu``, not states
+    here) are covered as in the INS/GNSS filter: their 1 g equivalent bias (β_xz g, β_yz g,
+    k_z g) widens the bias prior, and white noise of density 2 σ² |Δf|² τ_u (σ² the declared
+    scale-factor + misalignment variance, Δf the specific force's departure from 1 g) is added
+    on δV; both vanish for a block without those errors.
+
     Parameters
     ----------
     spec : the reference's declared error model;  imu : the accelerometer block
@@ -101,12 +107,6 @@ class AttitudeReferenceFilter:
     gate_sigma : innovation gate per component, σ
     unmodelled_tau_s : correlation time τ_u of the process noise standing in for the
         accelerometers' scale-factor and misalignment errors the filter does not carry, s
-
-    The accelerometers' scale factor k and misalignment β (declared in ``imu``, not states
-    here) are covered as in the INS/GNSS filter: their 1 g equivalent bias (β_xz g, β_yz g,
-    k_z g) widens the bias prior, and white noise of density 2 σ² |Δf|² τ_u (σ² the declared
-    scale-factor + misalignment variance, Δf the specific force's departure from 1 g) is added
-    on δV; both vanish for a block without those errors.
     """
 
     def __init__(self, spec: AttitudeReferenceSpec, imu: ImuModel, gnss: GnssSpec,
