@@ -48,30 +48,10 @@ def inject(source, fault: dict, t_s: float) -> dict:
     check_fault(fault, len(source.bank), source.baro is not None)
     kind, unit = fault["kind"], fault["unit"]
     end = t_s + fault["duration_s"] if "duration_s" in fault else math.inf
-    if unit.startswith("ins") and hasattr(source.bank, "inject"):
-        # a strapdown bank applies the fault to the unit's IMU itself
-        what = source.bank.inject(int(unit[3:]) - 1, fault)
-    elif unit.startswith("ins"):
-        i = int(unit[3:]) - 1
-        u = source.bank.units[i]
-        if kind == "gyro_bias_step":
-            u.x[12 + _AXIS[fault["axis"]]] += fault["size_dph"] * DPH_RPS
-            what = f"gyro {fault['axis']} bias {fault['size_dph']:+g} deg/h"
-        elif kind == "accel_bias_step":
-            u.x[9 + _AXIS[fault["axis"]]] += fault["size_ug"] * 1e-6 * G0_MPS2
-            what = f"accelerometer {fault['axis']} bias {fault['size_ug']:+g} ug"
-        elif kind == "drift_scale":
-            f = fault["factor"]
-            sigma = np.sqrt(source.filters[i].imu.p0_var[12:15])
-            u.x[12:15] += (f - 1.0) * sigma
-            q = u.imu.q_psd.copy()
-            q[12:15] *= f * f
-            u.replace_imu(replace(u.imu, q_psd=q))
-            what = (f"gyro drift x{f:g} of declared ({(f - 1) * sigma[0] / DPH_RPS:.3g} deg/h "
-                    f"excess per axis)")
-        else:                                               # stuck
-            source.bank.freeze(i, source.bank.output(i, source._prev_truth))
-            what = "output stuck"
+    if unit.startswith("ins"):
+        # the same fault on the unit flown free for the majority-voting baseline, if any
+        banks = [source.bank] + [b for b in [getattr(source, "free_bank", None)] if b is not None]
+        what = [_inject_ins(source, b, int(unit[3:]) - 1, fault) for b in banks][0]
     elif kind == "baro_failure":
         source.baro.spec = replace(source.baro.spec, failed_from_s=t_s)
         what = "static port stuck"
@@ -90,6 +70,32 @@ def inject(source, fault: dict, t_s: float) -> dict:
             what = "outage"
     return {"t_s": round(t_s, 3), "unit": unit, "kind": "fault_injected", "stage": "truth",
             "reason": f"{kind}: {what}"}
+
+
+def _inject_ins(source, bank, i: int, fault: dict) -> str:
+    """Apply an INS fault to unit ``i`` of ``bank`` (a strapdown bank applies it to the unit's
+    IMU itself; the linear twin to its error state); return what changed."""
+    kind = fault["kind"]
+    if hasattr(bank, "inject"):
+        return bank.inject(i, fault)
+    u = bank.units[i]
+    if kind == "gyro_bias_step":
+        u.x[12 + _AXIS[fault["axis"]]] += fault["size_dph"] * DPH_RPS
+        return f"gyro {fault['axis']} bias {fault['size_dph']:+g} deg/h"
+    if kind == "accel_bias_step":
+        u.x[9 + _AXIS[fault["axis"]]] += fault["size_ug"] * 1e-6 * G0_MPS2
+        return f"accelerometer {fault['axis']} bias {fault['size_ug']:+g} ug"
+    if kind == "drift_scale":
+        f = fault["factor"]
+        sigma = np.sqrt(source.filters[i].imu.p0_var[12:15])
+        u.x[12:15] += (f - 1.0) * sigma
+        q = u.imu.q_psd.copy()
+        q[12:15] *= f * f
+        u.replace_imu(replace(u.imu, q_psd=q))
+        return (f"gyro drift x{f:g} of declared ({(f - 1) * sigma[0] / DPH_RPS:.3g} deg/h "
+                f"excess per axis)")
+    bank.freeze(i, bank.output(i, source._prev_truth))                  # stuck
+    return "output stuck"
 
 
 __all__ = ["check_fault", "inject"]

@@ -26,6 +26,8 @@ from fms_testbed.navigation.identification.rules import MAJORITY, PAIRS, pair_fl
 from fms_testbed.navigation.identification.sensor import SensorPairTest
 from fms_testbed.navigation.identification.tuning import FdiTuning
 from fms_testbed.navigation.identification.two_stage import BY_TABLE, TwoStage
+from fms_testbed.sensors.sins.analysis import SinsOptions, initial_map, step_discrete
+from fms_testbed.sensors.sins.analysis import system_matrix as sins_F
 
 VERTICAL_CHANNELS = (2, 5)
 """Comparison channels of the vertical channel: position U and velocity U."""
@@ -281,6 +283,51 @@ class SensorComparator:
         return tuple(int(v) for v in self.test.update(errs[None], f_mps2, w_rps)[0])
 
 
+class FreeEnvelope:
+    """The declared covariance of a free inertial solution (no aiding, no feedback) along the
+    route flown: the majority-voting baseline's σ_free.
+
+    P(t₀) = A diag(p0) Aᵀ (the 33-state model's initial map, stationary alignment), then every
+    ``step_s``: P ← Φ P Φᵀ + Q_k with (Φ, Q_k) of the 33-state model (free vertical channel) at
+    the integrated solution and the measured specific force and rate.
+
+    Parameters
+    ----------
+    imu : the units' declared IMU model;  step_s : propagation step, s
+    """
+
+    def __init__(self, imu, step_s: float = 1.0):
+        self.imu, self.step_s = imu, float(step_s)
+        self.P: np.ndarray | None = None
+        self._t_s: float | None = None
+
+    def update(self, t_s: float, lat_rad: float, alt_m: float, v_enu_mps, rpy_rad,
+               f_b_mps2, w_eb_rps) -> None:
+        """Start at the first call; propagate once ``step_s`` (s) has passed since the last
+        propagation (F held over the step at this call's state: lat rad, alt m, V ENU m/s,
+        roll/pitch/heading rad, measured f m/s² and ω_eb rad/s, body)."""
+        opts = SinsOptions(vertical="free")
+        if self.P is None:
+            A = initial_map(lat_rad, rpy_rad, self.imu, SinsOptions())
+            self.P, self._t_s = (A * self.imu.p0_var) @ A.T, float(t_s)
+            return
+        dt = float(t_s) - self._t_s
+        if dt < self.step_s - 1e-9:
+            return
+        F = sins_F(lat_rad, alt_m, np.asarray(v_enu_mps, float), tuple(rpy_rad),
+                   np.asarray(w_eb_rps, float), np.asarray(f_b_mps2, float), self.imu, opts)
+        phi, qk = step_discrete(F, self.imu, dt, opts)
+        P = phi @ self.P @ phi.T + qk
+        self.P, self._t_s = 0.5 * (P + P.T), float(t_s)
+
+    def sigma(self) -> np.ndarray:
+        """(9,) σ of the comparison channels of a free unit (position ENU m, velocity m/s, roll
+        and pitch — the larger tilt σ — and heading rad)."""
+        d = np.sqrt(np.maximum(self.P.diagonal()[:9], 0.0))
+        d[6] = d[7] = max(d[6], d[7])
+        return d
+
+
 _GROUP_STATES = {"gnss_pos": (0, 1, 2), "gnss_vel": (3, 4, 5), "baro": (2,)}
 """Filter states each measurement group measures directly (the rows of H with a 1)."""
 
@@ -296,19 +343,46 @@ class FaultTolerantEstimator:
     every group, and ``diverge_count`` consecutive divergent updates of a group reset its
     filter's covariance along the measured states (P_jj += max(ν_j² − S_jj, 0)), an event.
 
+    With ``component_channels`` the GNSS groups are corrected per component (eq. 8): a component
+    failing |y_i − ŷ_i| ≤ ε_i = k_residual √S_ii has its gain column zeroed while the others are
+    used, and on a unit without another altitude channel (no baro, or its baro excluded) a failed
+    vertical component also zeroes the gain rows of :data:`VERTICAL_STATES` — ẑ_H, Ŵ_Z and the
+    baro bias keep their prediction — and the vertical comparison channels are dropped until
+    the vertical components pass again (``vertical_held``).
+
     Parameters
     ----------
-    filters : the units' filters (their public ``frozen`` mask and ``r_scale`` are set)
+    filters : the units' filters (their public ``frozen`` mask, ``r_scale``, ``channel_test``
+        and ``hold_vertical`` are set)
     tuning : thresholds;  adaptive : run the adaptive variant
+    component_channels : the per-component channel test (False: the filters' group gate)
     """
 
-    def __init__(self, filters: list, tuning: FdiTuning = FdiTuning(), adaptive: bool = False):
+    def __init__(self, filters: list, tuning: FdiTuning = FdiTuning(), adaptive: bool = False,
+                 component_channels: bool = True):
         self.filters, self.tuning, self.adaptive = filters, tuning, bool(adaptive)
         n = len(filters)
         self.baro_excluded = [False] * n
         self.vertical_frozen = [False] * n
+        self.vertical_held = [False] * n
+        self._held_by: list[set] = [set() for _ in range(n)]
         self._baro_fails: list[list[float]] = [[] for _ in range(n)]
         self._diverging = [dict() for _ in range(n)]
+        self.set_component_channels(component_channels)
+
+    def set_component_channels(self, on: bool) -> None:
+        """Switch the per-component channel test of every filter on or off."""
+        self.component_channels = bool(on)
+        for i in range(len(self.filters)):
+            self._set_channels(i)
+
+    def _set_channels(self, i: int) -> None:
+        f = self.filters[i]
+        if not hasattr(f, "channel_test"):
+            return
+        f.channel_test = self.tuning.k_residual if self.component_channels else 0.0
+        no_alt = getattr(f, "baro", None) is None or self.baro_excluded[i]
+        f.hold_vertical = frozen_states(f.frozen.size, True) if no_alt else None
 
     def _unit(self, i: int, sensor: str) -> str:
         return sensor if len(self.filters) == 1 else f"{sensor}@ins{i + 1}"
@@ -318,6 +392,8 @@ class FaultTolerantEstimator:
         at ``t_s`` (s); returns the events (baro channel excluded, divergence reset)."""
         ev: list[dict] = []
         for g in groups:
+            if g.name.startswith("gnss"):
+                ev += self._hold(i, t_s, g)
             if g.name == "baro" and not self.baro_excluded[i]:
                 ev += self._baro(i, t_s, residual_ok(g.innovation, g.S, self.tuning.k_residual))
             f = self.filters[i]
@@ -336,9 +412,27 @@ class FaultTolerantEstimator:
         if len(buf) < self.tuning.baro_fails:
             return []
         self.baro_excluded[i] = True
+        self._set_channels(i)
         return [_event(t_s, self._unit(i, "baro"), "excluded", "estimator",
                        f"baro residual beyond {self.tuning.k_residual:g}σ {len(buf)} times in "
                        f"{self.tuning.baro_window_s:g} s: its gain row zeroed")]
+
+    def _hold(self, i: int, t_s: float, g) -> list[dict]:
+        """Track unit ``i``'s vertical hold from a GNSS group's per-component result ``g``;
+        returns the ``reconfigured`` event of a change."""
+        f = self.filters[i]
+        if g.components is None and not g.used:
+            return []                              # nothing used: no verdict on the vertical
+        failed = (g.components is not None and not g.components[2]
+                  and getattr(f, "hold_vertical", None) is not None)
+        (self._held_by[i].add if failed else self._held_by[i].discard)(g.name)
+        held = bool(self._held_by[i])
+        if held == self.vertical_held[i]:
+            return []
+        self.vertical_held[i] = held
+        return [_event(t_s, self._unit(i, "ins"), "reconfigured", "estimator",
+                       f"vertical channel held and excluded: {g.name} U failed its channel test"
+                       if held else "vertical channel released: GNSS U passes its channel test")]
 
     def _divergence(self, i: int, t_s: float, g, diverging: bool) -> list[dict]:
         count = self._diverging[i].get(g.name, 0) + 1 if diverging else 0
@@ -372,10 +466,10 @@ class FaultTolerantEstimator:
     def mask(self, used: list[bool] | None = None) -> np.ndarray:
         """Comparison channels: the vertical ones out when a unit in use has it frozen."""
         live = range(len(self.filters)) if used is None else [i for i, u in enumerate(used) if u]
-        return channel_mask(any(self.vertical_frozen[i] for i in live))
+        return channel_mask(any(self.vertical_frozen[i] or self.vertical_held[i] for i in live))
 
 
-__all__ = ["FaultTolerantEstimator", "FdiTuning", "MAJORITY", "SensorComparator", "TwoStageFdi",
+__all__ = ["FaultTolerantEstimator", "FdiTuning", "FreeEnvelope", "MAJORITY", "SensorComparator", "TwoStageFdi",
            "VERTICAL_CHANNELS", "VERTICAL_STATES", "channel_mask", "channel_sigmas",
            "declared_sensor_noise", "frozen_states", "majority", "residual_ok",
            "switch_components", "unmodelled_variances"]

@@ -127,6 +127,7 @@ class GroupResult:
     nis: float
     used: bool
     reset: bool = False
+    components: tuple | None = None    # per component: used (channel test passed); None: all
 
 
 @njit(cache=True)
@@ -263,6 +264,10 @@ class InsGnssFilter:
         # public view of the gain-row mask (seed 001's fault-tolerant estimator, set by
         # fdi.FaultTolerantEstimator) and the adaptive-R inflation per group (1: nominal R)
         self.frozen = self._no_freeze
+        # seed 001's channel test per component (eq. 8; ``channel_test``: its ε_i in σ of S_ii,
+        # 0: the group gate) and the vertical rows held when a vertical component fails on a
+        # unit without another altitude channel (``hold_vertical``: the states, or None)
+        self.channel_test, self.hold_vertical = 0.0, None
         self.r_scale = {"gnss_pos": np.ones(3), "gnss_vel": np.ones(3), "baro": np.ones(1)}
         self._lag = PredictionLag()   # (t_start_s, Φ, Q_k) of the recent steps
         self._rejected: dict[str, int] = {}   # consecutive gate rejections per group
@@ -418,19 +423,43 @@ class InsGnssFilter:
         P_in = self.P
         if reset:
             self.P = self._reset_covariance(meas, z, H, R, lag)
-        if lag is None:
-            x, P, nu, S, nis, used = _gated_correct(self.x, self.P, z, H, R, sc,
-                                                    self._no_freeze, gate)
-        else:
-            x, P, nu, S, nis, used = _gated_correct_delayed(
-                self.x, self.P, z, H, R, sc, lag[0], lag[1], self._no_freeze, gate)
+        x, P, nu, S, nis, used = self._correct(z, H, R, sc, lag, self.frozen, gate)
+        comp = None
+        if self.channel_test > 0 and not reset and name.startswith("gnss"):
+            comp, used = self._components(z, H, R, sc, lag, nu, S)
+            if comp is not None and used:
+                x, P = comp[1]
+                comp = tuple(comp[0])
         if used:
             self.x, self.P = x, P
             self._rejected[name] = 0
         else:
             self.P = P_in
             self._rejected[name] = n_rej + 1
-        return GroupResult(name, nu, S, nis, bool(used), reset)
+        return GroupResult(name, nu, S, nis, bool(used), reset, comp)
+
+    def _correct(self, z, H, R, sc, lag, frozen, gate):
+        """(x, P, ν, S, NIS, passed): the gated correction, delayed when ``lag`` is set."""
+        if lag is None:
+            return _gated_correct(self.x, self.P, z, H, R, sc, frozen, gate)
+        return _gated_correct_delayed(self.x, self.P, z, H, R, sc, lag[0], lag[1], frozen, gate)
+
+    def _components(self, z, H, R, sc, lag, nu, S):
+        """Seed 001's channel test |y_i − ŷ_i| ≤ ε_i = ``channel_test`` √S_ii per component:
+        the failed components' gain columns are zeroed (the correction uses the passing rows of
+        z, H, R alone), and a failed vertical component (index 2) also zeroes the gain rows
+        ``hold_vertical`` (those states keep their prediction). Returns (None, True) when every
+        component passes, ((ok, (x, P)), True) when some do, (None, False) when none does."""
+        ok = np.abs(nu) <= self.channel_test * np.sqrt(np.diag(S))
+        if ok.all() or not ok.any():
+            return None, bool(ok.all())
+        frozen = self.frozen
+        if not ok[2] and self.hold_vertical is not None:
+            frozen = frozen | self.hold_vertical
+        Rs = np.ascontiguousarray(R[np.ix_(ok, ok)])
+        x, P, *_ = self._correct(np.ascontiguousarray(z[ok]), np.ascontiguousarray(H[ok]), Rs,
+                                 np.ascontiguousarray(sc[ok]), lag, frozen, math.inf)
+        return (ok, (x, P)), True
 
     def _reset_covariance(self, meas: Measurement, z, H, R, lag) -> np.ndarray:
         """P with the rows and columns of ``meas.reset_states`` zeroed and their variance set

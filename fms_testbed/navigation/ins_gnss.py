@@ -17,13 +17,16 @@ One :meth:`InsGnssNavigation.update` per navigation step: the INS units advance 
 errors), each filter predicts over the step, any delivered GNSS fix is used (innovation-gated,
 delayed-measurement correction, Joseph form) and the INS block of each estimate is fed back to
 its unit, then the baro reading; with two or three units the two-stage identification of seed
-001 (:mod:`.fdi`) runs, and the output is the mean of the units in use (unit 0 alone for one
+001 (:mod:`.fdi`) runs, and the output is the mean of the units in use — with three units
+weighted by the reference description's ranking (:func:`~.reference_description.rank_weights`)
+once it has distances — (unit 0 alone for one
 unit) with the filters' position covariance (``pos_cov_enu_m2``) and ANP. Logged columns
 (``NavSolution.errors``): ``anp_m`` (95 % horizontal radius of P, m), ``nav_mode``
 (:data:`~.monitor.NAV_MODES`), ``ins_used`` (bit mask of the units in use),
 ``nse_{east,north,up}_m`` (output - truth, truth side), ``att_err_{roll,pitch,heading}_deg``
 (output - truth), ``sigma_heading_deg`` (filter) and, with identification,
-``nse_vote_{east,north}_m`` (the majority-voting baseline) and ``fdi_nu`` (ν12 + 2 ν13 + 4 ν23).
+``nse_vote_{east,north}_m`` (the majority-voting baseline on the raw outputs: the units
+flown free beside them, :meth:`InsGnssNavigation._vote_raw`) and ``fdi_nu`` (ν12 + 2 ν13 + 4 ν23).
 Events (``events``: faults injected, gate rejections, detection, isolation, exclusion,
 reconfiguration) go to ``summary.json``; faults come from scenario events (:meth:`inject`).
 
@@ -50,14 +53,14 @@ from fms_testbed.core.units import G0_MPS2
 from fms_testbed.navigation.inertial.bank import StrapdownBank, set_lever_arm
 from fms_testbed.navigation.ins_bank import InsBank, derive_seeds
 from fms_testbed.navigation.faults import check_fault, inject
-from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, SensorComparator,
-                                        TwoStageFdi,
+from fms_testbed.navigation.fdi import (FaultTolerantEstimator, FdiTuning, FreeEnvelope,
+                                        SensorComparator, TwoStageFdi, channel_mask,
                                         channel_sigmas, declared_sensor_noise)
 from fms_testbed.navigation.ins_filter import FilterTuning, GroupResult, InsGnssFilter, _w_eb
 from fms_testbed.navigation.prediction import PredictionInterval, can_share_prediction
 from fms_testbed.navigation.monitor import DEFAULT_ALERT_DELAY_S
 from fms_testbed.navigation.recording import SensorRecorder
-from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor
+from fms_testbed.navigation.reference_description import ReferenceDescriptionMonitor, rank_weights
 from fms_testbed.sensors.baro import BaroAltimeter, BaroSpec
 from fms_testbed.sensors.gnss import GnssReceiver, GnssSpec, Interval, OutlierBurst, Ramp
 from fms_testbed.sensors.sins.analysis import horizontal_radius
@@ -164,6 +167,23 @@ def _mean_solution(C: np.ndarray, units: list[int]) -> tuple:
     return c[0], c[1], c[2], c[3:6], c[6], c[7], c[8]
 
 
+def weighted_solution(C: np.ndarray, units: list[int], w: np.ndarray) -> tuple:
+    """(lat rad, lon rad, alt m, V (3,) m/s, roll, pitch, heading rad): Σ w_i C_i over ``units``
+    of the corrected outputs ``C`` (k, 9) with weights ``w`` (summing to 1), heading by the
+    weighted circular mean atan2(Σ w sin ψ, Σ w cos ψ).
+
+    Parameters
+    ----------
+    C : (k, 9) corrected outputs (:func:`_corrected_many` layout);  units : their rows
+    w : (len(units),) weights, dimensionless
+    """
+    rows = C[units]
+    c = np.empty(9)
+    c[:8] = w @ rows[:, :8]
+    c[8] = math.atan2(w @ np.sin(rows[:, 8]), w @ np.cos(rows[:, 8])) % (2.0 * math.pi)
+    return c[0], c[1], c[2], c[3:6], c[6], c[7], c[8]
+
+
 def alignment_s(bank) -> float | None:
     """The stationary alignment's duration (s) of a strapdown bank, whose white-noise means are
     in the initial errors; None for another bank or alignment.
@@ -221,6 +241,11 @@ class InsGnssNavigation(NavigationSourceBase):
         self._anp = math.nan
         self._interval: PredictionInterval | None = None      # built at the first step
         self.recorder: SensorRecorder | None = None   # navigation.record_sensors (its tables)
+        # the majority-voting baseline's raw outputs: the same units flown free (no feedback;
+        # the same IMU errors, seeds and faults) and their declared envelope (set by from_spec)
+        self.free_bank: InsBank | None = None
+        self.free_env: FreeEnvelope | None = None
+        self._free_out: list[NavSolution] = []
 
     @classmethod
     def from_spec(cls, spec: dict, seed: int | None = None) -> "InsGnssNavigation":
@@ -242,18 +267,21 @@ class InsGnssNavigation(NavigationSourceBase):
         tuning = FilterTuning(b.filter.gate_sigma, b.filter.unmodelled_tau_s, b.filter.method,
                               b.filter.predict_interval_s, b.filter.predict_rotation_deg,
                               b.filter.reset_after)
-        if b.truth_model == "strapdown":
-            bank = StrapdownBank([imu] * b.n_ins, seeds[2:], alignment=b.alignment)
-        else:
-            bank = InsBank([imu] * b.n_ins, seeds[2:], method=b.filter.method,
+        def make_bank():
+            if b.truth_model == "strapdown":
+                return StrapdownBank([imu] * b.n_ins, seeds[2:], alignment=b.alignment)
+            return InsBank([imu] * b.n_ins, seeds[2:], method=b.filter.method,
                            matrices_dt_s=b.matrices_dt_s,
                            matrices_rotation_deg=b.matrices_rotation_deg)
+        bank = make_bank()
         filters = [InsGnssFilter(imu, g, br, tuning) for _ in range(b.n_ins)]
         baro = BaroAltimeter(br, seeds[1]) if br is not None else None
         fdi = TwoStageFdi(b.n_ins) if b.n_ins > 1 else None
         src = cls(bank, GnssReceiver(g, seeds[0]), baro, filters,
                   DEFAULT_ALERT_DELAY_S if b.alert_delay_s is None else b.alert_delay_s, fdi)
         src.seed = sd
+        if b.n_ins > 1:
+            src.free_bank, src.free_env = make_bank(), FreeEnvelope(imu)
         src.ft.adaptive = b.adaptive
         src.truth_model = b.truth_model
         if b.record_sensors:
@@ -267,6 +295,8 @@ class InsGnssNavigation(NavigationSourceBase):
         m), set before the first update; the linear model has none."""
         if isinstance(self.bank, StrapdownBank):
             set_lever_arm(self.bank, lever_arm_m)
+            if self.free_bank is not None:
+                set_lever_arm(self.free_bank, lever_arm_m)
             self.frame_properties = tuple(self.bank.frame_properties)
 
     # -- faults ----------------------------------------------------------------------------
@@ -330,6 +360,8 @@ class InsGnssNavigation(NavigationSourceBase):
         """Advance to ``truth.t_s``: INS, prediction, GNSS (feedback), baro, identification;
         return the output."""
         ins = self.bank.update(truth, frames)
+        if self.free_bank is not None:
+            self._free_out = self.free_bank.update(truth, frames)
         t = truth.t_s
         prev = self._prev_truth
         fixes = self.receiver.update(truth)
@@ -458,8 +490,26 @@ class InsGnssNavigation(NavigationSourceBase):
         both = [i for i in used if i in ref_used]
         return both or used
 
+    def _vote_raw(self, C: np.ndarray) -> list[int]:
+        """Majority voting on the raw outputs (the free units, no GNSS feedback): table 1 of
+        this instant at ε_N = k_pair √2 σ_free on the horizontal and attitude channels (the free
+        vertical channel excluded), σ_free from :class:`~.fdi.FreeEnvelope` along the
+        integrated solution ``C`` (mean of the corrected outputs, :func:`_corrected_many`
+        layout); the units it does not name."""
+        free = self._free_out
+        O = np.array([(s.lat_rad, s.lon_rad, s.alt_m, s.v_enu_mps[0], s.v_enu_mps[1],
+                       s.v_enu_mps[2], s.roll_rad, s.pitch_rad, s.heading_rad) for s in free])
+        _, Y = _corrected_many(O, np.zeros((len(free), 9)))
+        m = _mean_rows(C, np.arange(len(C), dtype=np.int64))
+        f_b, w_ib = self.bank.measured(0)
+        env = self.free_env
+        env.update(free[0].t_s, m[0], m[2], m[3:6], m[6:9], f_b, _w_eb(free[0], w_ib))
+        sig = env.sigma()
+        return self.fdi.vote(list(Y), [sig] * len(free), channel_mask(True))
+
     def solution(self, truth: AircraftState, ins: list[NavSolution]) -> NavSolution:
-        """The output: the mean of the units in use (unit 0 alone without identification), the
+        """The output: the mean of the units in use (weighted by the reference description's
+        ranking once it has distances; unit 0 alone without identification), the
         mean of their covariances, ANP, and the logged columns."""
         O = np.array([(s.lat_rad, s.lon_rad, s.alt_m, s.v_enu_mps[0], s.v_enu_mps[1],
                        s.v_enu_mps[2], s.roll_rad, s.pitch_rad, s.heading_rad) for s in ins])
@@ -484,7 +534,7 @@ class InsGnssNavigation(NavigationSourceBase):
             mask = self.ft.mask(self.fdi.state.used)
             self.events += self.fdi.update(truth.t_s, y, sig, self._sensor_pairs(truth), mask)
             used = [i for i, u in enumerate(self.fdi.state.used) if u]
-            voted = self.fdi.vote(y, sig, mask, flags=self.fdi.flags)
+            voted = self._vote_raw(C)
             vote = means[tuple(voted)] = _mean_solution(C, voted)
             extra = {"ins_used_vote": float(sum(1 << i for i in voted)),
                      "nse_vote_east_m": (vote[1] - truth.lon_rad) * nse[0],
@@ -500,10 +550,18 @@ class InsGnssNavigation(NavigationSourceBase):
         else:
             pick = [int(np.argmin([np.trace(f.P[:3, :3]) for f in self.filters]))]
         key = tuple(pick)
-        if key not in means:
-            means[key] = _mean_solution(C, pick)
-        lat, lon, alt, v, roll, pitch, hdg = means[key]
-        P = self._mean_P(pick)
+        d = None if self.refdesc is None else self.refdesc.d[pick]
+        if d is not None and len(pick) > 1 and np.isfinite(d).all():
+            # Zaitseva's ranking in the output: the units weighted by their distance to their
+            # reference descriptions (the best-ranked weighs most)
+            w = rank_weights(d)
+            lat, lon, alt, v, roll, pitch, hdg = weighted_solution(C, pick, w)
+            P = sum(wi * self.filters[i].P[:9, :9] for wi, i in zip(w, pick))
+        else:
+            if key not in means:
+                means[key] = _mean_solution(C, pick)
+            lat, lon, alt, v, roll, pitch, hdg = means[key]
+            P = self._mean_P(pick)
         mode = 2 if not valid else (1 if coast else 0)
         errors = {
             "anp_m": self._anp_m(P), "nav_mode": float(mode),
@@ -523,4 +581,4 @@ class InsGnssNavigation(NavigationSourceBase):
                            heading_sigma_rad=math.sqrt(max(P[8, 8], 0.0)))
 
 
-__all__ = ["InsGnssNavigation", "baro_spec", "corrected", "gnss_spec"]
+__all__ = ["InsGnssNavigation", "baro_spec", "corrected", "gnss_spec", "weighted_solution"]

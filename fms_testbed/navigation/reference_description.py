@@ -200,6 +200,19 @@ def reference_decision(d: np.ndarray, excluded: np.ndarray, outside_since: np.nd
     return ~new, new, since, rank
 
 
+def rank_weights(d: np.ndarray) -> np.ndarray:
+    """Weights of the units in the output from their distances to their reference descriptions:
+    w_i = (1 + d_i²)⁻¹ / Σ_j (1 + d_j²)⁻¹ — the best-ranked unit weighs most, a unit at d σ
+    weighs about 1/d² of one on its description (equal weights when the d are equal).
+
+    Parameters
+    ----------
+    d : (u,) normalised distances (:func:`normalised_distance`), dimensionless
+    """
+    w = 1.0 / (1.0 + np.asarray(d, float) ** 2)
+    return w / w.sum()
+
+
 def _raise_status(status: int, dt: float) -> None:
     """The epoch kernel's failures as errors (``status`` of :func:`.reference_kernels._epoch`,
     ``dt`` the step, s)."""
@@ -403,5 +416,5 @@ class ReferenceDescriptionMonitor:
 
 
 __all__ = ["CHANNELS", "ReferenceDescriptionMonitor", "ReferenceTuning", "channel_filter_step",
-           "channel_process_noise",
+           "channel_process_noise", "rank_weights",
            "envelope_start", "normalised_distance", "propagate", "reference_decision"]

@@ -172,3 +172,88 @@ def test_navigation_adaptive_key_selects_the_adaptive_variant():
     base = {"source": "ins_gnss", "imu": "STIM300", "n_ins": 1}
     assert not make_source(base, seed=0).ft.adaptive
     assert make_source({**base, "adaptive": True}, seed=0).ft.adaptive
+
+
+def _filter_with_a_vertical_coupling(baro=None):
+    """A filter whose position covariance couples δh to E and N (as a climbing turn does)."""
+    from fms_testbed.core.state import NavSolution
+    from fms_testbed.navigation.ins_filter import InsGnssFilter
+    from fms_testbed.sensors.gnss import GnssSpec
+    f = InsGnssFilter(load_imu("STIM300"), GnssSpec(), baro)
+    f.initialise(NavSolution(0.0, 0.8, 0.1, 3000.0, np.array([150.0, 0.0, 0.0]), 0.0, 0.0, 0.5))
+    f.P[:3, :3] += np.array([[4.0, 0.0, 2.0], [0.0, 4.0, 1.0], [2.0, 1.0, 9.0]])
+    f.P[5, 0] = f.P[0, 5] = 0.5
+    return f, NavSolution(0.0, 0.8, 0.1, 3000.0, np.array([150.0, 0.0, 0.0]), 0.0, 0.0, 0.5)
+
+
+def _gnss_pos(sol, de_m, dn_m, du_m):
+    from fms_testbed.navigation.measurements import GnssPosition
+    from fms_testbed.core.earth import radii_m
+    rm, rn = radii_m(sol.lat_rad)
+    return GnssPosition(0.0, sol.lat_rad - dn_m / (rm + sol.alt_m),
+                        sol.lon_rad - de_m / ((rn + sol.alt_m) * math.cos(sol.lat_rad)),
+                        sol.alt_m - du_m, np.array([1.0, 1.0, 2.0]), np.zeros(3))
+
+
+@pytest.mark.parametrize("hold", [True, False])
+def test_a_failed_gnss_vertical_zeroes_its_gain_column_and_without_altitude_holds_the_vertical(
+        hold):
+    """Seed 001 eq. 8 per component: U off by 200 m fails |ν| ≤ 5√S, E and N are used; with no
+    other altitude channel the gain rows of δh, δV_U are zeroed too (ẑ_H, Ŵ_Z keep their
+    prediction, their variance unchanged) — without the hold the E/N correction moves them
+    through the position covariance."""
+    from fms_testbed.navigation.fdi import FaultTolerantEstimator
+    f, sol = _filter_with_a_vertical_coupling()
+    ft = FaultTolerantEstimator([f])
+    assert f.channel_test == FdiTuning().k_residual and f.hold_vertical is not None
+    if not hold:
+        f.hold_vertical = None
+    P0 = f.P.copy()
+    g = f.use(_gnss_pos(sol, 3.0, -2.0, 200.0), sol)        # z = p_INS - p_GNSS = (3, -2, 200)
+    assert g.used and g.components == (True, True, False)
+    assert 1.0 < f.x[0] < 3.0 and -2.0 < f.x[1] < -0.6       # E, N used (a share of ν)
+    vert = f.x[[2, 5]]
+    if hold:
+        assert np.all(vert == 0.0) and np.all(f.P[[2, 5], [2, 5]] == P0[[2, 5], [2, 5]])
+    else:
+        assert np.all(np.abs(vert) > 1e-3)
+    assert abs(f.x[2]) < 10.0                                 # never the 200 m of U
+    ev = ft.check(0, 1.0, [g])
+    assert [e["reason"] for e in ev] == ([
+        "vertical channel held and excluded: gnss_pos U failed its channel test"] if hold else [])
+    assert list(np.flatnonzero(~ft.mask())) == ([2, 5] if hold else [])
+
+
+def test_with_a_baro_the_failed_gnss_vertical_is_left_out_but_not_held():
+    from fms_testbed.navigation.fdi import FaultTolerantEstimator
+    from fms_testbed.sensors.baro import BaroSpec
+    f, sol = _filter_with_a_vertical_coupling(BaroSpec())
+    FaultTolerantEstimator([f])
+    assert f.hold_vertical is None                            # the baro is the altitude channel
+    g = f.use(_gnss_pos(sol, 0.0, 0.0, 200.0), sol)
+    assert g.components == (True, True, False) and abs(f.x[2]) < 10.0
+
+
+@pytest.mark.slow
+def test_no_baro_an_outage_and_a_vertical_gnss_jump_hold_the_vertical_only_with_zeroing(climb):
+    """The three-unit case of seed 001: no baro, GNSS lost 150-250 s while its vertical error
+    ramps 0.5 m/s (50 m at re-acquisition). Per component, the vertical stays held and out of
+    the comparisons while the horizontal is GNSS-aided; the all-or-nothing gate rejects every
+    fix until its reset takes the jump into the vertical."""
+    out = {}
+    for on in (True, False):
+        nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3, "baro": None,
+                           "gnss": {"outages": [{"start_s": 150.0, "end_s": 250.0}],
+                                    "ramps": [{"start_s": 150.0, "rate_mps": [0, 0, 0.5]}]}},
+                          seed=1)
+        nav.ft.set_component_channels(on)
+        rows = [nav.update(s).errors for s in climb]
+        out[on] = (np.array([r["nse_up_m"] for r in rows]),
+                   np.array([math.hypot(r["nse_east_m"], r["nse_north_m"]) for r in rows]),
+                   [e for e in nav.events if "held" in e["reason"]], nav.filters[0].P.copy())
+    up_on, hz_on, held_on, P_on = out[True]
+    up_off, _, held_off, P_off = out[False]
+    assert len(held_on) == 3 and all(250.0 <= e["t_s"] < 252.0 for e in held_on) and not held_off
+    assert np.abs(up_on[2510:]).max() < 20.0 < 40.0 < np.abs(up_off[2510:]).max()
+    assert hz_on[2510:].max() < 15.0
+    assert not np.allclose(P_on[:6, :6], P_off[:6, :6])

@@ -144,3 +144,28 @@ def test_gnss_outage_and_baro_failure_events_reach_the_summary():
     df = res.df
     assert (df["nav_mode"][(df["t_s"] > 23) & (df["t_s"] < 30)] == 1).all()
     assert (df["nav_mode"][df["t_s"] > 33] == 0).all()
+
+
+@pytest.mark.slow
+def test_voting_on_raw_outputs_keeps_a_calibrated_drift_and_drops_a_large_step(states):
+    """Majority voting on the free units (no feedback): a drift ×2 (0.5 °/h excess, inside the
+    declared free-inertial σ) stays in; a 2,000 °/h gyro step leaves the raw output's attitude
+    beyond k_pair √2 σ_free within seconds and is voted out, while the corrected outputs of the
+    filters (which calibrate it) are what the identified output uses."""
+    nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=3)
+    votes, ts = [], []
+    for s in states[:1500]:
+        e = nav.update(s).errors
+        votes.append(int(e["ins_used_vote"]))
+        ts.append(s.t_s)
+        if abs(s.t_s - 20.0) < 1e-6:
+            nav.inject({"unit": "ins2", "kind": "drift_scale", "factor": 2.0}, s.t_s)
+        if abs(s.t_s - 100.0) < 1e-6:
+            nav.inject({"unit": "ins3", "kind": "gyro_bias_step", "axis": "y",
+                        "size_dph": 2000.0}, s.t_s)
+    ts, votes = np.array(ts), np.array(votes)
+    assert set(votes[ts < 100.0]) == {7}                       # the drift ×2 unit voted in
+    assert set(votes[ts > 110.0]) == {3}                       # ins3 out, ins1 + ins2 in
+    # the vote is on the raw outputs: the free unit 3 is far from its corrected twin
+    raw, cor = nav._free_out[2], nav.bank.output(2, states[1499])
+    assert abs(raw.pitch_rad - cor.pitch_rad) > math.radians(0.5)

@@ -144,3 +144,41 @@ def test_the_channel_filter_follows_an_error_that_turns_while_the_envelope_shrin
 
     assert run(lambda now, before: channel_process_noise(now, before, 1.0, 10.0)) < 0.1
     assert run(lambda now, before: max(now - before, 1e-10)) > 2.0      # the old rule lags
+
+
+def test_rank_weights_follow_the_ranking():
+    from fms_testbed.navigation.reference_description import rank_weights
+    w = rank_weights(np.array([0.0, 3.0, 1.0]))
+    np.testing.assert_allclose(w.sum(), 1.0)
+    assert list(np.argsort(-w)) == [0, 2, 1]                   # the ranking's order
+    np.testing.assert_allclose(w[1] / w[0], 1.0 / 10.0)        # (1 + 0²) / (1 + 3²)
+    np.testing.assert_allclose(rank_weights(np.full(3, 2.0)), 1.0 / 3.0)
+
+
+@pytest.mark.slow
+def test_the_output_is_weighted_by_the_reference_ranking_and_changes_with_it():
+    """Fault-free three units past the reference epoch: the output is Σ w_i C_i with the rank
+    weights of the monitor's distances, not the plain mean, and reversing the ranking moves it."""
+    import math
+    from fms_testbed.navigation.ins_gnss import _corrected_many, weighted_solution
+    from fms_testbed.navigation.reference_description import rank_weights
+    segs = [Segment(100.0), Segment(40.0, 3.0), Segment(60.0)]
+    states = aircraft_states(fly_profile(segs, dt_s=0.1, speed_mps=150.0))
+    nav = make_source({"source": "ins_gnss", "imu": "STIM300", "n_ins": 3}, seed=0)
+    for s in states:
+        out = nav.update(s)
+    d = nav.refdesc.d.copy()
+    assert np.isfinite(d).all() and np.ptp(d) > 0.1 and out.errors["ins_used"] == 7.0
+    O = np.array([(u.lat_rad, u.lon_rad, u.alt_m, *u.v_enu_mps, u.roll_rad, u.pitch_rad,
+                   u.heading_rad) for u in nav._prev_ins])
+    C, _ = _corrected_many(O, np.array([f.x[:9] for f in nav.filters]))
+    w = rank_weights(d)
+    ref = weighted_solution(C, [0, 1, 2], w)
+    assert math.isclose(out.lat_rad, ref[0], rel_tol=0, abs_tol=1e-13)
+    assert math.isclose(out.lon_rad, ref[1], rel_tol=0, abs_tol=1e-13)
+    rev = weighted_solution(C, [0, 1, 2], rank_weights(d[::-1]))
+    plain = weighted_solution(C, [0, 1, 2], np.full(3, 1.0 / 3.0))
+    r_m = 6.37e6
+    for other in (rev, plain):
+        moved_m = r_m * math.hypot(other[0] - ref[0], (other[1] - ref[1]) * math.cos(ref[0]))
+        assert moved_m > 1e-3
