@@ -12,10 +12,22 @@ the interval ``dt_s``. The window statistic is the generalised likelihood-ratio 
 shift of unknown size in a window (Basseville & Nikiforov 1993, § 2.4).
 
 With ``sensor_test = "cusum"`` the statistic is instead Page's two-sided CUSUM of each sample
-against the reference mean (Basseville & Nikiforov § 2.2, the test Lorden's bound T* is the
-delay of): e = x − μ_ref, σ² = σ_sample² + σ_k² |u − ū_ref|²,
-g± ← max(0, g± + Δ (±e − Δ/2) / σ²), ν_ij = 1 while some g > ``cusum_h``, for a design change
-Δ (``cusum_accel_mps2``, ``cusum_gyro_rps``).
+against the reference window's prediction of it (Basseville & Nikiforov § 2.2, the test
+Lorden's bound T* is the delay of), for a design change Δ (``cusum_accel_mps2``,
+``cusum_gyro_rps``). A manoeuvre changes the difference of two healthy units by c · u (c, per
+axis: the two units' scale-factor and misalignment difference; u the measured force or rate):
+not white noise but a bias held as long as the manoeuvre, which a CUSUM accumulates sample
+after sample whatever variance it is given. The reference window therefore estimates c too —
+the regression of the difference on u with the declared prior c ~ N(0, σ_k² I) (posterior
+mean and covariance; ū, d̄ the window means, S_uu = Σ (u − ū)(u − ū)ᵀ, S_du = Σ (d − d̄)(u − ū)ᵀ)::
+
+    A = S_uu + (σ_sample² / σ_k²) I,   ĉ = S_du A⁻¹,   P_c = σ_sample² A⁻¹
+    e = x − d̄ − ĉ (u − ū),   b = κ √((u − ū)ᵀ P_c (u − ū))
+    g± ← max(0, g± + Δ (±e − b − Δ/2) / σ_sample²),   ν_ij = 1 while some g > cusum_h
+
+— what the window could not resolve of c (a manoeuvre it has not seen) is a bounded nuisance
+bias: up to κ (``cusum_kappa``) of its posterior σ is taken off the excess before it
+accumulates (the CUSUM of the least favourable bias inside that bound).
 """
 
 from __future__ import annotations
@@ -55,7 +67,7 @@ class SensorPairTest:
     dt_s : sample interval, s
     sf_var : (U, 2) declared scale-factor + 2 × misalignment variance (accelerometer, gyro)
     tuning : ``sensor_test``, ``k_sensor``, ``accel_window_s``, ``gyro_window_s``,
-        ``reference_s``, ``cusum_h``, ``cusum_accel_mps2``, ``cusum_gyro_rps``
+        ``reference_s``, ``cusum_h``, ``cusum_kappa``, ``cusum_accel_mps2``, ``cusum_gyro_rps``
 
     Attributes
     ----------
@@ -79,6 +91,10 @@ class SensorPairTest:
             nl = ns + max(1, int(round(tuning.reference_s / dt_s)))
             self.groups.append((_Ring(ns, (n_real, P, 3)), _Ring(nl, (n_real, P, 3)),
                                 _Ring(ns, (3,)), _Ring(nl, (3,))))
+        # the CUSUM's regression sums: u uᵀ (shared) and d uᵀ per realisation, pair and axis
+        self.moments = ([(_Ring(g[0].n, (3, 3)), _Ring(g[1].n, (3, 3)),
+                          _Ring(g[0].n, (n_real, P, 3, 3)), _Ring(g[1].n, (n_real, P, 3, 3)))
+                         for g in self.groups] if tuning.sensor_test == "cusum" else [])
         self.last_z = np.zeros((n_real, P, 6))
         self.g = np.zeros((2, n_real, P, 6))                           # CUSUM g+, g-
         self.design = np.repeat([tuning.cusum_accel_mps2, tuning.cusum_gyro_rps], 3)
@@ -97,6 +113,11 @@ class SensorPairTest:
             cols = slice(3 * g, 3 * g + 3)
             for ring, v in ((short, d[:, :, cols]), (long_, d[:, :, cols]), (us, u), (ul, u)):
                 ring.push(v)
+            if self.moments:
+                uus, uul, dus, dul = self.moments[g]
+                uu, du_ = np.outer(u, u), d[:, :, cols, None] * u
+                for ring, v in ((uus, uu), (uul, uu), (dus, du_), (dul, du_)):
+                    ring.push(v)
             if long_.count < long_.n:
                 continue
             if self.tuning.sensor_test == "cusum":
@@ -113,17 +134,27 @@ class SensorPairTest:
 
     def _cusum(self, g: int, x, u, short, long_, us, ul) -> np.ndarray:
         """One CUSUM step of group ``g`` (0 accelerometers, 1 gyros) on the samples ``x``
-        (R, pairs, 3) against the reference window's mean; (R, pairs) bool alarms."""
+        (R, pairs, 3) against the reference window's prediction; (R, pairs) bool alarms."""
         cols = slice(3 * g, 3 * g + 3)
+        uus, uul, dus, dul = self.moments[g]
         nr = long_.n - short.n
-        mu = (long_.sum - short.sum) / nr
-        du = u - (ul.sum - us.sum) / nr
-        var = self.var[:, cols] + self.sf[:, cols] * float(du @ du)
+        d_bar = (long_.sum - short.sum) / nr                             # (R, P, 3)
+        u_bar = (ul.sum - us.sum) / nr                                   # (3,)
+        Suu = (uul.sum - uus.sum) - nr * np.outer(u_bar, u_bar)
+        Sdu = (dul.sum - dus.sum) - nr * d_bar[..., None] * u_bar        # (R, P, 3, 3)
+        var = self.var[:, cols]                                          # (P, 3)
+        lam = var / np.maximum(self.sf[:, cols], 1e-30)
+        Ainv = np.linalg.inv(Suu + lam[..., None, None] * np.eye(3))     # (P, 3, 3, 3)
+        c_hat = np.einsum("rpaj,pajk->rpak", Sdu, Ainv)
+        du = u - u_bar
+        mu = d_bar + c_hat @ du
+        b = self.tuning.cusum_kappa * np.sqrt(np.maximum(
+            var * np.einsum("j,pajk,k->pa", du, Ainv, du), 0.0))
         dd = self.design[cols]
         e = x - mu
         gp, gm = self.g[0][..., cols], self.g[1][..., cols]
-        np.maximum(gp + dd * (e - 0.5 * dd) / var, 0.0, out=gp)
-        np.maximum(gm + dd * (-e - 0.5 * dd) / var, 0.0, out=gm)
+        np.maximum(gp + dd * (e - b - 0.5 * dd) / var, 0.0, out=gp)
+        np.maximum(gm + dd * (-e - b - 0.5 * dd) / var, 0.0, out=gm)
         stat = np.maximum(gp, gm)
         self.g[0][..., cols], self.g[1][..., cols] = gp, gm
         self.last_z[:, :, cols] = stat
