@@ -52,6 +52,11 @@ events:
   - {t_s: 5, heading_deg: 120}
 """
 
+STEP_SCENARIO = SHORT_SCENARIO.replace("name: fuzz-short", "name: fuzz-steps").replace(
+    "one heading change", "one altitude step").replace(
+    "  - {t_s: 5, heading_deg: 120}", "  - {t_s: 5, alt_m: 3050}")
+"""The short flight with an altitude step instead of the turn (``compare`` measures steps)."""
+
 BASES = {
     "run": ["run", "{scenario}", "--no-plots", "--out", "{new}"],
     "demo": ["demo", "--out", "{new}"],
@@ -61,7 +66,7 @@ BASES = {
                          "{new}"],
     "procedures list": ["procedures", "list", "--airport", "KBFI"],
     "fly": ["fly", "--scenario", "{scenario}", "--no-plots", "--out", "{new}"],
-    "compare": ["compare", "{scenario}", "--out", "{new}"],
+    "compare": ["compare", "{steps}", "--out", "{new}"],
     "analyse": ["analyse", "--aircraft", "737", "--out", "{new}"],
     "tune": ["tune", "--aircraft", "737", "--quick", "--out", "{new}"],
     "ins": ["ins", "straight", "--duration-s", "60", "--out", "{new}"],
@@ -125,6 +130,8 @@ def one_run(seed: int, root: Path, case) -> tuple[str, str, str | None]:
     paths = _sandbox(box, case)
     (box / "short.yaml").write_text(SHORT_SCENARIO)
     paths["scenario"] = box / "short.yaml"
+    (box / "steps.yaml").write_text(STEP_SCENARIO)
+    paths["steps"] = box / "steps.yaml"
     name, argv = draw(seed, paths)
     before = _protected(paths)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO),
@@ -177,7 +184,7 @@ def test_every_command_has_a_base_and_each_line_changes_one_option(tmp_path):
     names = [" ".join(w) for w, _ in _commands()]
     assert set(names) == set(BASES), set(names) ^ set(BASES)
     paths = {k: tmp_path / k for k in ("file", "empty", "junk", "readonly", "link", "regress",
-                                       "mc", "missing", "new", "yaml", "scenario")}
+                                       "mc", "missing", "new", "yaml", "scenario", "steps")}
     drawn = Counter()
     for seed in range(3 * len(names)):
         name, argv = draw(seed, paths)
