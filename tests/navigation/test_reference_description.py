@@ -1,6 +1,6 @@
 """Zaitseva's reference-description monitor: its decision rule on arrays, its per-channel filter,
-the envelope's honesty on fault-free units, and a drift change identified while majority voting
-keeps the unit in."""
+the envelope's honesty on fault-free units, a large drift change identified (and seen by majority
+voting on the raw outputs), and the output weighted by the ranking."""
 
 import numpy as np
 import pytest
@@ -111,13 +111,15 @@ def test_fault_free_units_stay_inside_their_reference_description(states):
 
 
 @pytest.mark.slow
-def test_a_large_drift_change_is_excluded_by_the_reference_description_not_by_voting(states):
+def test_a_large_drift_change_is_excluded_by_the_reference_description_and_seen_by_raw_voting(
+        states):
     nav, rows = _fly(states, {"unit": "ins2", "kind": "drift_scale", "factor": 20.0})
     exc = [e for e in nav.events if e["kind"] == "excluded" and e["stage"] == "reference"]
     assert exc and exc[0]["unit"] == "ins2" and exc[0]["t_s"] - 300.0 <= 700.0   # 665 s at k 5
     after = [r for r in rows[int(exc[0]["t_s"] * 10) + 1:]]
     assert {r["ins_used_ref"] for r in after} == {5.0}
-    assert all(int(r["ins_used_vote"]) & 2 for r in after)     # voting keeps it in
+    # voting on the raw (free) outputs sees a ×20 drift (9.5 °/h excess) too: it votes it out
+    assert any(not int(r["ins_used_vote"]) & 2 for r in after)
 
 
 def test_the_channel_filter_follows_an_error_that_turns_while_the_envelope_shrinks():

@@ -40,7 +40,8 @@ class FdiTuning:
     Every threshold is a multiple of a σ derived from the declared unit performance: the
     filters' covariance for the output and estimator tests, the declared VRW/ARW densities and
     scale-factor/misalignment variances for the sensor-level test. The defaults of
-    ``k_pair``, ``k_sensor``, ``k_est`` and ``innovation_scale`` are calibrated: each is the
+    ``k_pair``, ``k_sensor``, ``k_est``, ``innovation_scale`` and ``cusum_h`` (with
+    ``sensor_test="cusum"``) are calibrated: each is the
     value a Gumbel fit to the per-hour maxima of its statistic on the calibration set of
     fault-free flights exceeds at 3e-4 per hour, rounded up (``bench/bench_detection.py
     calibrate``, docs/navigation.md "Thresholds").
