@@ -231,6 +231,32 @@ def _gated_correct_delayed(x, P, z, H, R, sc, phi_lag, q_lag, frozen, gate):
     return xn, Pn, nu, S, nis, _passes(nu, S, gate)
 
 
+def _correct(f, z, H, R, sc, lag, frozen, gate):
+    """(x, P, ν, S, NIS, passed): filter ``f``'s gated correction, delayed when ``lag`` is
+    set."""
+    if lag is None:
+        return _gated_correct(f.x, f.P, z, H, R, sc, frozen, gate)
+    return _gated_correct_delayed(f.x, f.P, z, H, R, sc, lag[0], lag[1], frozen, gate)
+
+
+def _components(f, z, H, R, sc, lag, nu, S):
+    """Seed 001's channel test |y_i − ŷ_i| ≤ ε_i = ``channel_test`` √S_ii per component:
+    the failed components' gain columns are zeroed (the correction uses the passing rows of
+    z, H, R alone), and a failed vertical component (index 2) also zeroes the gain rows
+    ``hold_vertical`` (those states keep their prediction). Returns (None, True) when every
+    component passes, ((ok, (x, P)), True) when some do, (None, False) when none does."""
+    ok = np.abs(nu) <= f.channel_test * np.sqrt(np.diag(S))
+    if ok.all() or not ok.any():
+        return None, bool(ok.all())
+    frozen = f.frozen
+    if not ok[2] and f.hold_vertical is not None:
+        frozen = frozen | f.hold_vertical
+    Rs = np.ascontiguousarray(R[np.ix_(ok, ok)])
+    x, P, *_ = _correct(f, np.ascontiguousarray(z[ok]), np.ascontiguousarray(H[ok]), Rs,
+                        np.ascontiguousarray(sc[ok]), lag, frozen, math.inf)
+    return (ok, (x, P)), True
+
+
 class InsGnssFilter:
     """The error-state filter of one INS (see the module docstring).
 
@@ -423,10 +449,10 @@ class InsGnssFilter:
         P_in = self.P
         if reset:
             self.P = self._reset_covariance(meas, z, H, R, lag)
-        x, P, nu, S, nis, used = self._correct(z, H, R, sc, lag, self.frozen, gate)
+        x, P, nu, S, nis, used = _correct(self, z, H, R, sc, lag, self.frozen, gate)
         comp = None
         if self.channel_test > 0 and not reset and name.startswith("gnss"):
-            comp, used = self._components(z, H, R, sc, lag, nu, S)
+            comp, used = _components(self, z, H, R, sc, lag, nu, S)
             if comp is not None and used:
                 x, P = comp[1]
                 comp = tuple(comp[0])
@@ -437,29 +463,6 @@ class InsGnssFilter:
             self.P = P_in
             self._rejected[name] = n_rej + 1
         return GroupResult(name, nu, S, nis, bool(used), reset, comp)
-
-    def _correct(self, z, H, R, sc, lag, frozen, gate):
-        """(x, P, ν, S, NIS, passed): the gated correction, delayed when ``lag`` is set."""
-        if lag is None:
-            return _gated_correct(self.x, self.P, z, H, R, sc, frozen, gate)
-        return _gated_correct_delayed(self.x, self.P, z, H, R, sc, lag[0], lag[1], frozen, gate)
-
-    def _components(self, z, H, R, sc, lag, nu, S):
-        """Seed 001's channel test |y_i − ŷ_i| ≤ ε_i = ``channel_test`` √S_ii per component:
-        the failed components' gain columns are zeroed (the correction uses the passing rows of
-        z, H, R alone), and a failed vertical component (index 2) also zeroes the gain rows
-        ``hold_vertical`` (those states keep their prediction). Returns (None, True) when every
-        component passes, ((ok, (x, P)), True) when some do, (None, False) when none does."""
-        ok = np.abs(nu) <= self.channel_test * np.sqrt(np.diag(S))
-        if ok.all() or not ok.any():
-            return None, bool(ok.all())
-        frozen = self.frozen
-        if not ok[2] and self.hold_vertical is not None:
-            frozen = frozen | self.hold_vertical
-        Rs = np.ascontiguousarray(R[np.ix_(ok, ok)])
-        x, P, *_ = self._correct(np.ascontiguousarray(z[ok]), np.ascontiguousarray(H[ok]), Rs,
-                                 np.ascontiguousarray(sc[ok]), lag, frozen, math.inf)
-        return (ok, (x, P)), True
 
     def _reset_covariance(self, meas: Measurement, z, H, R, lag) -> np.ndarray:
         """P with the rows and columns of ``meas.reset_states`` zeroed and their variance set
