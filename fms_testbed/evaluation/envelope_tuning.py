@@ -12,7 +12,8 @@ checks (margins on every loop, robustness, nonlinear JSBSim steps).
    actuator delay of :data:`ROBUST_DELAY_S`), and the nonlinear altitude and speed steps
    (max|ΔV|, max|ΔH|).
 
-Points run on a local process pool (``workers``); each job is one design point.
+Points run on a local process pool (``workers``) or through a caller's ``map_jobs`` (the CLI's
+Dask cluster); each job is one design point.
 """
 
 from __future__ import annotations
@@ -22,6 +23,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Callable
 
 import multiprocessing
 import control as ct
@@ -254,7 +256,8 @@ def _pool_map(fn, jobs: list[tuple], workers: int) -> list:
 
 
 def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int = 2,
-                  robust: bool = True, duration_s: float = 90.0) -> EnvelopeResult:
+                  robust: bool = True, duration_s: float = 90.0,
+                  map_jobs: Callable | None = None) -> EnvelopeResult:
     """Tune every point, fit the schedule, check every point with it (module docstring).
 
     Parameters
@@ -262,6 +265,9 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
     cfg : aircraft (loaded by name or file in the workers);  points : the design points
     workers : local processes;  robust : run the robustness set
     duration_s : length of each nonlinear step run, s
+    map_jobs : ``map_jobs(fn, jobs) -> [fn(*job) for job in jobs]`` in the jobs' order, run
+        elsewhere (e.g. on a Dask cluster); None: a local pool of ``workers`` processes. ``fn``
+        is a module-level function and every job's arguments are picklable
 
     Raises
     ------
@@ -269,8 +275,9 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
         When fewer than three points trim (no schedule can be fitted).
     """
     ref = cfg.source_file or cfg.name
+    run = map_jobs or (lambda fn, jobs: _pool_map(fn, jobs, workers))
     t0 = time.perf_counter()
-    tuned = _pool_map(_tune_job, [(ref, p) for p in points], workers)
+    tuned = run(_tune_job, [(ref, p) for p in points])
     t1 = time.perf_counter()
     ok = [r for r in tuned if "qbar_pa" in r]
     models = [r.pop("model") for r in ok]
@@ -280,8 +287,8 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
     sched = schedule_from_points([{"qbar_pa": r["qbar_pa"], "mass_kg": r["mass_kg"],
                                    **{n: r[f"tuned_{n}"] for n in SCHEDULED}} for r in ok])
     bank, before, after = tune_bank_loop(cfg, models)
-    checks = _pool_map(_check_job, [(ref, r["point"], sched, robust, duration_s, bank)
-                                    for r in tuned if "qbar_pa" in r], workers)
+    checks = run(_check_job, [(ref, r["point"], sched, robust, duration_s, bank)
+                              for r in tuned if "qbar_pa" in r])
     steps = [r for r in check_aircraft(replace_gains(cfg, "bank", bank)) if r.spec.loop == "bank"]
     t2 = time.perf_counter()
     rows, figs, it = [], {}, iter(checks)
