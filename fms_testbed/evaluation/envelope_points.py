@@ -334,7 +334,8 @@ def excess_power_mps(cfg: AircraftConfig, point: DesignPoint, duration_s: float 
     """Specific excess power at full thrust at ``point``, m/s: from the trim, the throttle at
     the inner loop's maximum and the n_y loop holding 1 g, the energy rate per unit weight
     ``P_s = ḣ + V V̇ / g = (T_max - D) V / W`` averaged over the last ``avg_s`` of
-    ``duration_s`` seconds (the engines have spooled up by then).
+    ``duration_s`` seconds (the engines have spooled up by then), at the speed reached then
+    (it has risen by about g P_s t / V: little where the margin is small).
 
     The altitude step a point is verified with needs ``P_s ≥`` its peak climb rate at constant
     speed (:func:`step_climb_rate_mps`); below it the speed must give the energy.
@@ -365,9 +366,35 @@ def excess_power_mps(cfg: AircraftConfig, point: DesignPoint, duration_s: float 
 def step_climb_rate_mps(pl: PointLoops) -> float:
     """Peak climb rate of the linear closed loop ``pl`` in the +:data:`DH_STEP_M` altitude
     step, m/s (the specific excess power the step needs at constant speed)."""
-    sys = pl.closed("lon", ["V_cmd", "H_cmd"], ["h"])
-    h = step_outputs(sys, np.array([0.0, DH_STEP_M]))[:, 0]
-    return float(np.max(np.diff(h)) / _DT_S)
+    return float(np.max(_step_climb_mps(pl)))
+
+
+def _step_climb_mps(pl: PointLoops) -> np.ndarray:
+    h = step_outputs(pl.closed("lon", ["V_cmd", "H_cmd"], ["h"]),
+                     np.array([0.0, DH_STEP_M]))[:, 0]
+    return np.diff(h) / _DT_S
+
+
+def thrust_margin(cfg: AircraftConfig, point: DesignPoint, pl: PointLoops) -> dict:
+    """Whether the engines can give the +:data:`DH_STEP_M` step of the loops ``pl`` at
+    ``point`` without the speed paying for it: ``ps_max_mps`` (:func:`excess_power_mps`),
+    ``ps_step_mps`` (:func:`step_climb_rate_mps`), ``thrust_limited`` (ps_max < ps_step) and
+    ``dv_energy_kmh``, the speed that following the step's linear climb V_y(t) at full thrust
+    costs by the energy balance ``V dV/dt = g (P_s,max - V_y)``::
+
+        ΔV = (g / V₀) ∫ max(0, V_y(t) - P_s,max) dt
+
+    Parameters
+    ----------
+    cfg, point : aircraft and design point;  pl : the point's loops (scheduled gains)
+    """
+    from fms_testbed.core.units import G0_MPS2
+
+    ps = excess_power_mps(cfg, point)
+    vy = _step_climb_mps(pl)
+    dv = G0_MPS2 / pl.V0_mps * float(np.sum(np.maximum(vy - ps, 0.0)) * _DT_S)
+    return {"ps_max_mps": ps, "ps_step_mps": float(vy.max()),
+            "thrust_limited": bool(ps < vy.max()), "dv_energy_kmh": dv / KMH_MPS}
 
 
 def verify(cfg: AircraftConfig, point: DesignPoint, make_law, duration_s: float = 90.0

@@ -9,8 +9,10 @@ checks (margins on every loop, robustness, nonlinear JSBSim steps).
 4. every point is checked with the *scheduled* gains — the ones the law flies: margins of the six
    broken loops (python-control ``stability_margins`` and ``disk_margins``), the same margins
    under the robustness set (mass ±:data:`ROBUST_MASS_FRAC`, CG ±:data:`ROBUST_CG_M`, an
-   actuator delay of :data:`ROBUST_DELAY_S`), and the nonlinear altitude and speed steps
-   (max|ΔV|, max|ΔH|).
+   actuator delay of :data:`ROBUST_DELAY_S`), the nonlinear altitude and speed steps
+   (max|ΔV|, max|ΔH|), and whether the engines can give the altitude step at constant speed
+   (:func:`.envelope_points.thrust_margin`: a point where the full-thrust excess power is below
+   the step's peak climb rate is ``thrust_limited``: there the speed must pay for the climb).
 
 Points run on a local process pool (``workers``) or through a caller's ``map_jobs`` (the CLI's
 Dask cluster); each job is one design point.
@@ -40,8 +42,8 @@ from fms_testbed.control.schedule import SCHEDULED, GainSchedule, schedule_from_
 from fms_testbed.core.atmosphere import cas_to_tas
 from fms_testbed.core.errors import ConfigError, TrimError
 from fms_testbed.core.units import SLUG_KG
-from fms_testbed.evaluation.envelope_points import (point_loops, tune_bank_loop, tune_point,
-                                                    verify)
+from fms_testbed.evaluation.envelope_points import (point_loops, thrust_margin, tune_bank_loop,
+                                                    tune_point, verify)
 from fms_testbed.sim.inner_steps import check_aircraft, replace_gains
 from fms_testbed.sim.linearise import DesignPoint, linearise
 
@@ -220,6 +222,7 @@ def _check_job(ref: str, point: DesignPoint, schedule: GainSchedule, robust: boo
     row = {f"sched_{k}": v for k, v in schedule.values(model.qbar_pa, model.mass_kg).items()}
     pl = point_loops(cfg, model, law_at(model))
     row.update(_loop_columns(pl))
+    row.update(thrust_margin(cfg, point, pl))
     row["gm_min_db"], row["pm_min_deg"], row["disk_margin"] = _mins(row)
     if robust:
         row.update(_robust_columns(cfg, point, model.mass_kg, law_at, model))
