@@ -81,15 +81,17 @@ def campaign_shift(old: pd.DataFrame, new: pd.DataFrame) -> CampaignShift:
 
 def goal_lines(s: CampaignShift) -> list[tuple[bool, str]]:
     """(met, text) of the campaign goal: median FTE95 and vertical path error p95 no worse than
-    with the file gains, fewer constraints missed."""
+    with the file gains, fewer constraints missed (of as many checked: a run that flew less
+    cannot meet it; a NaN median never does)."""
     t = s.table
     out = []
     for m, what in (("fte_p95_m", "median FTE95"), ("vpe_p95_m", "median vertical path error p95")):
         a, b = t.loc[f"{m} median", OLD], t.loc[f"{m} median", NEW]
         out.append((bool(b <= a), f"campaign {what} no worse: {b:.2f} m (file gains {a:.2f} m)"))
     a, b = int(t.loc["constraints_missed", OLD]), int(t.loc["constraints_missed", NEW])
-    out.append((b < a, f"campaign constraints missed fewer: {b} (file gains {a}) of "
-                       f"{int(t.loc['constraints_checked', NEW])}"))
+    checked = int(t.loc["constraints_checked", NEW])
+    out.append((b < a and checked == int(t.loc["constraints_checked", OLD]) and s.n_pairs > 0,
+                f"campaign constraints missed fewer: {b} (file gains {a}) of {checked}"))
     return out
 
 

@@ -55,6 +55,10 @@ def test_goal_lines_follow_the_medians_and_the_missed_constraints():
     assert [ok for ok, _ in goal_lines(campaign_shift(old, better))] == [True, True, True]
     got = [ok for ok, _ in goal_lines(campaign_shift(old, worse))]
     assert got == [False, True, False]       # FTE median 6.5 > 6.0; missed 2, not fewer
+    # a tuned run that flew nothing meets nothing (fewer missed of fewer checked is no gain)
+    none = better.assign(fte_p95_m=np.nan, vpe_p95_m=np.nan, spd_err_p95_kt=np.nan,
+                         constraints_checked=0, constraints_missed=0, status="error")
+    assert [ok for ok, _ in goal_lines(campaign_shift(old, none))] == [False, False, False]
 
 
 def test_conditions_file_is_one_set_the_regression_reads(tmp_path):
