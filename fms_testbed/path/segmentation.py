@@ -20,6 +20,7 @@ from dataclasses import replace
 
 from fms_testbed.core.atmosphere import cas_to_tas, tas_to_cas
 from fms_testbed.core.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
+from fms_testbed.core.planning import DECEL_MPS2
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
@@ -177,7 +178,8 @@ def leg_cls_hold(leg: ResolvedLeg) -> bool:
 
 def build_sequence(db: Database, seq: Sequence, perf: Performance,
                    params: BuildParams | None = None, start: FlightState | None = None,
-                   prev_fix: Fix | None = None) -> ProcedurePath:
+                   prev_fix: Fix | None = None, hold_legs: frozenset[int] = frozenset()
+                   ) -> ProcedurePath:
     """Build one procedure transition into a :class:`ProcedurePath` (segments + legs).
 
     Parameters
@@ -190,6 +192,10 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         :func:`start_state`. Guidance uses this to rebuild from the aircraft's actual state.
     prev_fix : the fix the first leg starts from (a leg rebuilt mid-way: a TF rejoins the track
         from it; its coded path is kept for the PDE); default none
+    hold_legs : indices of departure legs planned at the climb-out speed (held since the
+        acceleration height) instead of the departure schedule; a SID whose CF course cannot
+        be flown at the schedule's speed (a fly-by onto it flown over, the fix reached
+        against the course) is built again with its CFs held
 
     Returns
     -------
@@ -215,13 +221,17 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
                                for lg in legs[:-1]]
     b = LegBuilder(legs, perf, params, g, prev_fixes)
     b.climbing = seq.proc_type == "D"
+    b.dep_elev_m = departure_elev_m(db, seq, kind)
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
-    built = _build_legs(b, seq.proc_type, state, bank)
+    built = _build_legs(b, seq.proc_type, state, bank, hold_legs)
     segs = round_corners(b, perf, params, bank)
-    built = _attach_segments(built, segs)
+    built = _departure_slowdowns(_attach_segments(built, segs), segs)
     status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
     out = replace(path, legs=tuple(built), segments=tuple(segs),
                   findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
+    hold = _cf_legs_to_hold(out, perf) - hold_legs
+    if hold:
+        return build_sequence(db, seq, perf, params, start, prev_fix, hold_legs | hold)
     if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
         alt = _arrival_start_m(out, perf, params, state0.alt_m)
         if alt is not None:
@@ -230,8 +240,8 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     return out
 
 
-def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: float
-                ) -> list[BuiltLeg]:
+def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: float,
+                hold_legs: frozenset[int] = frozenset()) -> list[BuiltLeg]:
     """Run every leg's class from ``state`` (each planned by :func:`_plan_leg`: its climb
     cap from :func:`~fms_testbed.path.profile.climb_caps_m`, its approach CAS cap); stop at
     the first leg that cannot be built (an 'impossible' finding). Returns the built legs."""
@@ -242,11 +252,20 @@ def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: flo
                             path_climb_top_m(proc_type, params.climb_top_m), perf.alt_plan_max_m)
     built: list[BuiltLeg] = []
     for i, leg in enumerate(legs):
-        _plan_leg(b, i, state.alt_m, float(alt_caps[i + 1]), caps[i], bank_deg)
+        _plan_leg(b, i, state.alt_m, float(alt_caps[i + 1]), caps[i], bank_deg,
+                  hold=i in hold_legs)
         start_st = state
         leg_cls = LEG_TYPES[leg.pt]
+        snap = (len(b.segments), set(b.corners), len(b.findings), b._corner_pending)
         try:
             state, term = leg_cls.build(b, state)
+            if _held_speed_helps(b, snap[2], proc_type):
+                # a departure can have held its climb-out speed: the leg at that speed
+                del b.segments[snap[0]:], b.findings[snap[2]:]
+                b.corners, b._corner_pending = snap[1], snap[3]
+                _plan_leg(b, i, start_st.alt_m, float(alt_caps[i + 1]), caps[i], bank_deg,
+                          hold=True)
+                state, term = leg_cls.build(b, start_st)
         except LegError as exc:
             b.finding("impossible", f"leg {i + 1} {leg.pt}: {exc} (line {leg.rec.line})")
             break
@@ -255,8 +274,43 @@ def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: flo
             state = replace(state, alt_m=_descent_target(leg))
         built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps,
                               coded=leg_cls.coded_path(b, term), resolved=leg,
-                              from_fix=b.prev_fixes[i]))
+                              from_fix=b.prev_fixes[i], departure_cas_mps=b.dep_cas_mps))
     return built
+
+
+def _cf_legs_to_hold(path: ProcedurePath, perf: Performance) -> frozenset[int]:
+    """The CF legs of a departure planned faster than its climb-out speed whose course was
+    not flown as coded: a fly-by onto the course flown over (branch V,γ,φ,λ naming it), or
+    an 'impossible' finding on the leg; empty for other procedures."""
+    if path.proc_type != "D" or perf.departure_cas_mps is None:
+        return frozenset()
+    out = set()
+    for lg in path.legs:
+        if not LEG_TYPES[lg.path_term].course_to_fix or lg.departure_cas_mps is None or \
+                lg.departure_cas_mps <= perf.departure_cas_mps + 0.5:
+            continue
+        ident = lg.record.fix.ident if lg.record.fix else ""
+        if any(f.leg_index == lg.index and f.category == "impossible" or
+               f.branch == "V,γ,φ,λ" and f"CF {ident}" in f.message
+               and f.leg_index in (lg.index - 1, lg.index) for f in path.findings):
+            out.add(lg.index)
+    return frozenset(out)
+
+
+def _held_speed_helps(b: LegBuilder, n_findings: int, proc_type: str) -> bool:
+    """True when the leg just built (its findings from index ``n_findings``) is a departure
+    leg planned faster than the climb-out speed whose course could not be flown as coded (the
+    fix reached direct, or no room even at the minimum speed): it is built again at the
+    climb-out speed, which the aircraft can have held since the acceleration height."""
+    perf = b.perf
+    if proc_type != "D" or perf.departure_cas_mps is None or \
+            not LEG_TYPES[b.leg.pt].course_to_fix:
+        return False
+    if b.dep_cas_mps is not None and b.dep_cas_mps <= perf.departure_cas_mps + 0.5:
+        return False
+    return any(f.category == "impossible" or "flown direct to the fix" in f.message
+               or "joined at the minimum speed" in f.message
+               for f in b.findings[n_findings:])
 
 
 def _arrival_start_m(path: ProcedurePath, perf: Performance, params: BuildParams,
@@ -271,17 +325,21 @@ def _arrival_start_m(path: ProcedurePath, perf: Performance, params: BuildParams
 
 
 def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
-              cas_cap_mps: float | None, bank_deg: float) -> None:
+              cas_cap_mps: float | None, bank_deg: float, hold: bool = False) -> None:
     """Set the builder up for leg ``i`` planned from ``alt_m`` (m): its climb cap (m), its
     settings (the wind at its planned altitude; a hold in a climb: the strongest up to the
     climb top, planned at the top), its planned speed (m/s, under ``cas_cap_mps``), climb
     gradient and turn radius R = V²/(g tan γ) at ``bank_deg`` — for the faster of this leg
-    and the one before (a turn at its start is entered at the previous leg's speed)."""
+    and the one before (a turn at its start is entered at the previous leg's speed). A
+    departure leg is planned under the departure schedule
+    (:meth:`~fms_testbed.legs.model.Performance.departure_cas_at_mps`), or with ``hold`` at
+    the climb-out speed held since the acceleration height (the legs before are slowed to it:
+    :func:`_departure_slowdowns`)."""
     leg, params, perf = b.legs[i], b.params0, b.perf
     b.i, b.alt_cap_m = i, alt_cap_m
     if leg.rec.missed_approach_start:
         b.climbing = True
-    speed_in = b.speed_mps if i else None
+    speed_in = b.speed_mps if i and not hold else None
     alt_plan = alt_m
     b.params = params.for_altitude(alt_plan)
     if b.climbing and leg_cls_hold(leg) and params.climb_top_m is not None:
@@ -292,9 +350,82 @@ def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
         alt_plan = top
     b.leg_params[i] = b.params
     b.leg_alt_m[i] = alt_plan
+    b.dep_cas_mps = _departure_cas_mps(b, alt_m) if b.climbing else None
+    if hold:
+        b.dep_cas_mps = perf.departure_cas_mps
+    v_climb = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
+    if b.dep_cas_mps is not None:
+        cas_cap_mps = b.dep_cas_mps if cas_cap_mps is None else min(cas_cap_mps,
+                                                                     b.dep_cas_mps)
     b.speed_mps = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
-    b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
+    # the climb at the gradient of the speed without the departure schedule: the vertical
+    # profile (:func:`~fms_testbed.path.profile.plan_profile`) climbs at that one too
+    b.gradient = perf.climb_gradient_at(v_climb) if b.climbing else 0.0
     b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank_deg, b.g)
+
+
+def departure_elev_m(db: Database, seq: Sequence, kind: str) -> float | None:
+    """Elevation of the runway a SID is planned from, m, when its departure speeds apply
+    (:meth:`~fms_testbed.legs.model.Performance.departure_cas_at_mps`): a build from the
+    runway (start kind 'runway'), or the rest of a SID flown from its runway rebuilt in
+    flight ('given'); None otherwise (a SID joined at a fix, arrivals)."""
+    if seq.proc_type != "D" or kind not in ("runway", "given"):
+        return None
+    rwy = runway_record(db, seq.airport, seq.transition)
+    if rwy is None:
+        return None
+    apt = db.airports.get(seq.airport)
+    elev = rwy.elev_m if rwy.elev_m is not None else (apt.elev_m if apt else None)
+    return elev if elev is not None else 0.0
+
+
+def _departure_cas_mps(b: LegBuilder, alt_m: float) -> float | None:
+    """The departure schedule's CAS at the start of the leg being planned from ``alt_m`` (m),
+    m/s (None: not a departure from a runway). The path distance where the planned climb
+    passed the acceleration height is interpolated between the leg starts around it (the
+    climb is linear in distance between them); a rebuild that starts above it counts back
+    along the climb at the climb-out speed's gradient, d = Δh / Θ(V_c)."""
+    if b.dep_elev_m is None:
+        return None
+    perf = b.perf
+    h = alt_m - b.dep_elev_m
+    s = b.flown_before_m + math.fsum(sg.geom.length_m() for sg in b.segments)
+    if b.dep_accel_s_m is None and h >= perf.accel_height_m:
+        prev = b.dep_prev
+        if prev is None or prev[1] >= h:
+            v_c = isa_tas_mps(perf.departure_cas_mps or perf.tas_plan_mps, alt_m,
+                              b.params0.isa_dev_c)
+            b.dep_accel_s_m = s - (h - perf.accel_height_m) / perf.climb_gradient_at(v_c)
+        else:
+            b.dep_accel_s_m = prev[0] + (s - prev[0]) * (perf.accel_height_m - prev[1]) \
+                / (h - prev[1])
+    b.dep_prev = (s, h)
+    d = None if b.dep_accel_s_m is None else s - b.dep_accel_s_m
+    return perf.departure_cas_at_mps(d, alt_m)
+
+
+def _departure_slowdowns(built: list[BuiltLeg], segs: list[PathSegment]) -> list[BuiltLeg]:
+    """A departure leg planned slower than the schedule (a course joined at the minimum
+    speed) is flown at that speed from its start: the legs before it are capped, backwards,
+    so the aircraft can slow down over them at the planned deceleration a,
+    V_k ≤ √(V_k+1² + 2 a L_k) (CAS, L_k the leg's length, m)."""
+    if all(lg.departure_cas_mps is None for lg in built):
+        return built
+    length = [0.0] * len(built)
+    pos = {lg.index: k for k, lg in enumerate(built)}
+    for sg in segs:
+        k = pos.get(sg.leg_index)
+        if k is not None:
+            length[k] += sg.geom.length_m()
+    out = list(built)
+    for k in range(len(out) - 2, -1, -1):
+        v, v_next = out[k].departure_cas_mps, out[k + 1].departure_cas_mps
+        if v is None or v_next is None:
+            continue
+        cap = math.sqrt(v_next * v_next + 2.0 * DECEL_MPS2 * length[k])
+        if cap < v:
+            out[k] = replace(out[k], departure_cas_mps=cap)
+    return out
 
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
