@@ -19,15 +19,15 @@ import math
 from dataclasses import replace
 
 from fms_testbed.core.atmosphere import cas_to_tas, tas_to_cas
-from fms_testbed.core.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
-from fms_testbed.core.planning import DECEL_MPS2
+from fms_testbed.core.geodesy import direct, gravity_mps2, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
+from fms_testbed.path import departure
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
 from fms_testbed.path.profile import (PLAN_CLIMB_FRACTION, arrival_join_alt_m, climb_caps_m,
-                                     climb_phases, path_climb_top_m, window)
+                                     climb_phases, path_climb_top_m)
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
@@ -85,38 +85,11 @@ def runway_record(db: Database, airport: str, transition: str):
     return None
 
 
-SID_JOIN_CAP_M = 18000 * FT_M
-"""A SID joined at a fix away from the runway is never planned above this, m."""
-
-
-def sid_join_alt_m(db: Database, seq: Sequence, fix, elev_m: float,
-                   perf: Performance | None) -> float:
-    """Altitude at which a SID joined at ``fix`` (not from its runway: the runway part is
-    vectors or was not asked for) is planned to be there: 35 ft above the field plus a climb at
-    the aircraft's gradient over the distance from the airport to the fix, capped by every 'at
-    or below', 'at' or 'between' constraint of the transition (the top of its window) and by
-    :data:`SID_JOIN_CAP_M`, and raised into the first fix's own window, m — not the field
-    elevation (issue 12, class H: a start thousands of feet below the climb windows), nor
-    above an 'at' first fix (KAPA ECHOO1: joined at 18,000 ft over BAPME coded at 8,000 ft)."""
-    alt = elev_m + 35 * FT_M
-    apt = db.airports.get(seq.airport)
-    if perf is not None and apt is not None and fix is not None:
-        d = inverse(apt.lat_deg, apt.lon_deg, fix.lat_deg, fix.lon_deg)[0]
-        alt += perf.climb_gradient_at(perf.tas_plan_mps) * d
-    # capped by the top of every window ('at or below', 'at', 'between': an 'at 8,000 ft' at
-    # the first fix is a cap too), and inside the first fix's own window
-    wins = [window(r.alt_desc, r.alt1_m, r.alt2_m) for r in seq.legs]
-    caps = [hi for _, hi in wins if hi is not None]
-    alt = min([alt, SID_JOIN_CAP_M] + caps)
-    lo_first = wins[0][0] if wins else None
-    return alt if lo_first is None else max(alt, lo_first)
-
-
 def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
                 perf: Performance | None = None) -> FlightState:
     """Planned start: a SID runway transition starts at the departure end of the runway
     (threshold + length along the runway's true bearing, 35 ft above the threshold); a SID
-    joined at its first fix starts there at :func:`sid_join_alt_m`; other transitions start at
+    joined at its first fix starts there at :func:`~fms_testbed.path.departure.sid_join_alt_m`; other transitions start at
     their first fix (STAR/approach altitude: the first coded altitude, else airport elevation
     + 10,000 ft / 3,000 ft, no higher than ``perf.alt_plan_max_m``); a SID without either
     starts over the airport."""
@@ -130,7 +103,7 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
             lat, lon, az = direct(rwy.lat_deg, rwy.lon_deg, brg, rwy.length_m or 0.0)
             alt = (rwy.elev_m if rwy.elev_m is not None else elev) + 35 * FT_M
             return FlightState(lat, lon, wrap360(az), alt)
-        alt = sid_join_alt_m(db, seq, first.fix, elev, perf)
+        alt = departure.sid_join_alt_m(db, seq, first.fix, elev, perf)
     else:
         # the first coded altitude; of an 'between' window its middle (the top of it can
         # leave the next windows out of reach of the descent)
@@ -221,15 +194,16 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
                                for lg in legs[:-1]]
     b = LegBuilder(legs, perf, params, g, prev_fixes)
     b.climbing = seq.proc_type == "D"
-    b.dep_elev_m = departure_elev_m(db, seq, kind)
+    b.dep_elev_m = departure.departure_elev_m(db, seq, kind,
+                                             runway_record(db, seq.airport, seq.transition))
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
     built = _build_legs(b, seq.proc_type, state, bank, hold_legs)
     segs = round_corners(b, perf, params, bank)
-    built = _departure_slowdowns(_attach_segments(built, segs), segs)
+    built = departure.departure_slowdowns(_attach_segments(built, segs), segs)
     status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
     out = replace(path, legs=tuple(built), segments=tuple(segs),
                   findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
-    hold = _cf_legs_to_hold(out, perf) - hold_legs
+    hold = departure.cf_legs_to_hold(out, perf) - hold_legs
     if hold:
         return build_sequence(db, seq, perf, params, start, prev_fix, hold_legs | hold)
     if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
@@ -259,7 +233,7 @@ def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: flo
         snap = (len(b.segments), set(b.corners), len(b.findings), b._corner_pending)
         try:
             state, term = leg_cls.build(b, state)
-            if _held_speed_helps(b, snap[2], proc_type):
+            if departure.held_speed_helps(b, snap[2], proc_type):
                 # a departure can have held its climb-out speed: the leg at that speed
                 del b.segments[snap[0]:], b.findings[snap[2]:]
                 b.corners, b._corner_pending = snap[1], snap[3]
@@ -276,41 +250,6 @@ def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: flo
                               coded=leg_cls.coded_path(b, term), resolved=leg,
                               from_fix=b.prev_fixes[i], departure_cas_mps=b.dep_cas_mps))
     return built
-
-
-def _cf_legs_to_hold(path: ProcedurePath, perf: Performance) -> frozenset[int]:
-    """The CF legs of a departure planned faster than its climb-out speed whose course was
-    not flown as coded: a fly-by onto the course flown over (branch V,γ,φ,λ naming it), or
-    an 'impossible' finding on the leg; empty for other procedures."""
-    if path.proc_type != "D" or perf.departure_cas_mps is None:
-        return frozenset()
-    out = set()
-    for lg in path.legs:
-        if not LEG_TYPES[lg.path_term].course_to_fix or lg.departure_cas_mps is None or \
-                lg.departure_cas_mps <= perf.departure_cas_mps + 0.5:
-            continue
-        ident = lg.record.fix.ident if lg.record.fix else ""
-        if any(f.leg_index == lg.index and f.category == "impossible" or
-               f.branch == "V,γ,φ,λ" and f"CF {ident}" in f.message
-               and f.leg_index in (lg.index - 1, lg.index) for f in path.findings):
-            out.add(lg.index)
-    return frozenset(out)
-
-
-def _held_speed_helps(b: LegBuilder, n_findings: int, proc_type: str) -> bool:
-    """True when the leg just built (its findings from index ``n_findings``) is a departure
-    leg planned faster than the climb-out speed whose course could not be flown as coded (the
-    fix reached direct, or no room even at the minimum speed): it is built again at the
-    climb-out speed, which the aircraft can have held since the acceleration height."""
-    perf = b.perf
-    if proc_type != "D" or perf.departure_cas_mps is None or \
-            not LEG_TYPES[b.leg.pt].course_to_fix:
-        return False
-    if b.dep_cas_mps is not None and b.dep_cas_mps <= perf.departure_cas_mps + 0.5:
-        return False
-    return any(f.category == "impossible" or "flown direct to the fix" in f.message
-               or "joined at the minimum speed" in f.message
-               for f in b.findings[n_findings:])
 
 
 def _arrival_start_m(path: ProcedurePath, perf: Performance, params: BuildParams,
@@ -334,7 +273,7 @@ def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
     departure leg is planned under the departure schedule
     (:meth:`~fms_testbed.legs.model.Performance.departure_cas_at_mps`), or with ``hold`` at
     the climb-out speed held since the acceleration height (the legs before are slowed to it:
-    :func:`_departure_slowdowns`)."""
+    :func:`~fms_testbed.path.departure.departure_slowdowns`)."""
     leg, params, perf = b.legs[i], b.params0, b.perf
     b.i, b.alt_cap_m = i, alt_cap_m
     if leg.rec.missed_approach_start:
@@ -350,7 +289,7 @@ def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
         alt_plan = top
     b.leg_params[i] = b.params
     b.leg_alt_m[i] = alt_plan
-    b.dep_cas_mps = _departure_cas_mps(b, alt_m) if b.climbing else None
+    b.dep_cas_mps = departure.departure_cas_mps(b, alt_m) if b.climbing else None
     if hold:
         b.dep_cas_mps = perf.departure_cas_mps
     v_climb = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
@@ -362,70 +301,6 @@ def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
     # profile (:func:`~fms_testbed.path.profile.plan_profile`) climbs at that one too
     b.gradient = perf.climb_gradient_at(v_climb) if b.climbing else 0.0
     b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank_deg, b.g)
-
-
-def departure_elev_m(db: Database, seq: Sequence, kind: str) -> float | None:
-    """Elevation of the runway a SID is planned from, m, when its departure speeds apply
-    (:meth:`~fms_testbed.legs.model.Performance.departure_cas_at_mps`): a build from the
-    runway (start kind 'runway'), or the rest of a SID flown from its runway rebuilt in
-    flight ('given'); None otherwise (a SID joined at a fix, arrivals)."""
-    if seq.proc_type != "D" or kind not in ("runway", "given"):
-        return None
-    rwy = runway_record(db, seq.airport, seq.transition)
-    if rwy is None:
-        return None
-    apt = db.airports.get(seq.airport)
-    elev = rwy.elev_m if rwy.elev_m is not None else (apt.elev_m if apt else None)
-    return elev if elev is not None else 0.0
-
-
-def _departure_cas_mps(b: LegBuilder, alt_m: float) -> float | None:
-    """The departure schedule's CAS at the start of the leg being planned from ``alt_m`` (m),
-    m/s (None: not a departure from a runway). The path distance where the planned climb
-    passed the acceleration height is interpolated between the leg starts around it (the
-    climb is linear in distance between them); a rebuild that starts above it counts back
-    along the climb at the climb-out speed's gradient, d = Δh / Θ(V_c)."""
-    if b.dep_elev_m is None:
-        return None
-    perf = b.perf
-    h = alt_m - b.dep_elev_m
-    s = b.flown_before_m + math.fsum(sg.geom.length_m() for sg in b.segments)
-    if b.dep_accel_s_m is None and h >= perf.accel_height_m:
-        prev = b.dep_prev
-        if prev is None or prev[1] >= h:
-            v_c = isa_tas_mps(perf.departure_cas_mps or perf.tas_plan_mps, alt_m,
-                              b.params0.isa_dev_c)
-            b.dep_accel_s_m = s - (h - perf.accel_height_m) / perf.climb_gradient_at(v_c)
-        else:
-            b.dep_accel_s_m = prev[0] + (s - prev[0]) * (perf.accel_height_m - prev[1]) \
-                / (h - prev[1])
-    b.dep_prev = (s, h)
-    d = None if b.dep_accel_s_m is None else s - b.dep_accel_s_m
-    return perf.departure_cas_at_mps(d, alt_m)
-
-
-def _departure_slowdowns(built: list[BuiltLeg], segs: list[PathSegment]) -> list[BuiltLeg]:
-    """A departure leg planned slower than the schedule (a course joined at the minimum
-    speed) is flown at that speed from its start: the legs before it are capped, backwards,
-    so the aircraft can slow down over them at the planned deceleration a,
-    V_k ≤ √(V_k+1² + 2 a L_k) (CAS, L_k the leg's length, m)."""
-    if all(lg.departure_cas_mps is None for lg in built):
-        return built
-    length = [0.0] * len(built)
-    pos = {lg.index: k for k, lg in enumerate(built)}
-    for sg in segs:
-        k = pos.get(sg.leg_index)
-        if k is not None:
-            length[k] += sg.geom.length_m()
-    out = list(built)
-    for k in range(len(out) - 2, -1, -1):
-        v, v_next = out[k].departure_cas_mps, out[k + 1].departure_cas_mps
-        if v is None or v_next is None:
-            continue
-        cap = math.sqrt(v_next * v_next + 2.0 * DECEL_MPS2 * length[k])
-        if cap < v:
-            out[k] = replace(out[k], departure_cas_mps=cap)
-    return out
 
 
 def _start_kind(db: Database, seq: Sequence, legs: list[ResolvedLeg], st: FlightState) -> str:
