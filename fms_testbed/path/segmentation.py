@@ -293,10 +293,11 @@ def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
     if hold:
         b.dep_cas_mps = perf.departure_cas_mps
     v_climb = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
+    b.speed_mps = v_climb
     if b.dep_cas_mps is not None:
         cas_cap_mps = b.dep_cas_mps if cas_cap_mps is None else min(cas_cap_mps,
                                                                      b.dep_cas_mps)
-    b.speed_mps = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
+        b.speed_mps = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
     # the climb at the gradient of the speed without the departure schedule: the vertical
     # profile (:func:`~fms_testbed.path.profile.plan_profile`) climbs at that one too
     b.gradient = perf.climb_gradient_at(v_climb) if b.climbing else 0.0
