@@ -40,3 +40,8 @@ MIN_CLEAN_CAS_FACTOR = 1.15
 """The lowest CAS guidance flies clean is this multiple of the aircraft's minimum clean CAS
 (``guidance.vertical.MIN_CAS_FACTOR``, the same number): a departure's climb-out speed is
 planned no lower, so a SID started airborne (clean) flies the turn radii it was planned for."""
+
+ARC_BANK_MARGIN_DEG = 3.0
+"""Guidance flies arcs at a speed that needs at most the bank limit less this, deg; a turn a
+departure must fly at the climb-out speed (no slower CAS is flown clean) is planned with this
+margin below the bank limit too: its TAS grows as it climbs through the turn."""

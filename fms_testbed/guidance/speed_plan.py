@@ -23,14 +23,12 @@ import math
 from dataclasses import dataclass
 
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
-from fms_testbed.core.planning import DECEL_MPS2
+from fms_testbed.core.planning import ARC_BANK_MARGIN_DEG, DECEL_MPS2
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.guidance.geometry import LocalPiece
 from fms_testbed.guidance.locate import Where
 from fms_testbed.guidance.vertical import SPEED_MARGIN_MPS, SpeedLimit, cas_band, tas_target_mps
 
-ARC_BANK_MARGIN_DEG = 3.0
-"""Arcs are flown at a speed that needs at most the bank limit minus this, deg."""
 DECEL_EXTRA_S = 10.0
 """Flight time added to the deceleration distance before an arc, s."""
 LOOKAHEAD_M = 30000.0

@@ -121,6 +121,8 @@ class LegBuilder:
         not yet)."""
         self.dep_prev: tuple[float, float] | None = None
         """(path distance m, height above the runway m) at the previous leg's start."""
+        self.dep_legs: set[int] = set()
+        """Indices of the legs planned under the departure schedule."""
         self.dep_cas_mps: float | None = None
         """The departure schedule's CAS the current leg is planned under, m/s (None: none)."""
 

@@ -24,6 +24,7 @@ from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
+from fms_testbed.core.planning import ARC_BANK_MARGIN_DEG
 from fms_testbed.path import departure
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
 from fms_testbed.path.profile import (PLAN_CLIMB_FRACTION, arrival_join_alt_m, climb_caps_m,
@@ -246,6 +247,8 @@ def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: flo
         state = b.settle(state)
         if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
             state = replace(state, alt_m=_descent_target(leg))
+        if b.dep_cas_mps is not None:
+            b.dep_legs.add(i)
         built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps,
                               coded=leg_cls.coded_path(b, term), resolved=leg,
                               from_fix=b.prev_fixes[i], departure_cas_mps=b.dep_cas_mps))
@@ -558,7 +561,12 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
              depth: int = 0) -> list[PathSegment]:
     """Branch V,γ,φ,λ: the turn cannot be cut inside the fixes; fly over the corner, turn at
     the bank limit (radius ``r``, planned for the speed flown there: there is no room to slow
-    down) and rejoin the next line's course before its end."""
+    down) and rejoin the next line's course before its end. A departure leg's turn is
+    planned :data:`~fms_testbed.core.planning.ARC_BANK_MARGIN_DEG` below the bank limit (its
+    speed is the lowest flown clean, and its TAS grows in the climb through the turn)."""
+    gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
+    if seg.leg_index in b.dep_legs and gmax > ARC_BANK_MARGIN_DEG:
+        r *= math.tan(math.radians(gmax)) / math.tan(math.radians(gmax - ARC_BANK_MARGIN_DEG))
     at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
     b.finding("correction", f"fly-by at {at} (turn {omega:+.0f}°) "
               f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
@@ -568,7 +576,6 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     # rejoin the next line's own course before its end, so that the legs built after it (which
     # assumed that course) still start tangent to the path
     tmp = LegBuilder(b.legs, b.perf, b.params, b.g, b.prev_fixes)
-    gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
     # the turn is flown at the speed that gives radius r at the bank limit
     v_turn = min(seg.speed_mps,
                  math.sqrt(r * b.g * math.tan(math.radians(gmax))) - b.wind_mps)
