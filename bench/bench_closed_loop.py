@@ -82,22 +82,17 @@ def python_floor_us(cfg, scn: dict, n: int = 20000) -> dict[str, float]:
     return out
 
 
-NAV_PARTS = (
-    ("mechanisations", "fms_testbed.navigation.inertial.bank", "StrapdownBank", "update"),
-    ("filters: prediction", "fms_testbed.navigation.ins_gnss", "InsGnssNavigation", "_predict"),
-    ("filters: GNSS updates", "fms_testbed.navigation.ins_filter", "InsGnssFilter",
-     "gnss_update"),
-    ("filters: baro updates", "fms_testbed.navigation.ins_filter", "InsGnssFilter",
-     "baro_update"),
-    ("feedback", "fms_testbed.navigation.inertial.bank", "StrapdownBank", "correct"),
-    ("monitors", "fms_testbed.navigation.ins_gnss", "InsGnssNavigation", "solution"),
-    ("  of it: two-stage identification", "fms_testbed.navigation.fdi", "TwoStageFdi", "update"),
-    ("  of it: sensor-level comparator", "fms_testbed.navigation.ins_gnss", "InsGnssNavigation",
-     "_sensor_pairs"),
-    ("  of it: reference description", "fms_testbed.navigation.ins_gnss", "InsGnssNavigation",
-     "_reference_description"),
-    ("navigation step, all", "fms_testbed.navigation.ins_gnss", "InsGnssNavigation", "update"),
-)
+_NAV = "fms_testbed.navigation."
+NAV_PARTS = [(label, _NAV + mod, cls, meth) for mod, cls, parts in (
+    ("inertial.bank", "StrapdownBank", (("update", "mechanisations"), ("correct", "feedback"))),
+    ("ins_filter", "InsGnssFilter", (("gnss_update", "filters: GNSS updates"),
+                                     ("baro_update", "filters: baro updates"))),
+    ("fdi", "TwoStageFdi", (("update", "  of it: two-stage identification"),)),
+    ("ins_gnss", "InsGnssNavigation", (
+        ("_predict", "filters: prediction"), ("solution", "monitors"),
+        ("_sensor_pairs", "  of it: sensor-level comparator"),
+        ("_reference_description", "  of it: reference description"),
+        ("update", "navigation step, all")))) for meth, label in parts]
 """(label, module, class, method) of the parts of P_nav timed by :func:`nav_parts_us`."""
 
 
