@@ -96,6 +96,11 @@ def cmd_compare(args) -> int:
     if args.wind:
         overrides["wind"] = parse_wind(args.wind)
     scns = [load_scenario(_scenario_path(n), overrides) for n in names]
+    for n, scn in zip(names, scns):
+        if not any(e.altitude_m is not None or e.speed[1] is not None for e in scn.events):
+            raise UserError(f"{n}: no event steps the altitude or the speed; compare measures "
+                            "the laws on altitude and speed steps (events with alt_m/alt_ft or "
+                            "tas_*/cas_*)")
     if args.small_step and not args.scenarios:
         s0 = scns[0]
         small = s0.model_copy(update={"name": "altitude-step-100m", "events": [
@@ -122,8 +127,13 @@ def cmd_compare(args) -> int:
     if gl:
         print("\nGoals:\n" + gl)
     print(f"\nwritten to {out}/ (comparison.csv, comparison.md, *.png, *.parquet)")
+    failed = sorted({f"{r['scenario']}/{r['law']}: "
+                     f"{r['status'] if r.get('status') != 'ok' else 'no step flown'}"
+                     for r in rows if r.get("status") != "ok" or "step" not in r})
+    if failed:
+        print("\nflights not ok (no goals checked on them): " + ", ".join(failed))
     folder.commit()
-    return 0 if all(g.ok for g in goals) else 1
+    return 0 if all(g.ok for g in goals) and not failed else 1
 
 
 def _headline(rows: list[dict]) -> str:

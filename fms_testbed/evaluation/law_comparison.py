@@ -189,7 +189,9 @@ def check_goals(table: pd.DataFrame) -> list[Goal]:
         pure-second-order settling)
     """
     goals = []
-    t = table[table["status"] == "ok"]
+    if "step" not in table:  # no flight of the table measured a step (none ok, or none stepped)
+        return goals
+    t = table[(table["status"] == "ok") & table["step"].notna()]
 
     def pick(law, prefix):
         return t[(t["law"] == law) & t["step"].astype(str).str.startswith(prefix)]

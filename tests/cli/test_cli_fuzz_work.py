@@ -52,6 +52,11 @@ events:
   - {t_s: 5, heading_deg: 120}
 """
 
+STEP_SCENARIO = SHORT_SCENARIO.replace("name: fuzz-short", "name: fuzz-steps").replace(
+    "one heading change", "one altitude step").replace(
+    "  - {t_s: 5, heading_deg: 120}", "  - {t_s: 5, alt_m: 3050}")
+"""The short flight with an altitude step instead of the turn (``compare`` measures steps)."""
+
 BASES = {
     "run": ["run", "{scenario}", "--no-plots", "--out", "{new}"],
     "demo": ["demo", "--out", "{new}"],
@@ -61,7 +66,7 @@ BASES = {
                          "{new}"],
     "procedures list": ["procedures", "list", "--airport", "KBFI"],
     "fly": ["fly", "--scenario", "{scenario}", "--no-plots", "--out", "{new}"],
-    "compare": ["compare", "{scenario}", "--out", "{new}"],
+    "compare": ["compare", "{steps}", "--out", "{new}"],
     "analyse": ["analyse", "--aircraft", "737", "--out", "{new}"],
     "tune": ["tune", "--aircraft", "737", "--quick", "--out", "{new}"],
     "ins": ["ins", "straight", "--duration-s", "60", "--out", "{new}"],
@@ -125,6 +130,8 @@ def one_run(seed: int, root: Path, case) -> tuple[str, str, str | None]:
     paths = _sandbox(box, case)
     (box / "short.yaml").write_text(SHORT_SCENARIO)
     paths["scenario"] = box / "short.yaml"
+    (box / "steps.yaml").write_text(STEP_SCENARIO)
+    paths["steps"] = box / "steps.yaml"
     name, argv = draw(seed, paths)
     before = _protected(paths)
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(REPO),
@@ -162,20 +169,22 @@ def one_run(seed: int, root: Path, case) -> tuple[str, str, str | None]:
     return name, f"rc{rc} ({wall:.0f} s)" if fail is None else "FAILED", fail
 
 
-def fuzz(seeds, root: Path, case, jobs: int) -> tuple[Counter, list[str], Counter]:
-    """Run the seeds over ``jobs`` processes: (outcomes, failures, runs per command)."""
+def fuzz(seeds, root: Path, case, jobs: int) -> tuple[Counter, list[str], Counter, float]:
+    """Run the seeds over ``jobs`` processes: (outcomes, failures, runs per command, the
+    longest run's wall time in s among those that ended)."""
     with ThreadPoolExecutor(max_workers=jobs) as pool:
         results = list(pool.map(lambda s: one_run(s, root, case), seeds))
     outcomes = Counter(o.split(" ")[0] for _, o, _ in results)
     failures = [f for _, _, f in results if f]
-    return outcomes, failures, Counter(n for n, _, _ in results)
+    walls = [float(o.split("(")[1].split(" ")[0]) for _, o, _ in results if "(" in o]
+    return outcomes, failures, Counter(n for n, _, _ in results), max(walls, default=0.0)
 
 
 def test_every_command_has_a_base_and_each_line_changes_one_option(tmp_path):
     names = [" ".join(w) for w, _ in _commands()]
     assert set(names) == set(BASES), set(names) ^ set(BASES)
     paths = {k: tmp_path / k for k in ("file", "empty", "junk", "readonly", "link", "regress",
-                                       "mc", "missing", "new", "yaml", "scenario")}
+                                       "mc", "missing", "new", "yaml", "scenario", "steps")}
     drawn = Counter()
     for seed in range(3 * len(names)):
         name, argv = draw(seed, paths)
@@ -188,7 +197,7 @@ def test_every_command_has_a_base_and_each_line_changes_one_option(tmp_path):
 
 
 def test_fuzz_work_quick(tmp_path, regress_case):
-    outcomes, failures, by_cmd = fuzz(QUICK_SEEDS, tmp_path, regress_case, 1)
+    outcomes, failures, by_cmd, _ = fuzz(QUICK_SEEDS, tmp_path, regress_case, 1)
     assert not failures, "\n".join(failures)
     assert set(by_cmd) == {"regress run"} and outcomes == {"rc2": 1}
 
@@ -199,9 +208,11 @@ def test_fuzz_work(tmp_path, regress_case):
     jobs = int(os.environ.get("FUZZ_WORK_JOBS", 2))
     seed0 = int(os.environ.get("FUZZ_WORK_SEED0", 0))
     t0 = time.monotonic()
-    outcomes, failures, by_cmd = fuzz(range(seed0, seed0 + n), tmp_path, regress_case, jobs)
+    outcomes, failures, by_cmd, longest_s = fuzz(range(seed0, seed0 + n), tmp_path,
+                                                 regress_case, jobs)
     if os.environ.get("FUZZ_WORK_REPORT"):
         Path(os.environ["FUZZ_WORK_REPORT"]).write_text(json.dumps(
-            {"runs": n, "seeds": [seed0, seed0 + n - 1], "jobs": jobs, "wall_s": round(time.monotonic() - t0), **outcomes,
+            {"runs": n, "seeds": [seed0, seed0 + n - 1], "jobs": jobs,
+             "wall_s": round(time.monotonic() - t0), "longest_run_s": longest_s, **outcomes,
              "commands": by_cmd, "failures": failures}, indent=1))
     assert not failures, "\n".join(failures)

@@ -147,3 +147,23 @@ def test_compare_set_overrides_a_law_parameter_and_rejects_unknown_keys(tmp_path
     capsys.readouterr()
     assert main(["compare", "--set", "T_V=6"]) == 2
     assert "T_V_s" in capsys.readouterr().err
+
+
+def test_compare_refuses_a_scenario_without_an_altitude_or_speed_step(tmp_path, capsys):
+    scn = tmp_path / "turn.yaml"
+    scn.write_text('name: turn\naircraft: "737"\n'
+                   'initial: {lat_deg: 47.45, lon_deg: 8.55, alt_m: 3000, tas_kmh: 400, '
+                   'heading_deg: 90}\nduration_s: 20\nhold: true\n'
+                   'events:\n  - {t_s: 5, heading_deg: 120}\n')
+    from fms_testbed.cli import main
+    assert main(["compare", str(scn), "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err
+    assert "turn.yaml" in err and "no event steps the altitude or the speed" in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_check_goals_on_a_table_without_any_step_row_checks_nothing():
+    import pandas as pd
+    from fms_testbed.evaluation.law_comparison import check_goals
+    table = pd.DataFrame([{"scenario": "s", "law": "coupled", "status": "diverged"}])
+    assert check_goals(table) == []
