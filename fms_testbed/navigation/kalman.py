@@ -171,6 +171,8 @@ def rms_check_failure_probability(z, limit: float = 1.5, n_samples: int = 20000,
     ----------
     z : (runs, N) normalised errors of one state at equally spaced epochs
     limit : the check's bound on RMS(e/σ)
+    n_samples : Monte-Carlo draws of the weighted χ² sum
+    seed : seed of those draws
     """
     from scipy.linalg import toeplitz
 
