@@ -82,6 +82,53 @@ def python_floor_us(cfg, scn: dict, n: int = 20000) -> dict[str, float]:
     return out
 
 
+_NAV = "fms_testbed.navigation."
+NAV_PARTS = [(label, _NAV + mod, cls, meth) for mod, cls, parts in (
+    ("inertial.bank", "StrapdownBank", (("update", "mechanisations"), ("correct", "feedback"))),
+    ("ins_filter", "InsGnssFilter", (("gnss_update", "filters: GNSS updates"),
+                                     ("baro_update", "filters: baro updates"))),
+    ("fdi", "TwoStageFdi", (("update", "  of it: two-stage identification"),)),
+    ("ins_gnss", "InsGnssNavigation", (
+        ("_predict", "filters: prediction"), ("solution", "monitors"),
+        ("_sensor_pairs", "  of it: sensor-level comparator"),
+        ("_reference_description", "  of it: reference description"),
+        ("update", "navigation step, all")))) for meth, label in parts]
+"""(label, module, class, method) of the parts of P_nav timed by :func:`nav_parts_us`."""
+
+
+def nav_parts_us(cfg, scn: dict, sim_s: float) -> dict[str, float]:
+    """Process time per outer step (µs) of each part of the three-INS navigation step
+    (:data:`NAV_PARTS`: each method wrapped with a process-time counter, ~0.3 µs per call) over
+    one closed-loop flight of ``sim_s`` simulated seconds; "flight" is the whole loop's."""
+    import importlib
+    import time
+
+    spent: dict[str, float] = {}
+    saved = []
+    for label, mod, cls, meth in NAV_PARTS:
+        klass = getattr(importlib.import_module(mod), cls)
+        fn = getattr(klass, meth)
+        saved.append((klass, meth, fn))
+
+        def timed(*a, _fn=fn, _label=label, **k):
+            t0 = time.process_time()
+            try:
+                return _fn(*a, **k)
+            finally:
+                spent[_label] = spent.get(_label, 0.0) + time.process_time() - t0
+        setattr(klass, meth, timed)
+    try:
+        f = Flight(parse_scenario({**scn, "duration_s": sim_s}), cfg=cfg, progress=False)
+        t0 = time.process_time()
+        f.run()
+        spent["flight"] = time.process_time() - t0
+    finally:
+        for klass, meth, fn in saved:
+            setattr(klass, meth, fn)
+    steps = sim_s * scn.get("outer_rate_hz", 10)
+    return {k: 1e6 * v / steps for k, v in spent.items()}
+
+
 def measure(cfg, scn: dict, chunk_s: float = CHUNK_S) -> dict:
     """Interleaved ratio of the benchmark flight with aircraft configuration ``cfg``."""
     res = interleaved_ratio(Flight(parse_scenario(scn), cfg=cfg, progress=False), cfg, chunk_s)
@@ -153,6 +200,19 @@ def main() -> None:
     floor = python_floor_us(cfg, scn, floor_n)
     print("Python no outer step can skip: " + ", ".join(f"{k} {v:.2f}" for k, v in floor.items())
           + f" = {sum(floor.values()):.1f} us")
+    # the speed goal: the closed loop on three INS against the closed loop on truth, flight by
+    # flight (each interleaved with its own bare JSBSim); ratio = T_truth / (T_truth + P_nav)
+    nav_ratio = [n["ratio"] / d["ratio"] for n, d in zip(runs["ins3"], runs["default"])]
+    t_truth = [1e6 * n_frames / m["closed_fps"] for m in runs["default"]]
+    p_nav = [1e6 * n_frames * (1.0 / n["closed_fps"] - 1.0 / d["closed_fps"])
+             for n, d in zip(runs["ins3"], runs["default"])]
+    print(f"closed loop on three INS / on truth: {', '.join(f'{r:.3f}' for r in nav_ratio)}, "
+          f"median {statistics.median(nav_ratio):.3f} (goal >= 0.5); T_truth "
+          f"{statistics.median(t_truth):.0f} us, P_nav {statistics.median(p_nav):.0f} us per "
+          "outer step (wall, from the rates)")
+    parts = nav_parts_us(cfg, {**scn, **nav}, min(args.sim_s, 120.0))
+    print("P_nav by part (process time per outer step): " + ", ".join(
+        f"{k} {v:.1f} us" for k, v in parts.items()))
     b = statistics.median(m["bare_fps"] for m in runs["default"])
     print(f"whole run_scenario (load, trim, loop, DataFrame), not interleaved: {whole:.0f} "
           f"frames/s = {whole / b:.2f} of the median bare rate")
@@ -171,9 +231,21 @@ def main() -> None:
                  ", ".join(f"{c['ratio']:.3f}" for c in ceil), f"**{c_med:.3f}**",
                  f"{min(c['bare_fps'] for c in ceil):.0f}-{max(c['bare_fps'] for c in ceil):.0f}",
                  "–"])
+    nav_rows = [[label.strip(), f"{v:.0f}", f"{100 * v / parts['navigation step, all']:.0f} %"]
+                for label, v in parts.items() if label not in ("flight",)]
+    nav_md = "\n".join([
+        "", f"**Navigation on three strapdown INS against truth navigation** (the flights above, "
+        f"paired): ratio {', '.join(f'{r:.3f}' for r in nav_ratio)}, median "
+        f"**{statistics.median(nav_ratio):.3f}** (goal ≥ 0.5). Per outer step from the rates: "
+        f"T_truth {statistics.median(t_truth):.0f} µs, P_nav {statistics.median(p_nav):.0f} µs "
+        f"(wall); ratio = T_truth / (T_truth + P_nav), so 0.5 needs P_nav ≤ T_truth.", "",
+        f"P_nav by part: process time per outer step, one {min(args.sim_s, 120.0):.0f}-s flight "
+        "with each part's method wrapped by a counter (the whole flight "
+        f"{parts['flight']:.0f} µs per step):", "",
+        report.table(["part", "µs per outer step", "share of the navigation step"], nav_rows)])
     report.write(args.md, report.table(
         ["configuration", "ratio closed loop / bare JSBSim, each flight", "median",
-         "bare JSBSim frames/s", "goal"], rows),
+         "bare JSBSim frames/s", "goal"], rows) + "\n" + nav_md,
         note=f"{args.aircraft}, {args.sim_s:.0f} s simulated per flight ("
              + ("quick run: hold, 90° turn, the start of the 300 m climb" if args.quick else
                 "hold, 90° turn, 300 m climb, turn back")

@@ -63,7 +63,8 @@ def one(name: str, workers: int, keep: Path, grid: str | None = None
     df = pd.read_csv(out / "points.csv")
     goals = "\n".join(f"- {'PASS' if ok else 'FAIL'}: {t}" for ok, t in goal_lines(df))
     cols = ["alt_m", "tas_mps", "mass_kg", "config", "gm_min_db", "pm_min_deg", "disk_margin",
-            "max_dv_kmh", "max_dh_m", "old_max_dv_kmh", "old_max_dh_m", "robust_pm_mass_lo_deg",
+            "max_dv_kmh", "max_dh_m", "old_max_dv_kmh", "old_max_dh_m", "ps_max_mps",
+            "ps_step_mps", "dv_energy_kmh", "robust_pm_mass_lo_deg",
             "robust_pm_mass_hi_deg", "robust_pm_cg_fwd_deg", "robust_pm_cg_aft_deg",
             "robust_pm_delay_deg"]
     fig = report.FIGURES / "tuning"

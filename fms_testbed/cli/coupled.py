@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from fms_testbed.config.aircraft import load_aircraft
-from fms_testbed.cli.common import WIND_HELP, markdown_table, parse_wind
+from fms_testbed.cli.common import WIND_HELP, bounded_int, markdown_table, parse_wind
 from fms_testbed.cli.common import add_overwrite_option
 from fms_testbed.core.errors import UserError
 from fms_testbed.run.outputs import OutputFolder
@@ -310,6 +310,15 @@ def _tune_report(cfg, args, res, op, alt: float, tas: float, hist: pd.DataFrame)
     return report
 
 
+def _no_envelope_options(args) -> None:
+    """A single-point ``tune`` refuses the options of ``tune --envelope``."""
+    given = [o for o, on in (("--verify-campaign", args.verify_campaign),
+                             ("--scheduler", args.scheduler), ("--grid", args.grid),
+                             ("--airports", args.airports)) if on]
+    if given:
+        raise UserError(f"tune: {', '.join(given)} need --envelope")
+
+
 def cmd_tune(args) -> int:
     """Optimise the law's (T, ξ) on JSBSim; write gains, report and plots
     (``--envelope``: :func:`fms_testbed.cli.tune_envelope.cmd_tune_envelope`)."""
@@ -317,6 +326,7 @@ def cmd_tune(args) -> int:
         from fms_testbed.cli.tune_envelope import cmd_tune_envelope
 
         return cmd_tune_envelope(args)
+    _no_envelope_options(args)
     from fms_testbed.viz.control import plot_tuning_overlay
     from fms_testbed.viz.figure import save
     from fms_testbed.evaluation.law_tuning import (OperatingPoint, gains_yaml, linear_prediction, tune,
@@ -453,9 +463,28 @@ def _register_tune(subparsers) -> None:
     p.add_argument("--grid", metavar="FILE.yaml",
                    help="with --envelope: design points (points: [{alt_m, tas_mps, mass_kg, "
                         "config: clean|approach}]) instead of the default grid")
-    p.add_argument("--workers", type=int, default=2, help="with --envelope: local processes")
+    ex = p.add_mutually_exclusive_group()
+    ex.add_argument("--workers", type=int, default=2, help="with --envelope: local processes")
+    ex.add_argument("--scheduler", metavar="tcp://HOST:PORT",
+                    help="with --envelope: run the design points (and the campaign check) on "
+                         "this Dask scheduler instead of the local pool")
     p.add_argument("--no-robust", action="store_true",
                    help="with --envelope: skip the robustness set (mass, CG, actuator delay)")
+    p.add_argument("--verify-campaign", action="store_true",
+                   help="with --envelope: fly a procedure sample in wind and turbulence with "
+                        "the file gains and the tuned aircraft.yaml; the distribution shift "
+                        "into the report (campaign/)")
+    p.add_argument("--airports", nargs="+", metavar="ICAO",
+                   help="with --verify-campaign: airports of the embedded excerpt (default all)")
+    p.add_argument("--campaign-limit", type=bounded_int(1, 100_000), metavar="N",
+                   help="with --verify-campaign: fly only the first N cases")
+    p.add_argument("--campaign-types", default="STAR,APPROACH",
+                   help="with --verify-campaign: procedure types (default STAR,APPROACH)")
+    p.add_argument("--campaign-wind", default="270/30", metavar="FROM/SPEED",
+                   help="with --verify-campaign: steady wind, deg/kt (default 270/30)")
+    p.add_argument("--campaign-turbulence", default="moderate",
+                   choices=("light", "moderate", "severe"),
+                   help="with --verify-campaign: turbulence severity (default moderate)")
     p.add_argument("--out", help="output folder (default results/tune-<aircraft>-<time>)")
     add_overwrite_option(p)
     p.set_defaults(func=cmd_tune)

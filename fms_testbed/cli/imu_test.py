@@ -26,11 +26,12 @@ from fms_testbed.data import results_dir
 DEFAULT_STAGES = "none,temperature,run-to-run,slow-drift"
 MIN_DURATION_S = 60.0
 """Shortest test, s (the run-to-run stage averages the first 60 s after switch-on)."""
-BYTES_PER_PROFILE_S = 120
+BYTES_PER_PROFILE_S = 150
 """Memory of the test per second of its duration, bytes: the 1-s temperature grid, its
 hysteresis state and the play operator's working list (the samples are streamed in chunks and
-the kept series is bounded, so nothing else grows with the duration)."""
-FIXED_B = 512 * 2 ** 20
+the kept series is bounded, so nothing else grows with the duration); an upper bound of the
+peak RSS's growth between a 100-h and a 1,000-h test (docs/mems.md)."""
+FIXED_B = 640 * 2 ** 20
 """Memory of the test that does not grow with the duration, bytes: the chunks of every stage,
 the kept series of :data:`~fms_testbed.sensors.mems.static_test.MAX_SERIES_ROWS` rows, the
 CSV and the plots (an upper bound of the peak RSS over the interpreter's)."""
@@ -142,8 +143,8 @@ def register(sub) -> None:
                                                     "(default STIM210)")
     p.add_argument("--duration-h", type=float, default=2.0,
                    help="test length, h (default 2; at least 60 s; streamed in chunks, at "
-                        "most what half the available memory holds at 120 B per second of test "
-                        "plus 512 MiB)")
+                        "most what half the available memory holds at 150 B per second of test "
+                        "plus 640 MiB)")
     p.add_argument("--temperature-profile", default="warmup",
                    help="warmup (switch-on self-heating, default), ramp (thermal cycle over the "
                         "operating range), constant, or a CSV file with t_s,temperature_degC")

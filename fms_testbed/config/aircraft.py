@@ -17,6 +17,7 @@ from typing import Annotated
 from pydantic import AliasChoices, BaseModel, ConfigDict, Field, ValidationError, model_validator
 
 from fms_testbed.core.errors import ConfigError
+from fms_testbed.core.planning import DEPARTURE_ACCEL_MPS2
 from fms_testbed.core.units import KT_MPS
 from fms_testbed.data import aircraft_dir
 from fms_testbed.config.yamlfile import read_mapping, validation_message
@@ -263,6 +264,10 @@ class TakeoffSettings(_Frozen):
         10.0 * KT_MPS, description="climb out at V2 plus this (default 10 kt), m/s")
     thrust_norm: Annotated[float, Field(gt=0, le=1)] = Field(
         1.0, description="takeoff throttle (normalised)")
+    departure_accel_mps2: Pos = Field(
+        DEPARTURE_ACCEL_MPS2, description="acceleration (CAS along the path) a departure is "
+        "planned to make good from the acceleration height while it goes on climbing, m/s² "
+        "(the planner's departure speeds: fms_testbed.legs.model.Performance)")
     mass_ref_kg: Pos = Field(description="mass the speeds are given at, kg")
     pitch_rate_kp: Pos = Field(
         8.0, description="elevator (normalised) per rad/s of pitch-rate error, at the design "

@@ -51,7 +51,7 @@ from fms_testbed.core.units import G0_MPS2
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.atmosphere import isa
 from fms_testbed.control.schedule import (REFRESH_REL, GainSchedule, qbar_from_state,
-                                          schedule_from_points)
+                                          schedule_from_config)
 
 _SAT_EPS = 0.005
 """Throttle within this of a limit counts as saturated (normalised throttle)."""
@@ -115,15 +115,6 @@ class CoupledLawParams:
     def vy_limit_mps(self) -> float:
         """Steady climb/descent rate of the level-change mode, ``dH_limit / (2 ξ_H T_H)``, m/s."""
         return self.dH_limit_m / (2.0 * self.xi_H * self.T_H_s)
-
-
-def schedule_from_config(cfg: AircraftConfig) -> GainSchedule | None:
-    """The aircraft configuration ``cfg``'s ``coupled_law_schedule`` as a :class:`GainSchedule`
-    (None when absent)."""
-    sc = cfg.coupled_law_schedule
-    if sc is None:
-        return None
-    return schedule_from_points([p.model_dump() for p in sc.points])
 
 
 def params_from_config(cfg: AircraftConfig, **overrides) -> CoupledLawParams:

@@ -164,6 +164,40 @@ def law_block(p: CoupledLawParams, V0_mps: float) -> ct.StateSpace:
                  states=["nxa_int", "ny_model", "ny_trim"], name="coupled_law")
 
 
+GUST_INPUTS = ("w_gust", "u_gust")
+"""Disturbance inputs of :func:`with_gusts`: vertical wind (up positive) and headwind, m/s."""
+
+
+def with_gusts(lon: ct.StateSpace, V0_mps: float) -> ct.StateSpace:
+    """The longitudinal airframe ``lon`` with the wind inputs :data:`GUST_INPUTS`, m/s.
+
+    The airframe's α and V are air-relative. An updraft w raises α by w/V₀ and the inertial
+    climb rate by w (ḣ = V γ_air + w); a headwind u raises V by u. With ``x' = x - E w`` (E
+    the α or V unit column scaled by 1/V₀ or 1) the state equation needs no derivative of the
+    wind: ``ẋ' = A x' + (A E + e_h) w + B u`` for the updraft (``A E`` for the headwind), and
+    every output sees the air-relative state: ``y = C x' + C E w + D u``, except the
+    flight-path angle ``gamma`` the law reads, which is inertial (γ_air + w / V₀: the law's
+    V_y is measured against the ground).
+
+    Parameters
+    ----------
+    lon : longitudinal airframe (:func:`fms_testbed.sim.linearise.longitudinal_ss`)
+    V0_mps : trim TAS, m/s
+    """
+    A, B, C, D = (np.asarray(m) for m in (lon.A, lon.B, lon.C, lon.D))
+    states = list(lon.state_labels)
+    ia, iV, ih = states.index("alpha_rad"), states.index("V_mps"), states.index("h_m")
+    E = np.zeros((A.shape[0], 2))
+    E[ia, 0], E[iV, 1] = 1.0 / V0_mps, 1.0
+    Bw = A @ E
+    Bw[ih, 0] += 1.0
+    Dw = C @ E
+    Dw[list(lon.output_labels).index("gamma"), 0] += 1.0 / V0_mps   # the law's γ is inertial
+    return ct.ss(A, np.hstack([B, Bw]), C, np.hstack([D, Dw]), states=states,
+                 inputs=list(lon.input_labels) + list(GUST_INPUTS),
+                 outputs=list(lon.output_labels), name=lon.name)
+
+
 def delay_block(signal: str, delay_s: float) -> ct.StateSpace:
     """Second-order Padé delay of ``delay_s`` seconds from ``<signal>_c`` to ``<signal>``."""
     num, den = ct.pade(delay_s, 2)

@@ -12,8 +12,9 @@ coupled law's (T_V, ξ_V, T_H, ξ_H) and its n_y-trim time constant are tuned th
   speed step ``dV``: tracking (integral of |error| over the step, in step sizes × 10 s),
   decoupling ((max|ΔV| / 0.5 km/h)² + (max|ΔH| / 0.75 m)², half the nonlinear goals), path
   tracking (the steady altitude error on a :data:`RAMP_MPS` descent path read ahead by the
-  guidance's fixed lead 2 ξ_H T_H of the aircraft file, / :data:`RAMP_ERR_M`, squared: a
-  schedule that moves ξ_H T_H away from that lead leaves the path), and
+  guidance's lead, the tuning's own 2 ξ_H T_H as VNAV reads it from the schedule in flight,
+  / :data:`RAMP_ERR_M`, squared: what is left is the inner loops' lag), gust rejection
+  (:func:`gust_rejection`: |ΔV| and |ΔH| integrated after an updraft and a headwind step), and
   activity (peak throttle in 0.3 of its range and peak elevator in 0.1, per step), plus a pull
   towards the starting tuning (:data:`REG_WEIGHT`).
 
@@ -34,9 +35,10 @@ from scipy.optimize import minimize
 
 from fms_testbed.config.aircraft import AircraftConfig
 from fms_testbed.control.coupled_law import CoupledLaw, CoupledLawParams
-from fms_testbed.control.loops import (LON_BREAKS, LateralLaw, PointLoops, closed_loop_damping,
-                                       inner_gains)
+from fms_testbed.control.loops import (GUST_INPUTS, LON_BREAKS, LateralLaw, PointLoops,
+                                       closed_loop_damping, inner_gains, with_gusts)
 from fms_testbed.core.atmosphere import isa
+from fms_testbed.core.errors import TrimError
 from fms_testbed.core.units import KMH_MPS
 from fms_testbed.sim.linearise import AirframeModel, DesignPoint, trim_point
 
@@ -71,6 +73,10 @@ RAMP_MPS = 5.0
 RAMP_ERR_M = 5.0
 """Soft goal: the ramp's steady altitude error is scored against this, m."""
 _DT_S = 0.1
+GUST_MPS = 1.0
+"""Size of the updraft and headwind steps of the gust-rejection goal, m/s."""
+GUST_WEIGHT = 1.0
+"""Weight of :func:`gust_rejection` in the soft cost."""
 _OMEGA = np.logspace(-3, 2, 400)
 
 
@@ -163,9 +169,12 @@ class LinearGoals:
     cost: float
 
 
-def linear_goals(pl: PointLoops, lead_s: float = 0.0) -> LinearGoals:
+def linear_goals(pl: PointLoops, lead_s: float | None = None) -> LinearGoals:
     """Evaluate :class:`LinearGoals` for the loops ``pl`` (module docstring); ``lead_s`` is the
-    guidance's altitude read-ahead, s (:func:`fms_testbed.guidance.vertical.altitude_lead_s`)."""
+    guidance's altitude read-ahead, s (None: the law's own 2 ξ_H T_H, which VNAV reads from the
+    schedule in flight: :func:`fms_testbed.guidance.vertical.scheduled_lead`)."""
+    if lead_s is None:
+        lead_s = 2.0 * pl.law.xi_H * pl.law.T_H_s
     ms = [grid_margins(pl.loop(b)) for b in LON_BREAKS]
     zeta, _ = closed_loop_damping(pl, "lon")
     sys = pl.closed("lon", ["V_cmd", "H_cmd"], ["V", "h", "throttle", "elevator"])
@@ -185,7 +194,25 @@ def linear_goals(pl: PointLoops, lead_s: float = 0.0) -> LinearGoals:
     act = (np.abs(yv[:, 2]).max() + np.abs(yh[:, 2]).max()) / 0.3 + \
         (np.abs(yv[:, 3]).max() + np.abs(yh[:, 3]).max()) / 0.1
     return LinearGoals(min(m[0] for m in ms), min(m[1] for m in ms), min(m[2] for m in ms),
-                       zeta, max_dv, max_dh, float(track + couple + 0.5 * act))
+                       zeta, max_dv, max_dh,
+                       float(track + couple + 0.5 * act + GUST_WEIGHT * gust_rejection(pl)))
+
+
+def gust_rejection(pl: PointLoops) -> float:
+    """Disturbance-rejection soft goal of the loops ``pl``: the closed loop's integral of |ΔV|
+    (m/s·s) and |ΔH| (m·s) after a :data:`GUST_MPS` updraft step and a headwind step
+    (:func:`fms_testbed.control.loops.with_gusts`), each over :data:`T_STEP_S`, in units of
+    (1 m/s or 1 m) × 10 s per m/s of gust::
+
+        J = Σ_gust (∫|ΔV| dt / (1 m/s · 10 s) + ∫|ΔH| dt / (1 m · 10 s)) / w_gust
+    """
+    sys = replace(pl, lon=with_gusts(pl.lon, pl.V0_mps)).closed("lon", list(GUST_INPUTS),
+                                                               ["V", "h"])
+    j = 0.0
+    for u in (np.array([GUST_MPS, 0.0]), np.array([0.0, GUST_MPS])):
+        y = step_outputs(sys, u)
+        j += float(np.abs(y).sum() * _DT_S / 10.0 / GUST_MPS)
+    return j
 
 
 def _constraints(g: LinearGoals) -> np.ndarray:
@@ -220,11 +247,8 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
     cfg : aircraft;  model : linear airframe at the point
     start : starting tuning (clipped into :data:`BOUNDS`);  max_iter : SLSQP iterations
     """
-    from fms_testbed.guidance.vertical import altitude_lead_s
-
     lo = np.array([BOUNDS[n][0] for n in NAMES])
     hi = np.array([BOUNDS[n][1] for n in NAMES])
-    lead = altitude_lead_s(cfg)
     cache: dict[tuple, tuple[np.ndarray, LinearGoals]] = {}
 
     def params(u):
@@ -234,7 +258,7 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
     def goals(u) -> LinearGoals:
         key = tuple(np.round(np.clip(u, 0.0, 1.0), 4))
         if key not in cache:
-            cache[key] = (np.array(key), linear_goals(point_loops(cfg, model, params(u)), lead))
+            cache[key] = (np.array(key), linear_goals(point_loops(cfg, model, params(u))))
         return cache[key][1]
 
     u0 = (np.clip([getattr(start, n) for n in NAMES], lo, hi) - lo) / (hi - lo)
@@ -303,6 +327,74 @@ def fly_step(cfg: AircraftConfig, point: DesignPoint, law: CoupledLaw, kind: str
         st = ac.state()
         out[k] = (st.t_s, st.alt_m, st.tas_mps, st.throttle)
     return out
+
+
+def excess_power_mps(cfg: AircraftConfig, point: DesignPoint, duration_s: float = 15.0,
+                     avg_s: float = 3.0) -> float:
+    """Specific excess power at full thrust at ``point``, m/s: from the trim, the throttle at
+    the inner loop's maximum and the n_y loop holding 1 g, the energy rate per unit weight
+    ``P_s = ḣ + V V̇ / g = (T_max - D) V / W`` averaged over the last ``avg_s`` of
+    ``duration_s`` seconds (the engines have spooled up by then), at the speed reached then
+    (it has risen by about g P_s t / V: little where the margin is small).
+
+    The altitude step a point is verified with needs ``P_s ≥`` its peak climb rate at constant
+    speed (:func:`step_climb_rate_mps`); below it the speed must give the energy.
+
+    Parameters
+    ----------
+    cfg, point : aircraft and design point
+    duration_s : run length, s;  avg_s : averaging window at its end, s
+    """
+    from fms_testbed.core.units import G0_MPS2
+
+    ac, _ = trim_point(cfg, point)
+    ac.engage(nx=False)
+    ac.command(bank_rad=0.0, ny=1.0, throttle=cfg.inner_loops.throttle_max)
+    n = int(duration_s / ac.dt_s)
+    k0 = n - int(avg_s / ac.dt_s)
+    e = []
+    for k in range(n):
+        if not ac.run(1):
+            raise TrimError(f"{cfg.name} at {point.label()}: the full-thrust run stopped")
+        if k >= k0:
+            st = ac.state()
+            e.append((st.t_s, st.alt_m + st.tas_mps ** 2 / (2.0 * G0_MPS2)))
+    t, h_e = np.array(e).T
+    return float(np.polyfit(t, h_e, 1)[0])
+
+
+def step_climb_rate_mps(pl: PointLoops) -> float:
+    """Peak climb rate of the linear closed loop ``pl`` in the +:data:`DH_STEP_M` altitude
+    step, m/s (the specific excess power the step needs at constant speed)."""
+    return float(np.max(_step_climb_mps(pl)))
+
+
+def _step_climb_mps(pl: PointLoops) -> np.ndarray:
+    h = step_outputs(pl.closed("lon", ["V_cmd", "H_cmd"], ["h"]),
+                     np.array([0.0, DH_STEP_M]))[:, 0]
+    return np.diff(h) / _DT_S
+
+
+def thrust_margin(cfg: AircraftConfig, point: DesignPoint, pl: PointLoops) -> dict:
+    """Whether the engines can give the +:data:`DH_STEP_M` step of the loops ``pl`` at
+    ``point`` without the speed paying for it: ``ps_max_mps`` (:func:`excess_power_mps`),
+    ``ps_step_mps`` (:func:`step_climb_rate_mps`), ``thrust_limited`` (ps_max < ps_step) and
+    ``dv_energy_kmh``, the speed that following the step's linear climb V_y(t) at full thrust
+    costs by the energy balance ``V dV/dt = g (P_s,max - V_y)``::
+
+        ΔV = (g / V₀) ∫ max(0, V_y(t) - P_s,max) dt
+
+    Parameters
+    ----------
+    cfg, point : aircraft and design point;  pl : the point's loops (scheduled gains)
+    """
+    from fms_testbed.core.units import G0_MPS2
+
+    ps = excess_power_mps(cfg, point)
+    vy = _step_climb_mps(pl)
+    dv = G0_MPS2 / pl.V0_mps * float(np.sum(np.maximum(vy - ps, 0.0)) * _DT_S)
+    return {"ps_max_mps": ps, "ps_step_mps": float(vy.max()),
+            "thrust_limited": bool(ps < vy.max()), "dv_energy_kmh": dv / KMH_MPS}
 
 
 def verify(cfg: AircraftConfig, point: DesignPoint, make_law, duration_s: float = 90.0

@@ -9,10 +9,13 @@ checks (margins on every loop, robustness, nonlinear JSBSim steps).
 4. every point is checked with the *scheduled* gains — the ones the law flies: margins of the six
    broken loops (python-control ``stability_margins`` and ``disk_margins``), the same margins
    under the robustness set (mass ±:data:`ROBUST_MASS_FRAC`, CG ±:data:`ROBUST_CG_M`, an
-   actuator delay of :data:`ROBUST_DELAY_S`), and the nonlinear altitude and speed steps
-   (max|ΔV|, max|ΔH|).
+   actuator delay of :data:`ROBUST_DELAY_S`), the nonlinear altitude and speed steps
+   (max|ΔV|, max|ΔH|), and whether the engines can give the altitude step at constant speed
+   (:func:`.envelope_points.thrust_margin`: a point where the full-thrust excess power is below
+   the step's peak climb rate is ``thrust_limited``: there the speed must pay for the climb).
 
-Points run on a local process pool (``workers``); each job is one design point.
+Points run on a local process pool (``workers``) or through a caller's ``map_jobs`` (the CLI's
+Dask cluster); each job is one design point.
 """
 
 from __future__ import annotations
@@ -22,6 +25,7 @@ import time
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Callable
 
 import multiprocessing
 import control as ct
@@ -38,8 +42,8 @@ from fms_testbed.control.schedule import SCHEDULED, GainSchedule, schedule_from_
 from fms_testbed.core.atmosphere import cas_to_tas
 from fms_testbed.core.errors import ConfigError, TrimError
 from fms_testbed.core.units import SLUG_KG
-from fms_testbed.evaluation.envelope_points import (point_loops, tune_bank_loop, tune_point,
-                                                    verify)
+from fms_testbed.evaluation.envelope_points import (point_loops, thrust_margin, tune_bank_loop,
+                                                    tune_point, verify)
 from fms_testbed.sim.inner_steps import check_aircraft, replace_gains
 from fms_testbed.sim.linearise import DesignPoint, linearise
 
@@ -218,6 +222,7 @@ def _check_job(ref: str, point: DesignPoint, schedule: GainSchedule, robust: boo
     row = {f"sched_{k}": v for k, v in schedule.values(model.qbar_pa, model.mass_kg).items()}
     pl = point_loops(cfg, model, law_at(model))
     row.update(_loop_columns(pl))
+    row.update(thrust_margin(cfg, point, pl))
     row["gm_min_db"], row["pm_min_deg"], row["disk_margin"] = _mins(row)
     if robust:
         row.update(_robust_columns(cfg, point, model.mass_kg, law_at, model))
@@ -254,7 +259,8 @@ def _pool_map(fn, jobs: list[tuple], workers: int) -> list:
 
 
 def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int = 2,
-                  robust: bool = True, duration_s: float = 90.0) -> EnvelopeResult:
+                  robust: bool = True, duration_s: float = 90.0,
+                  map_jobs: Callable | None = None) -> EnvelopeResult:
     """Tune every point, fit the schedule, check every point with it (module docstring).
 
     Parameters
@@ -262,6 +268,9 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
     cfg : aircraft (loaded by name or file in the workers);  points : the design points
     workers : local processes;  robust : run the robustness set
     duration_s : length of each nonlinear step run, s
+    map_jobs : ``map_jobs(fn, jobs) -> [fn(*job) for job in jobs]`` in the jobs' order, run
+        elsewhere (e.g. on a Dask cluster); None: a local pool of ``workers`` processes. ``fn``
+        is a module-level function and every job's arguments are picklable
 
     Raises
     ------
@@ -269,8 +278,9 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
         When fewer than three points trim (no schedule can be fitted).
     """
     ref = cfg.source_file or cfg.name
+    run = map_jobs or (lambda fn, jobs: _pool_map(fn, jobs, workers))
     t0 = time.perf_counter()
-    tuned = _pool_map(_tune_job, [(ref, p) for p in points], workers)
+    tuned = run(_tune_job, [(ref, p) for p in points])
     t1 = time.perf_counter()
     ok = [r for r in tuned if "qbar_pa" in r]
     models = [r.pop("model") for r in ok]
@@ -280,8 +290,8 @@ def tune_envelope(cfg: AircraftConfig, points: list[DesignPoint], workers: int =
     sched = schedule_from_points([{"qbar_pa": r["qbar_pa"], "mass_kg": r["mass_kg"],
                                    **{n: r[f"tuned_{n}"] for n in SCHEDULED}} for r in ok])
     bank, before, after = tune_bank_loop(cfg, models)
-    checks = _pool_map(_check_job, [(ref, r["point"], sched, robust, duration_s, bank)
-                                    for r in tuned if "qbar_pa" in r], workers)
+    checks = run(_check_job, [(ref, r["point"], sched, robust, duration_s, bank)
+                              for r in tuned if "qbar_pa" in r])
     steps = [r for r in check_aircraft(replace_gains(cfg, "bank", bank)) if r.spec.loop == "bank"]
     t2 = time.perf_counter()
     rows, figs, it = [], {}, iter(checks)

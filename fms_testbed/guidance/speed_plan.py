@@ -23,15 +23,12 @@ import math
 from dataclasses import dataclass
 
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
+from fms_testbed.core.planning import ARC_BANK_MARGIN_DEG, DECEL_MPS2
 from fms_testbed.core.units import G0_MPS2
 from fms_testbed.guidance.geometry import LocalPiece
 from fms_testbed.guidance.locate import Where
 from fms_testbed.guidance.vertical import SPEED_MARGIN_MPS, SpeedLimit, cas_band, tas_target_mps
 
-ARC_BANK_MARGIN_DEG = 3.0
-"""Arcs are flown at a speed that needs at most the bank limit minus this, deg."""
-DECEL_MPS2 = 0.3
-"""Deceleration assumed when slowing for an arc ahead, m/s²."""
 DECEL_EXTRA_S = 10.0
 """Flight time added to the deceleration distance before an arc, s."""
 LOOKAHEAD_M = 30000.0
@@ -173,7 +170,9 @@ class SpeedPlan:
     def update(self, t_s: float, alt_m: float, w: Where) -> float:
         """The TAS target at time ``t_s`` (s) and navigation altitude ``alt_m`` (m) with the
         aircraft at ``w`` on the active path, m/s (recomputed every :data:`SPEED_UPDATE_S`):
-        the leg's coded band, the arcs ahead (:func:`arc_speed_cap_mps` in the planned wind,
+        the leg's coded band, a departure leg's planned CAS (``BuiltLeg.departure_cas_mps``:
+        the climb-out speed to the acceleration height, then the acceleration the plan's
+        turn radii were built for), the arcs ahead (:func:`arc_speed_cap_mps` in the planned wind,
         :func:`planned_wind_mps`), the limits of fixes ahead planned before them
         (:meth:`limit_ahead_cap_mps`) and the approach's planned speeds (the profile's
         ``SpeedProfile``, read :data:`SPEED_LEAD_S` ahead)."""
@@ -186,7 +185,10 @@ class SpeedPlan:
             return self._go_around_update(t_s, alt_m, w, ga, wind_mps)
         lim = self.limits[leg] if leg < len(self.limits) else None
         lo, hi = cas_band(lim, self.carry_max_cas_mps if self.descent else None)
-        plan = min(cas_to_tas_scalar(self.plan_cas_mps, alt_m, self.isa_dev_c),
+        plan_cas = self.plan_cas_mps
+        if w.built.departure_cas_mps is not None:   # a departure: its planned speeds
+            plan_cas = min(plan_cas, w.built.departure_cas_mps)
+        plan = min(cas_to_tas_scalar(plan_cas, alt_m, self.isa_dev_c),
                    arc_speed_cap_mps(a.pieces, i, along_m, gs_mps, self.bank_max_deg, wind_mps))
         plan = min(plan, self.limit_ahead_cap_mps(alt_m, leg, a.pieces, i, along_m,
                                                   self.tas_cmd_mps, a.piece_legs))

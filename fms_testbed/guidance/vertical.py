@@ -104,6 +104,25 @@ def altitude_lead_s(cfg) -> float:
     return 2.0 * g.xi_H * g.T_H_s if g is not None else 10.0
 
 
+LEAD_NAMES = ("T_H_s", "xi_H")
+"""Scheduled coupled-law parameters the altitude read-ahead uses."""
+
+
+def scheduled_lead(schedule, tas_mps: float, p_static_pa: float, t_static_k: float,
+                   mass_kg: float) -> tuple[float, float] | None:
+    """The read-ahead terms (2 ξ_H T_H in s, T_H² in s²) of the coupled law's gain schedule
+    ``schedule`` (:class:`~.vertical_schedule.GainSchedule`) at the measured air data — TAS
+    ``tas_mps`` (m/s), static pressure ``p_static_pa`` (Pa) and temperature ``t_static_k`` (K),
+    q̄ = ½ ρ V², ρ = p_s / (R T_s) — and mass ``mass_kg`` (kg): the values the law flies there.
+    None when the air data are not finite (the caller keeps its terms)."""
+    from fms_testbed.guidance.vertical_schedule import qbar_from_state
+
+    if not (math.isfinite(p_static_pa) and math.isfinite(t_static_k) and math.isfinite(tas_mps)):
+        return None
+    v = schedule.values(qbar_from_state(tas_mps, p_static_pa, t_static_k), mass_kg, LEAD_NAMES)
+    return 2.0 * v["xi_H"] * v["T_H_s"], v["T_H_s"] ** 2
+
+
 BLEND_S = 6.0
 """Each slope change of the planned profile is blended over ±BLEND_S seconds of flight."""
 

@@ -20,7 +20,8 @@ from fms_testbed.guidance.active_path import ActivePath
 from fms_testbed.guidance.locate import Where
 from fms_testbed.guidance.speed_plan import GoAround, SpeedPlan
 from fms_testbed.guidance.profile_kernel import ProfileNodes, altitude_command_fast_m
-from fms_testbed.guidance.vertical import altitude_lead_s, planned_limits
+from fms_testbed.guidance.vertical import altitude_lead_s, planned_limits, scheduled_lead
+from fms_testbed.guidance.vertical_schedule import schedule_from_config
 from fms_testbed.legs.model import CEILING_MARGIN_M
 from fms_testbed.path.plan import FlyablePath
 
@@ -80,6 +81,10 @@ class VerticalGuidance:
         self.cfg = cfg
         self.lead_s = altitude_lead_s(cfg)
         self.t2_s2 = cfg.coupled_law.T_H_s ** 2 if cfg.coupled_law is not None else 0.0
+        # with a gain schedule the read-ahead follows the scheduled ξ_H, T_H (set_mass)
+        self.lead_schedule = (schedule_from_config(cfg) if cfg.coupled_law is not None
+                              else None)
+        self.mass_kg: float | None = None
         self.top_m = climb_top_m(fp, cfg, spec)
         self.approach = fp.path.proc_type == "F"
         self.speed = SpeedPlan(planned_limits(fp.seq.legs, fp.path.proc_type, lim.cas_min_mps),
@@ -116,7 +121,9 @@ class VerticalGuidance:
         return self.go_around_leg is not None and leg >= self.go_around_leg
 
     def set_mass(self, mass_kg: float) -> None:
-        """The gross weight the FMS flies with (kg): Vapp is scaled to it (approach settings)."""
+        """The gross weight the FMS flies with (kg): Vapp is scaled to it (approach settings),
+        and with a coupled-law gain schedule the altitude read-ahead follows the schedule at it."""
+        self.mass_kg = mass_kg
         ap = self.cfg.approach
         if ap is None or self.speed.vapp_cas_mps is None:
             return
@@ -140,6 +147,11 @@ class VerticalGuidance:
 
     def update(self, w: Where, nav: NavSolution, air: AirData) -> tuple[float, float]:
         """(altitude command m, TAS target m/s) at ``w`` (module docstring)."""
+        if self.lead_schedule is not None and self.mass_kg is not None:
+            lead = scheduled_lead(self.lead_schedule, air.tas_mps, air.p_static_pa,
+                                  air.t_static_k, self.mass_kg)
+            if lead is not None:
+                self.lead_s, self.t2_s2 = lead
         alt_cmd = max(altitude_command_fast_m(self._nodes(w.act, w.leg), w.s_path_m, w.gs_mps,
                                               self.lead_s, self.t2_s2, self.top_m,
                                               self.approach, air.tas_mps),

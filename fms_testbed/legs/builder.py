@@ -36,9 +36,6 @@ reversal over the fix, e.g. a missed approach coded back along the final) keeps 
 join, so the monitor still sees the reversal."""
 CF_OFF_COURSE_DEG = 20.0
 """A CF's own straight more than this off its coded course is not the coded leg, deg."""
-DECEL_PLAN_MPS2 = 0.3
-"""Deceleration a plan may count on to slow down for a turn, m/s² (the speed guidance slows
-for an arc ahead at this rate)."""
 PARALLEL_TOL_M = 30.0
 """A turn from over a fix that ends closer than this to the coded course line out of the fix
 is left parallel to it; beyond, the line is rejoined with a 45° intercept, m."""
@@ -116,6 +113,18 @@ class LegBuilder:
         """The settings each leg was built with (the wind at its planned altitude)."""
         self.leg_alt_m: dict[int, float] = {}
         """Each leg's planned start altitude, m."""
+        self.dep_elev_m: float | None = None
+        """Elevation of the runway a departure is planned from, m (None: not a departure from
+        a runway: no departure speed schedule)."""
+        self.dep_accel_s_m: float | None = None
+        """Path distance at which the planned climb passed the acceleration height, m (None:
+        not yet)."""
+        self.dep_prev: tuple[float, float] | None = None
+        """(path distance m, height above the runway m) at the previous leg's start."""
+        self.dep_legs: set[int] = set()
+        """Indices of the legs planned under the departure schedule."""
+        self.dep_cas_mps: float | None = None
+        """The departure schedule's CAS the current leg is planned under, m/s (None: none)."""
 
     # ------------------------------------------------------------------ context
     @property

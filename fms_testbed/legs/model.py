@@ -12,6 +12,9 @@ import math
 from dataclasses import dataclass, replace
 
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
+from fms_testbed.core.planning import (ACCEL_HEIGHT_M, DEPARTURE_ACCEL_MPS2,
+                                       MIN_CLEAN_CAS_FACTOR, SPEED_LIMIT_10000FT_CAS_MPS,
+                                       SPEED_LIMIT_ALT_M)
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.wind import WindProfile
 from fms_testbed.core.units import FT_M, KT_MPS, NM_M
@@ -107,6 +110,16 @@ class Performance:
     alt_max_m: float = math.inf
     cas_max_mps: float = math.inf
     mach_max: float = math.inf
+    departure_cas_mps: float | None = None
+    """Climb-out CAS of a departure up to the acceleration height, m/s: V2 + the takeoff's
+    climb-out increment, never below the lowest CAS guidance flies clean
+    (:data:`~fms_testbed.core.planning.MIN_CLEAN_CAS_FACTOR` × the minimum clean CAS; None: no
+    takeoff data — a departure is planned at ``tas_plan_mps`` from the runway on)."""
+    accel_height_m: float = ACCEL_HEIGHT_M
+    """Height above the runway where a departure starts to accelerate, m."""
+    accel_mps2: float = DEPARTURE_ACCEL_MPS2
+    """Acceleration a departure makes good from the acceleration height, m/s² (CAS along the
+    path)."""
 
     def tas_max_mps(self, alt_m: float, isa_dev_c: float = 0.0) -> float:
         """Largest TAS inside the speed envelope at ``alt_m`` (m) on a day ``isa_dev_c`` (K)
@@ -131,13 +144,40 @@ class Performance:
     @classmethod
     def from_aircraft(cls, ac) -> "Performance":
         """Take the limits of an :class:`~fms_testbed.config.aircraft.AircraftConfig`."""
-        lim = ac.limits
+        lim, to, ap = ac.limits, ac.takeoff, ac.approach
+        dep = None
+        if to is not None:   # the takeoff flight's climb-out speed, at the reference mass
+            dep = min(max(to.v2_cas_mps + to.climb_add_cas_mps,
+                          MIN_CLEAN_CAS_FACTOR * lim.cas_min_mps), lim.climb_cas_mps)
         return cls(tas_plan_mps=lim.climb_cas_mps, tas_min_mps=lim.cas_min_mps,
                    climb_gradient_max=lim.climb_gradient_max,
                    climb_rate_max_mps=lim.climb_rate_max_mps,
                    descent_rate_max_mps=lim.descent_rate_max_mps, bank_max_deg=lim.bank_max_deg,
                    alt_max_m=lim.alt_max_m, cas_max_mps=lim.cas_max_mps,
-                   mach_max=lim.mach_max)
+                   mach_max=lim.mach_max, departure_cas_mps=dep,
+                   accel_height_m=ap.acceleration_height_m if ap is not None
+                   else ACCEL_HEIGHT_M,
+                   accel_mps2=to.departure_accel_mps2 if to is not None
+                   else DEPARTURE_ACCEL_MPS2)
+
+    def departure_cas_at_mps(self, accel_dist_m: float | None, alt_m: float) -> float:
+        """Planned CAS of a departure, m/s (the one schedule the leg builder plans turn radii
+        for and guidance flies): the climb-out CAS V_c = :attr:`departure_cas_mps` up to the
+        acceleration height (``accel_dist_m`` None), then what the aircraft can have reached
+        ``accel_dist_m`` (m) of path after it at :attr:`accel_mps2` a,
+
+            V = min(√(V_c² + 2 a d), V_plan, 250 kt below 10,000 ft)
+
+        V_plan = :attr:`tas_plan_mps` (the planned terminal-area CAS); ``alt_m`` (m) is where
+        the 250 kt limit is looked at. Without takeoff data: V_plan (250 kt below 10,000 ft)."""
+        v = self.tas_plan_mps
+        if alt_m < SPEED_LIMIT_ALT_M:
+            v = min(v, SPEED_LIMIT_10000FT_CAS_MPS)
+        if self.departure_cas_mps is None:
+            return v
+        c = self.departure_cas_mps
+        d = 0.0 if accel_dist_m is None else max(accel_dist_m, 0.0)
+        return min(v, math.sqrt(c * c + 2.0 * self.accel_mps2 * d))
 
     def climb_gradient_at(self, tas_mps: float) -> float:
         """Climb gradient capability at a TAS, rise over run: the climb rate is taken as
@@ -269,6 +309,10 @@ class BuiltLeg:
     from_fix: object = None
     """The :class:`~fms_testbed.procedures.records.Fix` the leg starts from (the previous
     leg's fix when that leg ends there), or None."""
+    departure_cas_mps: float | None = None
+    """The departure schedule's CAS the leg was planned under
+    (:meth:`Performance.departure_cas_at_mps` at its start), m/s: guidance flies a SID's leg
+    no faster (None: not a departure from a runway)."""
 
 
 @dataclass(frozen=True)

@@ -19,11 +19,11 @@ import math
 from dataclasses import replace
 
 from fms_testbed.core.geodesy import direct, inverse, wrap180, wrap360
+from fms_testbed.core.planning import DECEL_MPS2
 from fms_testbed.core.segments import Arc, Line, turn_angle_deg
 from fms_testbed.core.units import KT_MPS, NM_M
 from fms_testbed.legs.builder import (CF_FROM_FIX_DEG, CF_FROM_FIX_TURN_MAX_DEG, CF_OFF_COURSE_DEG,
-                                      CLOSE_S, DECEL_PLAN_MPS2,
-                                      DIRECT_XTK_M, PARALLEL_TOL_M, LegBuilder,
+                                      CLOSE_S, DIRECT_XTK_M, PARALLEL_TOL_M, LegBuilder,
                                       intercept_angle_deg)
 from fms_testbed.legs.construct import (_foot, direct_to_arc, ray_geodesic_intersection,
                                         turn_to_course)
@@ -322,8 +322,9 @@ def direct_no_room(b: LegBuilder, state: FlightState, fix: Fix, direction: str |
     'info' finding says its track is not flown. A leg whose path is the course (CF:
     ``course_deg`` given, deg true) flies direct when the direct line's straight is within
     :data:`~.builder.CF_OFF_COURSE_DEG` of the course, or when the path behind is shorter than
-    the distance to slow to the minimum speed, (V² − V_min²) / (2 a) with a
-    :data:`~.builder.DECEL_PLAN_MPS2` (the monitor then reports the course not flown); else
+    the distance to slow to the minimum speed, (V² − V_min²) / (2 a) (V: the planned TAS; on a
+    departure no more than its climb-out speed, which it can have held) with a
+    :data:`~fms_testbed.core.planning.DECEL_MPS2` (the monitor then reports the course not flown); else
     it joins the course at the aircraft's minimum speed at the bank limit
     (:func:`min_speed_radius`; branch V,γ, a correction) when that radius leaves room; else
     the coded course cannot be flown before the fix and the leg is 'impossible' with the
@@ -344,7 +345,12 @@ def direct_no_room(b: LegBuilder, state: FlightState, fix: Fix, direction: str |
         return st
     v_min, r_min = min_speed_radius(b, state.alt_m)
     flown = b.flown_before_m + sum(sg.geom.length_m() for sg in b.segments)
-    slow_m = max(b.speed_mps ** 2 - v_min ** 2, 0.0) / (2.0 * DECEL_PLAN_MPS2)
+    v_from = b.speed_mps
+    if b.dep_cas_mps is not None and b.perf.departure_cas_mps is not None:
+        # a departure can have held its climb-out speed since the acceleration height
+        v_from = min(v_from, isa_tas_mps(b.perf.departure_cas_mps, state.alt_m,
+                                         b.params.isa_dev_c))
+    slow_m = max(v_from ** 2 - v_min ** 2, 0.0) / (2.0 * DECEL_MPS2)
     if flown < slow_m:
         # no distance behind to slow down in (a SID just after the runway): flown direct,
         # the monitor reports the coded course not flown
@@ -359,6 +365,8 @@ def direct_no_room(b: LegBuilder, state: FlightState, fix: Fix, direction: str |
         st = join_course(t, state, fix, course_deg, direction, flyby_end, course_leg=True)
         if not any(f.category == "impossible" for f in t.findings):
             commit(b, t)
+            if b.dep_cas_mps is not None:   # a departure flies the leg at that speed
+                b.dep_cas_mps = min(b.dep_cas_mps, b.perf.tas_min_mps)
             b.finding("correction", f"course into {fix.ident} joined at the minimum speed "
                       f"{t.speed_mps / KT_MPS:.0f} kt, radius {r_min:.0f} m (no room at the "
                       f"planned radius {b.radius_m:.0f} m)", "V,γ")

@@ -4,12 +4,13 @@ loop with :class:`~fms_testbed.guidance.fms.ProcedureGuidance`, then measure the
 Start condition (stated plainly, it is a simplification): by default a SID starts
 **airborne at the departure end of the runway (DER)** at the
 builder's planned start altitude (35 ft above the runway), trimmed straight and level at the
-aircraft's planned climb TAS on the runway heading; the profile then climbs it. STARs and
+planned start speed on the runway heading; the profile then climbs it. STARs and
 approaches start at their first fix at the first coded altitude, on the first segment's
 course. In both cases the aircraft is placed one roll-in anticipation distance (≈ 400 m for the
 737) *before* the path start on that course, so a turn that begins at the path start is entered
-like any other planned turn. The start speed is the planned TAS moved into the first leg's coded
-speed limit. An approach ends at the runway/MAP unless the missed approach is flown
+like any other planned turn. The start speed is the planned TAS (a SID from its runway: the
+plan's climb-out speed, V2 + the takeoff's increment) moved into the first leg's coded speed
+limit. An approach ends at the runway/MAP unless the missed approach is flown
 (``procedure.missed``: go-around at the MAP, the missed-approach legs to the end of the first
 holding circuit). JSBSim's terrain is set to the procedure's airport
 (:func:`fms_testbed.path.runway.terrain_elevation_m`: an approach's runway threshold, else the
@@ -66,7 +67,10 @@ def initial_from_path(fp: FlyablePath, cfg) -> dict[str, float]:
     lo, hi = cas_band(planned_limits(fp.seq.legs, fp.path.proc_type,
                                      cfg.limits.cas_min_mps)[0], None)
     dev = fp.params.isa_dev_c if fp.params is not None else 0.0
-    tas = tas_target_mps(cas_to_tas_scalar(cfg.limits.climb_cas_mps, alt, dev), alt, lo, hi,
+    cas = cfg.limits.climb_cas_mps
+    if fp.path.legs[0].departure_cas_mps is not None:   # a departure: its climb-out speed
+        cas = min(cas, fp.path.legs[0].departure_cas_mps)
+    tas = tas_target_mps(cas_to_tas_scalar(cas, alt, dev), alt, lo, hi,
                          cfg.limits.cas_min_mps, dev)
     hdg = fp.path.segments[0].heading_deg   # a heading leg: its heading (drift in the plan)
     return {"lat_deg": lat, "lon_deg": lon, "alt_m": alt,

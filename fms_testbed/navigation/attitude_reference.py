@@ -68,7 +68,7 @@ from fms_testbed.navigation.fdi import unmodelled_variances
 from fms_testbed.navigation.ins_bank import derive_seeds
 from fms_testbed.navigation.measurements import enu_difference_m
 from fms_testbed.navigation.ins_gnss import gnss_spec
-from fms_testbed.navigation.inertial.strapdown import correct_row
+from fms_testbed.navigation.inertial.strapdown import cg_state, correct_row
 from fms_testbed.navigation.kalman import (PredictionLag, correct, correct_delayed, innovation,
                                           predict)
 from fms_testbed.sensors.attitude_reference import (ANGLES, N_STATES, AttitudeReferenceSpec,
@@ -77,7 +77,9 @@ from fms_testbed.sensors.attitude_reference import (ANGLES, N_STATES, AttitudeRe
                                                     noise_density, system_matrix)
 from fms_testbed.sensors.gnss import GnssFix, GnssReceiver, GnssSpec
 from fms_testbed.sensors.sins.analysis import horizontal_radius
-from fms_testbed.sensors.imu.kinematics import euler_to_quat, forward_step, inverse_step
+from fms_testbed.sensors.imu.kinematics import (euler_to_quat, forward_step, inverse_step, qmul,
+                                                qrot, rotvec_to_quat)
+from fms_testbed.sensors.imu.synthesis import frame_offset_rotation
 from fms_testbed.sensors.sins.discretize import discretize
 from fms_testbed.sensors.sins.presets import ImuModel, load_imu
 
@@ -205,7 +207,12 @@ class FlightTestComputer:
     rotation and sculling terms, gravity, Coriolis). The body rotation those terms need is the
     one the angle samples imply, Δθ with q_k = q(-ζ) ⊗ q_{k-1} ⊗ q(Δθ + Δθ' × Δθ/12)
     (:func:`~fms_testbed.sensors.imu.kinematics.inverse_step` of the attitude at the frame's
-    start velocity); the attitude is then set to q_k. Nothing here reads the true state: the
+    start velocity); the attitude is then set to q_k. With the accelerometers at a lever arm l
+    from the CG (:meth:`set_lever_arm`) the computer mechanises the IMU point — its attitude
+    q(-ρ) ⊗ q_k in the IMU point's local frame (ρ the frame rotation over the offset C_b^n l) —
+    and moves its output to the CG, v_cg = q(ρ) v_imu - C_b^n (ω_eb × l) with the rate the angle
+    samples imply (:func:`~fms_testbed.navigation.inertial.strapdown.cg_state`), as an INS
+    compensates its installation lever arm. Nothing here reads the true state: the
     sensors (:class:`~fms_testbed.sensors.attitude_reference.FlightTestSensors`) make the only
     reads, and the output of :meth:`computer_position` is the computer's own.
 
@@ -231,15 +238,33 @@ class FlightTestComputer:
         self._f = np.zeros(3)
         self._scratch = np.zeros(22)
         self._zero3 = np.zeros(3)
+        self.lever = np.zeros(3)            # the lever arm the computer compensates, m
+        self._w_ib = np.zeros(3)            # the last frame's angle-implied rate, rad/s
 
     @property
     def frame_properties(self):
         """The JSBSim samples the sensors need per frame."""
         return self.sensors.frame_properties
 
+    def set_lever_arm(self, lever_arm_m, compensate: bool = True) -> None:
+        """Place the accelerometer block at ``lever_arm_m`` (3,) m from the CG (body axes),
+        before the first update; ``compensate``: the computer knows that lever arm and moves
+        its output to the CG (False: it takes the IMU point for the CG)."""
+        self.sensors.set_lever_arm(lever_arm_m)
+        self.lever = self.sensors.lever_arm_m if compensate else np.zeros(3)
+
+    def _imu_attitude(self, a) -> tuple:
+        """q_b^n of the IMU point's local frame for the CG attitude of Euler angles ``a``."""
+        q = euler_to_quat(a[0], a[1], a[2])
+        if not self.lever.any():
+            return q
+        r = self.row
+        rho = frame_offset_rotation(r[0], r[2], qrot(q, (self.lever[0], self.lever[1],
+                                                         self.lever[2])))
+        return qmul(rotvec_to_quat((-rho[0], -rho[1], -rho[2])), q)
+
     def _set_attitude(self) -> None:
-        a = self.ref_out - self.c_rad
-        self.row[6:10] = euler_to_quat(a[0], a[1], a[2])
+        self.row[6:10] = self._imu_attitude(self.ref_out - self.c_rad)
 
     def update(self, truth: AircraftState, frames=None) -> None:
         """Take the sensors' measurements up to ``truth.t_s`` and mechanise them (the first
@@ -257,14 +282,14 @@ class FlightTestComputer:
         c0 = self.c_rad
         for j in range(dv.shape[0]):
             c = c0 + self.c_rps * (dt * (j + 1))
-            a = ang[j] - c
-            q1 = euler_to_quat(a[0], a[1], a[2])
+            q1 = self._imu_attitude(ang[j] - c)
             scr[:] = row
             dth, _ = inverse_step(scr, (row[3], row[4], row[5]), q1, dt)
             forward_step(row, dth, (dv[j, 0], dv[j, 1], dv[j, 2]), dt)
             row[6:10] = q1
         self.c_rad = c0 + self.c_rps * (dt * dv.shape[0])
         self.ref_out = ang[-1].copy()
+        self._w_ib = np.asarray(dth, float) / dt
         self._f = dv.sum(axis=0) / (dt * dv.shape[0])
 
     def specific_force_mps2(self) -> np.ndarray:
@@ -282,8 +307,13 @@ class FlightTestComputer:
         return float(a[0]), float(a[1]), float(a[2]) % (2 * math.pi)
 
     def computer_position(self, truth=None) -> tuple[float, float, float, np.ndarray]:
-        """(lat rad, lon rad, alt m (sea-level datum), V ENU (3,) m/s) of the computer."""
+        """(lat rad, lon rad, alt m (sea-level datum), V ENU (3,) m/s) of the computer at the
+        CG."""
         r = self.row
+        if self.lever.any():
+            lat, lon, h, _, v, _ = cg_state(r, self.lever, self._w_ib)
+            return (float(lat), float(lon), float(sea_level_height_m(lat, h)),
+                    np.array([v[1], v[0], -v[2]]))
         return (float(r[0]), float(r[1]), float(sea_level_height_m(r[0], r[2])),
                 np.array([r[4], r[3], -r[5]]))
 
@@ -295,7 +325,7 @@ class FlightTestComputer:
         dx = np.asarray(dx, float)
         d9 = np.zeros(9)
         d9[:6] = dx[:6]
-        correct_row(self.row, d9, self._zero3, self._zero3)
+        correct_row(self.row, d9, self.lever, self._w_ib)
         self.c_rad = self.c_rad + dx[6:9]
         self.c_rps = self.c_rps + dx[9:12]
         self._set_attitude()
@@ -368,6 +398,14 @@ class AttitudeReferenceNavigation(NavigationSourceBase):
                                                                          b.gate_sigma))
         src.seed = sd
         return src
+
+    def install_imu(self, lever_arm_m) -> None:
+        """The accelerometers' position from the CG (the aircraft file's ``imu_lever_arm_m``,
+        body axes, m), set before the first update; the computer compensates it. The linear
+        model has none."""
+        if isinstance(self.errors, FlightTestComputer):
+            self.errors.set_lever_arm(lever_arm_m)
+            self.frame_properties = tuple(self.errors.frame_properties)
 
     def _at(self, t_s: float) -> tuple | None:
         for t, comp in reversed(self._buffer):

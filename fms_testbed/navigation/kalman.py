@@ -149,4 +149,45 @@ class PredictionLag:
         return phi_lag, q_lag
 
 
-__all__ = ["PredictionLag", "correct", "correct_delayed", "innovation", "predict"]
+def rms_check_failure_probability(z, limit: float = 1.5, n_samples: int = 20000,
+                                  seed: int = 0) -> float:
+    """Probability that a *consistent* filter fails the per-run check RMS(e/σ) < ``limit`` on
+    one state, given how its normalised errors are correlated in time.
+
+    For a consistent filter z_k = e_k/σ_k (k = 1..N, one run) is zero-mean Gaussian with unit
+    variance; with the autocorrelation ρ(L) of the runs ``z`` (runs, N), the run's mean square
+    is zᵀz/N = Σ_i λ_i χ²_1,i / N with λ_i the eigenvalues of the Toeplitz matrix of ρ, so
+
+        P(fail) = P(Σ_i λ_i χ²_1,i ≥ N limit²)
+
+    (Monte Carlo over ``n_samples`` draws). ρ is pooled over the runs and normalised by their
+    mean square, so only its *shape* enters, not the filter's σ; it is tapered by
+    exp(-(L/N)²) and negative eigenvalues (sampling noise) are dropped, as are those below
+    1e-3 of the largest. A state whose error stays
+    correlated for a large part of the run (an effective sample count N²/Σλ² of a few) fails
+    the check in a sizeable fraction of runs however honest σ is.
+
+    Parameters
+    ----------
+    z : (runs, N) normalised errors of one state at equally spaced epochs
+    limit : the check's bound on RMS(e/σ)
+    n_samples : Monte-Carlo draws of the weighted χ² sum
+    seed : seed of those draws
+    """
+    from scipy.linalg import toeplitz
+
+    z = np.asarray(z, float)
+    n = z.shape[1]
+    ac = np.array([np.mean(z[:, :n - lag] * z[:, lag:]) for lag in range(n)]) / np.mean(z ** 2)
+    ac *= np.exp(-(np.arange(n) / n) ** 2)
+    lam = np.linalg.eigvalsh(toeplitz(ac))
+    lam = lam[lam > 1e-3 * lam.max()]
+    rng = np.random.default_rng(seed)
+    total = np.zeros(n_samples)
+    for chunk in np.array_split(np.arange(n_samples), max(1, n_samples // 2000)):
+        total[chunk] = rng.standard_normal((chunk.size, lam.size)) ** 2 @ lam
+    return float(np.mean(total >= n * limit ** 2))
+
+
+__all__ = ["PredictionLag", "correct", "correct_delayed", "innovation", "predict",
+           "rms_check_failure_probability"]

@@ -19,14 +19,16 @@ import math
 from dataclasses import replace
 
 from fms_testbed.core.atmosphere import cas_to_tas, tas_to_cas
-from fms_testbed.core.geodesy import direct, gravity_mps2, inverse, wrap180, wrap360
+from fms_testbed.core.geodesy import direct, gravity_mps2, wrap180, wrap360
 from fms_testbed.core.segments import Arc, Line
 from fms_testbed.core.units import FT_M, KT_MPS
 from fms_testbed.legs.builder import LegBuilder, ResolvedLeg
 from fms_testbed.legs.construct import turn_arc
+from fms_testbed.core.planning import ARC_BANK_MARGIN_DEG
+from fms_testbed.path import departure
 from fms_testbed.path.fillets import arc_line_fillet, line_arc_fillet, retarget_arc
 from fms_testbed.path.profile import (PLAN_CLIMB_FRACTION, arrival_join_alt_m, climb_caps_m,
-                                     climb_phases, path_climb_top_m, window)
+                                     climb_phases, path_climb_top_m)
 from fms_testbed.procedures.database import Database, Sequence
 from fms_testbed.procedures.records import Fix
 from fms_testbed.legs.types import LEG_TYPES, LegError
@@ -84,38 +86,11 @@ def runway_record(db: Database, airport: str, transition: str):
     return None
 
 
-SID_JOIN_CAP_M = 18000 * FT_M
-"""A SID joined at a fix away from the runway is never planned above this, m."""
-
-
-def sid_join_alt_m(db: Database, seq: Sequence, fix, elev_m: float,
-                   perf: Performance | None) -> float:
-    """Altitude at which a SID joined at ``fix`` (not from its runway: the runway part is
-    vectors or was not asked for) is planned to be there: 35 ft above the field plus a climb at
-    the aircraft's gradient over the distance from the airport to the fix, capped by every 'at
-    or below', 'at' or 'between' constraint of the transition (the top of its window) and by
-    :data:`SID_JOIN_CAP_M`, and raised into the first fix's own window, m — not the field
-    elevation (issue 12, class H: a start thousands of feet below the climb windows), nor
-    above an 'at' first fix (KAPA ECHOO1: joined at 18,000 ft over BAPME coded at 8,000 ft)."""
-    alt = elev_m + 35 * FT_M
-    apt = db.airports.get(seq.airport)
-    if perf is not None and apt is not None and fix is not None:
-        d = inverse(apt.lat_deg, apt.lon_deg, fix.lat_deg, fix.lon_deg)[0]
-        alt += perf.climb_gradient_at(perf.tas_plan_mps) * d
-    # capped by the top of every window ('at or below', 'at', 'between': an 'at 8,000 ft' at
-    # the first fix is a cap too), and inside the first fix's own window
-    wins = [window(r.alt_desc, r.alt1_m, r.alt2_m) for r in seq.legs]
-    caps = [hi for _, hi in wins if hi is not None]
-    alt = min([alt, SID_JOIN_CAP_M] + caps)
-    lo_first = wins[0][0] if wins else None
-    return alt if lo_first is None else max(alt, lo_first)
-
-
 def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
                 perf: Performance | None = None) -> FlightState:
     """Planned start: a SID runway transition starts at the departure end of the runway
     (threshold + length along the runway's true bearing, 35 ft above the threshold); a SID
-    joined at its first fix starts there at :func:`sid_join_alt_m`; other transitions start at
+    joined at its first fix starts there at :func:`~fms_testbed.path.departure.sid_join_alt_m`; other transitions start at
     their first fix (STAR/approach altitude: the first coded altitude, else airport elevation
     + 10,000 ft / 3,000 ft, no higher than ``perf.alt_plan_max_m``); a SID without either
     starts over the airport."""
@@ -129,7 +104,7 @@ def start_state(db: Database, seq: Sequence, legs: list[ResolvedLeg],
             lat, lon, az = direct(rwy.lat_deg, rwy.lon_deg, brg, rwy.length_m or 0.0)
             alt = (rwy.elev_m if rwy.elev_m is not None else elev) + 35 * FT_M
             return FlightState(lat, lon, wrap360(az), alt)
-        alt = sid_join_alt_m(db, seq, first.fix, elev, perf)
+        alt = departure.sid_join_alt_m(db, seq, first.fix, elev, perf)
     else:
         # the first coded altitude; of an 'between' window its middle (the top of it can
         # leave the next windows out of reach of the descent)
@@ -177,7 +152,8 @@ def leg_cls_hold(leg: ResolvedLeg) -> bool:
 
 def build_sequence(db: Database, seq: Sequence, perf: Performance,
                    params: BuildParams | None = None, start: FlightState | None = None,
-                   prev_fix: Fix | None = None) -> ProcedurePath:
+                   prev_fix: Fix | None = None, hold_legs: frozenset[int] = frozenset()
+                   ) -> ProcedurePath:
     """Build one procedure transition into a :class:`ProcedurePath` (segments + legs).
 
     Parameters
@@ -190,6 +166,10 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
         :func:`start_state`. Guidance uses this to rebuild from the aircraft's actual state.
     prev_fix : the fix the first leg starts from (a leg rebuilt mid-way: a TF rejoins the track
         from it; its coded path is kept for the PDE); default none
+    hold_legs : indices of departure legs planned at the climb-out speed (held since the
+        acceleration height) instead of the departure schedule; a SID whose CF course cannot
+        be flown at the schedule's speed (a fly-by onto it flown over, the fix reached
+        against the course) is built again with its CFs held
 
     Returns
     -------
@@ -215,13 +195,18 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
                                for lg in legs[:-1]]
     b = LegBuilder(legs, perf, params, g, prev_fixes)
     b.climbing = seq.proc_type == "D"
+    b.dep_elev_m = departure.departure_elev_m(db, seq, kind,
+                                             runway_record(db, seq.airport, seq.transition))
     bank = min(params.bank_plan_deg, params.bank_limit_deg, perf.bank_max_deg)
-    built = _build_legs(b, seq.proc_type, state, bank)
+    built = _build_legs(b, seq.proc_type, state, bank, hold_legs)
     segs = round_corners(b, perf, params, bank)
-    built = _attach_segments(built, segs)
+    built = departure.departure_slowdowns(_attach_segments(built, segs), segs)
     status = "impossible" if any(f.category == "impossible" for f in b.findings) else "ok"
     out = replace(path, legs=tuple(built), segments=tuple(segs),
                   findings=path.findings + tuple(b.findings), status=status, start_kind=kind)
+    hold = departure.cf_legs_to_hold(out, perf) - hold_legs
+    if hold:
+        return build_sequence(db, seq, perf, params, start, prev_fix, hold_legs | hold)
     if start is None and seq.proc_type in ("E", "F") and len(built) > 1:
         alt = _arrival_start_m(out, perf, params, state0.alt_m)
         if alt is not None:
@@ -230,8 +215,8 @@ def build_sequence(db: Database, seq: Sequence, perf: Performance,
     return out
 
 
-def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: float
-                ) -> list[BuiltLeg]:
+def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: float,
+                hold_legs: frozenset[int] = frozenset()) -> list[BuiltLeg]:
     """Run every leg's class from ``state`` (each planned by :func:`_plan_leg`: its climb
     cap from :func:`~fms_testbed.path.profile.climb_caps_m`, its approach CAS cap); stop at
     the first leg that cannot be built (an 'impossible' finding). Returns the built legs."""
@@ -242,20 +227,31 @@ def _build_legs(b: LegBuilder, proc_type: str, state: FlightState, bank_deg: flo
                             path_climb_top_m(proc_type, params.climb_top_m), perf.alt_plan_max_m)
     built: list[BuiltLeg] = []
     for i, leg in enumerate(legs):
-        _plan_leg(b, i, state.alt_m, float(alt_caps[i + 1]), caps[i], bank_deg)
+        _plan_leg(b, i, state.alt_m, float(alt_caps[i + 1]), caps[i], bank_deg,
+                  hold=i in hold_legs)
         start_st = state
         leg_cls = LEG_TYPES[leg.pt]
+        snap = (len(b.segments), set(b.corners), len(b.findings), b._corner_pending)
         try:
             state, term = leg_cls.build(b, state)
+            if departure.held_speed_helps(b, snap[2], proc_type):
+                # a departure can have held its climb-out speed: the leg at that speed
+                del b.segments[snap[0]:], b.findings[snap[2]:]
+                b.corners, b._corner_pending = snap[1], snap[3]
+                _plan_leg(b, i, start_st.alt_m, float(alt_caps[i + 1]), caps[i], bank_deg,
+                          hold=True)
+                state, term = leg_cls.build(b, start_st)
         except LegError as exc:
             b.finding("impossible", f"leg {i + 1} {leg.pt}: {exc} (line {leg.rec.line})")
             break
         state = b.settle(state)
         if not b.climbing and leg.rec.alt1_m is not None and term.kind == "fix":
             state = replace(state, alt_m=_descent_target(leg))
+        if b.dep_cas_mps is not None:
+            b.dep_legs.add(i)
         built.append(BuiltLeg(i, leg.rec, leg.pt, start_st, state, term, b.speed_mps,
                               coded=leg_cls.coded_path(b, term), resolved=leg,
-                              from_fix=b.prev_fixes[i]))
+                              from_fix=b.prev_fixes[i], departure_cas_mps=b.dep_cas_mps))
     return built
 
 
@@ -271,17 +267,21 @@ def _arrival_start_m(path: ProcedurePath, perf: Performance, params: BuildParams
 
 
 def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
-              cas_cap_mps: float | None, bank_deg: float) -> None:
+              cas_cap_mps: float | None, bank_deg: float, hold: bool = False) -> None:
     """Set the builder up for leg ``i`` planned from ``alt_m`` (m): its climb cap (m), its
     settings (the wind at its planned altitude; a hold in a climb: the strongest up to the
     climb top, planned at the top), its planned speed (m/s, under ``cas_cap_mps``), climb
     gradient and turn radius R = V²/(g tan γ) at ``bank_deg`` — for the faster of this leg
-    and the one before (a turn at its start is entered at the previous leg's speed)."""
+    and the one before (a turn at its start is entered at the previous leg's speed). A
+    departure leg is planned under the departure schedule
+    (:meth:`~fms_testbed.legs.model.Performance.departure_cas_at_mps`), or with ``hold`` at
+    the climb-out speed held since the acceleration height (the legs before are slowed to it:
+    :func:`~fms_testbed.path.departure.departure_slowdowns`)."""
     leg, params, perf = b.legs[i], b.params0, b.perf
     b.i, b.alt_cap_m = i, alt_cap_m
     if leg.rec.missed_approach_start:
         b.climbing = True
-    speed_in = b.speed_mps if i else None
+    speed_in = b.speed_mps if i and not hold else None
     alt_plan = alt_m
     b.params = params.for_altitude(alt_plan)
     if b.climbing and leg_cls_hold(leg) and params.climb_top_m is not None:
@@ -292,8 +292,18 @@ def _plan_leg(b: LegBuilder, i: int, alt_m: float, alt_cap_m: float,
         alt_plan = top
     b.leg_params[i] = b.params
     b.leg_alt_m[i] = alt_plan
-    b.speed_mps = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
-    b.gradient = perf.climb_gradient_at(b.speed_mps) if b.climbing else 0.0
+    b.dep_cas_mps = departure.departure_cas_mps(b, alt_m) if b.climbing else None
+    if hold:
+        b.dep_cas_mps = perf.departure_cas_mps
+    v_climb = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
+    b.speed_mps = v_climb
+    if b.dep_cas_mps is not None:
+        cas_cap_mps = b.dep_cas_mps if cas_cap_mps is None else min(cas_cap_mps,
+                                                                     b.dep_cas_mps)
+        b.speed_mps = planned_speed_mps(perf, leg, alt_plan, cas_cap_mps, params.isa_dev_c)
+    # the climb at the gradient of the speed without the departure schedule: the vertical
+    # profile (:func:`~fms_testbed.path.profile.plan_profile`) climbs at that one too
+    b.gradient = perf.climb_gradient_at(v_climb) if b.climbing else 0.0
     b.radius_m = turn_radius_m(max(b.speed_mps, speed_in or 0.0) + b.wind_mps, bank_deg, b.g)
 
 
@@ -551,7 +561,12 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
              depth: int = 0) -> list[PathSegment]:
     """Branch V,γ,φ,λ: the turn cannot be cut inside the fixes; fly over the corner, turn at
     the bank limit (radius ``r``, planned for the speed flown there: there is no room to slow
-    down) and rejoin the next line's course before its end."""
+    down) and rejoin the next line's course before its end. A departure leg's turn is
+    planned :data:`~fms_testbed.core.planning.ARC_BANK_MARGIN_DEG` below the bank limit (its
+    speed is the lowest flown clean, and its TAS grows in the climb through the turn)."""
+    gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
+    if seg.leg_index in b.dep_legs and gmax > ARC_BANK_MARGIN_DEG:
+        r *= math.tan(math.radians(gmax)) / math.tan(math.radians(gmax - ARC_BANK_MARGIN_DEG))
     at = a.fix_ident or f"the intercept of {seg.path_term} {seg.fix_ident}"
     b.finding("correction", f"fly-by at {at} (turn {omega:+.0f}°) "
               f"does not fit even at minimum speed: flown over the fix, radius {r:.0f} m",
@@ -561,7 +576,6 @@ def _flyover(b: LegBuilder, a: PathSegment, seg: PathSegment, omega: float, r: f
     # rejoin the next line's own course before its end, so that the legs built after it (which
     # assumed that course) still start tangent to the path
     tmp = LegBuilder(b.legs, b.perf, b.params, b.g, b.prev_fixes)
-    gmax = min(b.params.bank_limit_deg, b.perf.bank_max_deg)
     # the turn is flown at the speed that gives radius r at the bank limit
     v_turn = min(seg.speed_mps,
                  math.sqrt(r * b.g * math.tan(math.radians(gmax))) - b.wind_mps)

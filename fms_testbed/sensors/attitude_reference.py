@@ -56,7 +56,8 @@ from fms_testbed.core.state import AircraftState
 from fms_testbed.sensors.imu.errors import (N_ROW, ROW_A, ROW_LSB, ROW_RES, ROW_S, ROW_WSD,
                                             ImuErrors, advance_slow, imu_error_params,
                                             measure_row)
-from fms_testbed.sensors.imu.synthesis import FRAME_PROPERTIES, sample_of, start_row, synthesize
+from fms_testbed.sensors.imu.synthesis import (FRAME_PROPERTIES, frame_properties, sample_of,
+                                              start_row, synthesize)
 from fms_testbed.sensors.sins.discretize import discretize
 from fms_testbed.sensors.sins.euler import euler_errors_to_eps
 from fms_testbed.sensors.sins.model import build_F, dcm_body_to_enu
@@ -293,8 +294,9 @@ class ReferenceAngleErrors:
 
 
 class FlightTestSensors:
-    """The flight-test sensors on the strapdown truth: an accelerometer block at the centre of
-    gravity with its preset's errors, and the attitude reference's angles.
+    """The flight-test sensors on the strapdown truth: an accelerometer block with its preset's
+    errors, at the centre of gravity or at a lever arm from it (:meth:`set_lever_arm`), and the
+    attitude reference's angles.
 
     Per JSBSim frame (``FRAME_PROPERTIES`` samples, at least the navigation step) the error-free
     increments are those of :func:`~fms_testbed.sensors.imu.synthesis.synthesize` (exact for the
@@ -314,6 +316,22 @@ class FlightTestSensors:
     """
 
     frame_properties = FRAME_PROPERTIES
+
+    def set_lever_arm(self, lever_arm_m) -> None:
+        """Place the accelerometer block at ``lever_arm_m`` (3,) m from the CG (body axes x
+        forward, y right, z down; the aircraft file's ``imu_lever_arm_m``) before the first
+        step: its increments are then those of the IMU point, v_imu = v + C_b^n (ω_eb × l)
+        (:func:`~fms_testbed.sensors.imu.synthesis.lever_to_imu`), which needs the body rates
+        per frame (:func:`~fms_testbed.sensors.imu.synthesis.frame_properties`)."""
+        if self.T is not None:
+            raise RuntimeError("FlightTestSensors.set_lever_arm after start()")
+        self._lever = np.ascontiguousarray(lever_arm_m, dtype=float).reshape(3)
+        self.frame_properties = frame_properties(self._lever)
+
+    @property
+    def lever_arm_m(self) -> np.ndarray:
+        """(3,) the block's position from the CG, body axes, m."""
+        return self._lever.copy()
 
     def __init__(self, spec: AttitudeReferenceSpec, imu, seed: int):
         self.spec = spec
@@ -369,7 +387,8 @@ class FlightTestSensors:
         advance_slow(self.U, self.U[:, ROW_A:ROW_S], self.U[:, ROW_S:ROW_WSD],
                      acc.rng_slow[0].standard_normal((1, 30)))
         inc = np.empty((n_f, 6))
-        synthesize(self.T, np.ascontiguousarray(frames), dt, self._lever, False, inc)
+        synthesize(self.T, np.ascontiguousarray(frames), dt, self._lever,
+                   bool(np.any(self._lever != 0.0)), inc)
         z = acc.rng_white[0].standard_normal((n_f, 6))
         u = self.U[0]
         dv = np.empty((n_f, 3))

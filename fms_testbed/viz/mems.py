@@ -154,9 +154,9 @@ def plot_allan(res) -> Figure:
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(fontsize=7)
     ax.set_title(f"{res.imu} Allan deviation ({res.allan_signal} output, "
-                 f"{fit.record_s / 3600:g} h at {res.rate_hz:g} Hz): ARW "
+                 f"{fit.record_s / 3600:g} h at {res.rate_hz:g} Hz)\nARW "
                  f"{fit.arw_deg_per_sqrt_h.mean():.4f} °/√h, BI "
-                 f"{fit.bias_instability_deg_per_h.mean():.3f} °/h (mean of axes)\n"
+                 f"{fit.bias_instability_deg_per_h.mean():.3f} °/h (mean of axes); "
                  f"preset {p['arw_deg_per_sqrt_h']} °/√h, {p['bias_instability_deg_per_h']} °/h",
                  fontsize=10)
     fig.tight_layout()

@@ -12,6 +12,14 @@ from fms_testbed.control import procedure_law
 from fms_testbed.evaluation.envelope_tuning import POINT_COLUMNS
 
 
+def _three_point_grid(folder):
+    grid = folder / "grid.yaml"
+    grid.write_text(yaml.safe_dump({"points": [
+        {"alt_m": 1000.0, "tas_mps": 105.0}, {"alt_m": 3000.0, "tas_mps": 111.1},
+        {"alt_m": 6000.0, "tas_mps": 150.0}]}))
+    return grid
+
+
 def test_bad_grid_file_is_one_line_naming_the_field(tmp_path, capsys):
     grid = tmp_path / "grid.yaml"
     grid.write_text("points:\n  - {alt_m: 3000, tas_mps: 111, config: landing}\n")
@@ -20,6 +28,24 @@ def test_bad_grid_file_is_one_line_naming_the_field(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert "grid.yaml" in err and "config" in err and "Traceback" not in err
     assert not (tmp_path / "out").exists()
+
+
+@pytest.mark.parametrize("extra, words", [
+    (["--campaign-wind", "west/30"], ("--wind", "west/30")),
+    (["--campaign-types", "SID,HOLD"], ("HOLD",)),
+])
+def test_bad_campaign_option_fails_before_any_tuning(tmp_path, capsys, extra, words):
+    assert main(["tune", "--aircraft", "737", "--envelope", "--verify-campaign", *extra,
+                 "--out", str(tmp_path / "out")]) == 2
+    err = capsys.readouterr().err.strip()
+    assert all(w in err for w in words) and "Traceback" not in err and "\n" not in err
+    assert not (tmp_path / "out").exists()
+
+
+def test_envelope_options_without_envelope_are_a_user_error(tmp_path, capsys):
+    assert main(["tune", "--aircraft", "737", "--verify-campaign", "--out",
+                 str(tmp_path / "out")]) == 2
+    assert "--verify-campaign need --envelope" in capsys.readouterr().err
 
 
 def test_too_few_trimmed_points_is_a_user_error(tmp_path, capsys):
@@ -31,10 +57,7 @@ def test_too_few_trimmed_points_is_a_user_error(tmp_path, capsys):
 
 
 def test_envelope_tuning_writes_points_schedule_and_a_flyable_aircraft(tmp_path, capsys):
-    grid = tmp_path / "grid.yaml"
-    grid.write_text(yaml.safe_dump({"points": [
-        {"alt_m": 1000.0, "tas_mps": 105.0}, {"alt_m": 3000.0, "tas_mps": 111.1},
-        {"alt_m": 6000.0, "tas_mps": 150.0}]}))
+    grid = _three_point_grid(tmp_path)
     out = tmp_path / "env"
     rc = main(["tune", "--aircraft", "737", "--envelope", "--grid", str(grid), "--workers", "1",
                "--no-robust", "--out", str(out)])
@@ -60,6 +83,27 @@ def test_envelope_tuning_writes_points_schedule_and_a_flyable_aircraft(tmp_path,
     assert "PASS" in (out / "report.md").read_text() or "FAIL" in (out / "report.md").read_text()
     for f in ("nichols.png", "bode-worst.png", "steps.png", "schedule.png"):
         assert (out / f).stat().st_size > 10_000, f
+    bode = sorted((out / "bode").glob("*.png"))
+    assert len(bode) == 3 and all(b.stat().st_size > 10_000 for b in bode)
+    assert all(f"bode/{b.name}" in (out / "report.md").read_text() for b in bode)
+
+
+@pytest.mark.slow
+def test_verify_campaign_flies_both_files_and_reports_the_shift(tmp_path, capsys):
+    grid = _three_point_grid(tmp_path)
+    out = tmp_path / "env"
+    rc = main(["tune", "--aircraft", "737", "--envelope", "--grid", str(grid), "--workers", "1",
+               "--no-robust", "--verify-campaign", "--airports", "KBFI", "--campaign-limit", "2",
+               "--out", str(out)])
+    assert rc in (0, 1)
+    old = pd.read_parquet(out / "campaign" / "old" / "flights")
+    new = pd.read_parquet(out / "campaign" / "new" / "flights")
+    assert len(old) == len(new) == 2
+    assert (new.aircraft.astype(str).str.endswith("aircraft.yaml")).all(), new.aircraft
+    rep = (out / "report.md").read_text()
+    assert "## Campaign check" in rep and "2 paired flights" in rep
+    assert "campaign median FTE95 no worse" in rep
+    assert (out / "campaign" / "campaign-shift.png").stat().st_size > 10_000
 
 
 def test_analyse_jsbsim_prints_modes_checked_against_the_nonlinear_model(tmp_path, capsys):

@@ -84,3 +84,45 @@ def test_law_follows_the_schedule_in_flight():
     want = 5.0 + 4.0 * math.log(q / 4000.0) / math.log(4.0)
     assert 5.0 < want < 9.0
     assert law.params.T_V_s == pytest.approx(want, rel=1e-6)
+
+
+def _airframe(V0=120.0):
+    """A stable hand-made longitudinal airframe (V, α, θ, q, h; the aero terms in the
+    air-relative V and α only, ḣ = V₀ (θ - α))."""
+    from fms_testbed.sim.linearise import longitudinal_ss
+
+    g = 9.80665
+    A = np.array([[-0.02, 5.0, -g, 0.0, 0.0],
+                  [-0.002, -0.8, 0.0, 1.0, 0.0],
+                  [0.0, 0.0, 0.0, 1.0, 0.0],
+                  [0.0, -2.0, 0.0, -1.2, 0.0],
+                  [0.0, -V0, V0, 0.0, 0.0]])
+    B = np.array([[2.0, 0.0], [0.0, -0.1], [0.0, 0.0], [0.0, -3.0], [0.0, 0.0]])
+    return longitudinal_ss(A, B, V0, 0.2), V0
+
+
+def test_gusts_leave_the_air_relative_trim_and_carry_the_aircraft_with_the_air():
+    """Controls fixed, a steady updraft w or headwind u: the aircraft settles back to its
+    air-relative trim (V, α as before) while climbing with the air (ḣ = w, inertial γ =
+    w / V₀); the headwind changes nothing inertial in the climb."""
+    from fms_testbed.control.loops import GUST_INPUTS, with_gusts
+
+    lon, V0 = _airframe()
+    sys = with_gusts(lon, V0)
+    assert list(sys.input_labels) == ["throttle", "elevator", *GUST_INPUTS]
+    A, B, C, D = (np.asarray(m) for m in (sys.A, sys.B, sys.C, sys.D))
+    ih = list(sys.state_labels).index("h_m")
+    keep = [i for i in range(A.shape[0]) if i != ih]          # h is an integrator
+    out = list(sys.output_labels)
+    for k, w in ((2, 1.5), (3, 2.0)):
+        # the first instant: α (updraft) or V (headwind) jumps by the gust
+        y0 = D[:, k] * w
+        assert y0[out.index("alpha" if k == 2 else "V")] == pytest.approx(
+            w / V0 if k == 2 else w, rel=1e-9)
+        # the steady state with the controls fixed
+        x = np.zeros(A.shape[0])
+        x[keep] = -np.linalg.solve(A[np.ix_(keep, keep)], B[keep, k] * w)
+        y = C @ x + D[:, k] * w
+        assert abs(y[out.index("alpha")]) < 1e-12 and abs(y[out.index("V")]) < 1e-9
+        assert A[ih] @ x + B[ih, k] * w == pytest.approx(w if k == 2 else 0.0, abs=1e-9)
+        assert y[out.index("gamma")] == pytest.approx(w / V0 if k == 2 else 0.0, abs=1e-12)

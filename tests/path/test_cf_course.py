@@ -26,9 +26,10 @@ NO_ROOM = [("KMCO", "I36R", "", "DNMOR"), ("KATL", "I28", "", "PAJVO"),
 # minimum speed
 MIN_SPEED = [("KBJC", "D30L", "", "BIZEN"), ("KBJC", "D30R", "", "BIZEN")]
 # SIDs whose CF is to be joined within a few NM of the runway (the demo SID's SKORR among
-# them): no distance behind to slow to the minimum speed, still flown direct (a correction)
-NO_SLOWDOWN = [("KJFK", "SKORR5", "RW31L", "SKORR"), ("KSFO", "MOLEN9", "RW19B", "SIPLY"),
-               ("KRDD", "KENDL4", "RW12", "KENDL")]
+# them): once flown direct 34-60° off the course at the 230 kt climb speed; planned at the
+# departure's climb-out speed they are flown along it
+DEPARTURE_CF = [("KJFK", "SKORR5", "RW31L", "SKORR"), ("KSFO", "MOLEN9", "RW19B", "SIPLY"),
+                ("KRDD", "KENDL4", "RW12", "KENDL")]
 G_MPS2 = 9.80665
 
 
@@ -93,20 +94,43 @@ def test_a_cf_with_no_room_at_the_planned_radius_is_joined_at_the_minimum_speed(
             assert bank <= 25.0 + 0.05, (s.role, s.geom.radius_m, s.speed_mps)
 
 
-@pytest.mark.parametrize("airport, proc, trans, fix", NO_SLOWDOWN)
-def test_a_cf_with_no_distance_to_slow_down_is_a_correction_saying_so(cifp, airport, proc,
-                                                                      trans, fix):
-    """Never 'ok': a V,γ,φ,λ correction says the coded course is not flown; and the reason
-    holds: the path before the CF is shorter than the distance to slow from the leg's planned
-    TAS to the minimum speed at 0.3 m/s², (V² − V_min²) / (2 a)."""
+@pytest.mark.parametrize("airport, proc, trans, fix", DEPARTURE_CF)
+def test_a_cf_just_after_the_runway_is_flown_along_its_course_at_the_climb_out_speed(
+        cifp, airport, proc, trans, fix):
+    """The CF's own straights lie within 20° of the record's course (course + variation) and
+    end at the database fix; a leg that starts below the acceleration height (1,000 ft above
+    the runway record's elevation) is planned at the 737 file's climb-out speed, V2 + 10 kt
+    (150 + 10 kt) raised to 1.15 × its 150 kt minimum clean CAS (172.5 kt, the lowest clean
+    CAS guidance flies) as TAS at the leg's start altitude, a later one between that and the
+    230 kt climb speed; no turn of the path needs more
+    than the 25° bank at the speed it is planned for."""
+    from fms_testbed.config.aircraft import load_aircraft
+    from fms_testbed.core.units import FT_M, KT_MPS
+    from fms_testbed.path.segmentation import runway_record
+
     p = _path(cifp, airport, proc, trans)
-    assert p.status in ("corrected", "coding_suspect")
-    assert any(f"CF {fix} built" in f.message and "without flying the coded course" in f.message
-               for f in p.findings if f.category == "correction")
+    assert p.status in ("ok", "corrected", "coding_suspect")
+    assert not any(f"CF {fix} built" in f.message for f in p.findings)
     lg = next(lg for lg in p.legs if lg.path_term == "CF" and lg.record.fix.ident == fix)
-    before = sum(s.geom.length_m() for s in p.segments if s.leg_index < lg.index - 1)
-    v_min = cas_to_tas_scalar(PERF.tas_min_mps, lg.start.alt_m)
-    assert before < (lg.speed_mps ** 2 - v_min ** 2) / (2 * 0.3)
+    crs = _coded_true_deg(lg)
+    lines = [s for s in p.segments if s.leg_index == lg.index and s.role == "leg"
+             and isinstance(s.geom, Line) and s.geom.length_m() >= 1.0]
+    assert lines
+    for s in lines:
+        assert abs(wrap180(s.geom.end_course_deg - crs)) <= 20.0, (s.geom.end_course_deg, crs)
+    end = lines[-1].geom.end
+    assert inverse(*end, lg.resolved.fix.lat_deg, lg.resolved.fix.lon_deg)[0] < 1.0
+    rwy = runway_record(cifp, airport, trans)
+    ac = load_aircraft("737")
+    cas = max(ac.takeoff.v2_cas_mps + 10 * KT_MPS, 1.15 * ac.limits.cas_min_mps)
+    assert cas - 0.01 <= lg.departure_cas_mps <= ac.limits.climb_cas_mps + 0.01
+    if lg.start.alt_m - rwy.elev_m < 1000 * FT_M:
+        assert lg.departure_cas_mps == pytest.approx(cas, abs=0.01)
+        assert lg.speed_mps == pytest.approx(cas_to_tas_scalar(cas, lg.start.alt_m), abs=0.05)
+    for s in p.segments:
+        if s.geom.kind == "arc":
+            bank = math.degrees(math.atan(s.speed_mps ** 2 / (s.geom.radius_m * G_MPS2)))
+            assert bank <= 25.0 + 0.05, (s.role, s.geom.radius_m, s.speed_mps)
 
 
 @pytest.mark.parametrize("airport", ["KBJC", "KJFK", "KMCO", "KSFO", "KDFW", "KATL"])

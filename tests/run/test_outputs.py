@@ -10,6 +10,7 @@ import signal
 import subprocess
 import sys
 import time
+from pathlib import Path
 
 import pytest
 
@@ -195,3 +196,18 @@ def test_a_run_json_that_is_not_json_is_named(tmp_path):
     (out / RUN_MARKER).write_text("{oops")
     with pytest.raises(UserError, match="its run.json is not valid JSON: line 1 col 2"):
         check_out_dir(out, kind="fly")
+
+
+def test_unwritable_targets_are_refused_whoever_runs_the_test(tmp_path, monkeypatch):
+    """The refusal of a read-only folder, also where the test runs as root (who writes
+    anywhere): ``os.access`` answers as it would for an ordinary user."""
+    import fms_testbed.run.outputs as outputs
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    real_access = os.access
+    monkeypatch.setattr(outputs.os, "access",
+                        lambda p, mode: False if Path(p) == ro else real_access(p, mode))
+    with pytest.raises(UserError, match=r"cannot write in .*ro \(permission denied\)"):
+        check_out_dir(ro / "out")
+    with pytest.raises(UserError, match="the folder is read-only"):
+        check_out_dir(ro)
