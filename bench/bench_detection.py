@@ -53,10 +53,12 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 import report  # noqa: E402
 
 PAGES = ("fdi_calibration.md", "fdi_false_alarms.md", "detection_limits_without_drift.md",
-         "detection_limits_drift.md", "detection_limits_cusum_step.md")
+         "detection_limits_drift.md", "detection_limits_cusum_step.md",
+         "fdi_calibration_cusum.md", "fdi_false_alarms_cusum.md")
 """The docs/results pages this bench writes (``--only 'gyro drift'`` with and without
 ``--exclude`` for the two detection-limit pages; ``--only 'gyro step' --sensor-test cusum`` for
-the CUSUM comparison)."""
+the CUSUM comparison; ``calibrate`` and ``false-alarms`` with ``--sensor-test cusum`` for its
+threshold and false alarms)."""
 RATE_PER_H = 3e-3
 """The goal's false-alarm rate (zero in 1,000 one-hour flights: ≤ 3e-3/h at 95 %)."""
 FAULT_AT_S = 200.0
