@@ -197,9 +197,10 @@ class Replanner:
         self._drift_rebuilt_s = -math.inf
 
     def leg_ended(self, w: Where, nav: NavSolution) -> tuple[list[int], Rebuild | None]:
-        """The conditional leg flown ended: (the DF legs after it already passed, the rebuild
-        of the legs after those — None when nothing is left)."""
-        v = self.cfg.limits.climb_cas_mps
+        """The conditional leg flown ended: (the DF legs after it already passed — judged on
+        the turn diameter at the present ground speed, at most the climb CAS, the speed the
+        aircraft turns at — the rebuild of the legs after those; None when nothing is left)."""
+        v = min(self.cfg.limits.climb_cas_mps, math.hypot(*nav.v_enu_mps[:2]))
         passed = passed_direct_legs(self.whole, w.leg + 1, nav.lat_rad, nav.lon_rad, w.trk_rad,
                                     v)
         nxt = (passed[-1] if passed else w.leg) + 1

@@ -122,6 +122,8 @@ class Flight:
         # approach settings starts with the flaps its start speed has out on the schedule
         ap = cfg.approach if proc is not None else None
         k0 = flap_index_for_cas(ap, float(tas_to_cas(tas0, ini.altitude_m))) if ap else 0
+        if proc is not None and proc.path.path.proc_type == "D":
+            k0 = 0   # a SID is planned clean (climb-out CAS >= 1.15 x the minimum clean CAS)
         runway = proc.takeoff_runway() if proc is not None else None
         if runway is not None:
             start_on_runway(ac, runway, cfg)

@@ -276,11 +276,10 @@ def test_heading_legs_are_left_out_of_the_path_error_statistics(db):
 
 def test_demo_sid_flies_with_a_finite_pde_on_its_cf_leg():
     """Issue 10: PDE on CF legs raised UnboundLocalError, hidden as NaN by a broad except.
-    DEEZZ5 RW31L (demo-sid.yaml), from the departure end of the runway (issue 12, class D):
-    the VI meets the CF course 971 m out, too close for the 77° fly-by at 230 kt, so the turn
-    is flown over the intercept and the CF flown direct to SKORR — its own path is the line
-    from there, whose PDE is finite and equals its offset from the coded course; the fly-by
-    arc that ends the leg is a transition (NaN)."""
+    DEEZZ5 RW31L (demo-sid.yaml), from the departure end of the runway: planned at the
+    climb-out speed, the CF to SKORR is joined on its coded course and its own line (the
+    part between the turns) is flown with a finite PDE equal to that line's offset from the
+    coded course (nil: it is built on it); the turns and the fly-by arcs are transitions (NaN)."""
     import fms_testbed
     from pathlib import Path
     from fms_testbed.legs.construct import _foot
@@ -290,7 +289,7 @@ def test_demo_sid_flies_with_a_finite_pde_on_its_cf_leg():
     df = res.df
     cf = df[df["leg_code"] == "CF"]
     own = cf.loc[cf["seg_role"] == "leg", "pde_m"].to_numpy()
-    assert own.size > 100 and np.isfinite(own).all()
+    assert own.size > 10 and np.isfinite(own).all()
     fp = res.procedure.path
     line = next(s.geom for s in fp.path.segments if s.path_term == "CF" and s.role == "leg")
     rec = next(lg for lg in fp.path.legs if lg.path_term == "CF")
@@ -300,7 +299,8 @@ def test_demo_sid_flies_with_a_finite_pde_on_its_cf_leg():
     offset = max(abs(_foot(t.lat_deg, t.lon_deg, crs, *line.point_at(line.length_m() * k / 4))[1])
                  for k in range(5))
     assert own.max() == pytest.approx(offset, rel=1e-3, abs=0.5)
-    assert cf.loc[cf["seg_role"] == "flyby", "pde_m"].isna().all()
+    assert own.max() < 1.0                  # on the coded course, not flown direct off it
+    assert cf.loc[cf["seg_role"].isin(["flyby", "turn"]), "pde_m"].isna().all()
 
 
 def test_pde_is_logged_on_a_flown_hold_circuit(db):
