@@ -53,7 +53,7 @@ import numpy as np
 from fms_testbed.core.earth import radii_m
 from fms_testbed.core.errors import ConfigError
 from fms_testbed.core.state import AircraftState
-from fms_testbed.sensors.imu.errors import (N_ROW, ROW_A, ROW_LSB, ROW_RES, ROW_S, ROW_WSD,
+from fms_testbed.sensors.imu.errors import (N_ROW, ROW_A, ROW_RES, ROW_S, ROW_WSD,
                                             ImuErrors, advance_slow, imu_error_params,
                                             measure_row)
 from fms_testbed.sensors.imu.synthesis import (FRAME_PROPERTIES, frame_properties, sample_of,
@@ -356,13 +356,9 @@ class FlightTestSensors:
             self.reference.theta_rad
 
     def _coefficients(self, step_s: float, frame_s: float) -> None:
-        key = (step_s, frame_s)
+        key = (step_s, frame_s, self.accel.version)
         if key != self._key:
-            a, s = self.accel.coefficients(step_s)
-            self.U[:, ROW_A:ROW_S] = a
-            self.U[:, ROW_S:ROW_WSD] = s
-            self.U[:, ROW_WSD:ROW_LSB] = self.accel.white_sd(frame_s)
-            self.U[:, ROW_LSB:ROW_RES] = self.accel.lsb
+            self.accel.pack_rows(self.U, step_s, frame_s)
             self._key = key
 
     def step(self, truth: AircraftState, frames: np.ndarray | None = None

@@ -25,7 +25,7 @@ from fms_testbed.core.state import AircraftState, NavSolution
 from fms_testbed.core.units import DPH_RPS, G0_MPS2
 from fms_testbed.navigation.inertial.alignment import ALIGNMENTS, align, initial_errors_applied
 from fms_testbed.navigation.inertial.strapdown import (N_OUT, N_T, N_U, T_MEAN, U_A, U_COMP, U_E,
-                                                       U_LSB, U_MEAN, U_RES, U_S, U_W, U_WSD,
+                                                       U_MEAN, U_RES, U_W,
                                                        bank_step, correct_row, nav_errors,
                                                        output_row, outputs, vertical_aid,
                                                        vertical_gains)
@@ -139,11 +139,7 @@ class StrapdownBank:
         key = (step_s, frame_s, self.imu.version)
         if key == self._coef_key:
             return
-        a, s = self.imu.coefficients(step_s)
-        self.U[:, U_A:U_S] = a
-        self.U[:, U_S:U_WSD] = s
-        self.U[:, U_WSD:U_LSB] = self.imu.white_sd(frame_s)
-        self.U[:, U_LSB:U_RES] = self.imu.lsb
+        self.imu.pack_rows(self.U, step_s, frame_s)
         self._coef_key = key
 
     def _start(self, truth: AircraftState) -> None:

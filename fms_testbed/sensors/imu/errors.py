@@ -276,9 +276,9 @@ class ImuErrors:
     def __len__(self) -> int:
         return len(self.params)
 
-    def coefficients(self, dt_s: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(a, s, white σ per frame) for a step of ``dt_s`` and frames of the same length (s),
-        (n, 30), (n, 30), (n, 6); cached while ``dt_s`` does not change."""
+    def coefficients(self, dt_s: float) -> tuple[np.ndarray, np.ndarray]:
+        """(a, s) of the slow states for a step of ``dt_s`` (s), (n, 30) each; cached while
+        ``dt_s`` does not change."""
         c = self._coef
         if c is None or abs(c[0] - dt_s) > 1e-12 * dt_s:
             ab = [p.step_coefficients(dt_s) for p in self.params]
@@ -295,6 +295,16 @@ class ImuErrors:
             psd = np.array([p.white_psd for p in self.params])
             self._white = w = (frame_dt_s, np.sqrt(psd * frame_dt_s))
         return w[1]
+
+    def pack_rows(self, U: np.ndarray, step_s: float, frame_s: float) -> None:
+        """Write the slow states' one-step a and s for a step of ``step_s`` (s), the white σ
+        per increment of ``frame_s`` (s) and the quanta into the sensor rows ``U`` (n,
+        :data:`N_ROW`; the layout of :data:`ROW_E`); the error states and residues are left."""
+        a, s = self.coefficients(step_s)
+        U[:, ROW_A:ROW_S] = a
+        U[:, ROW_S:ROW_WSD] = s
+        U[:, ROW_WSD:ROW_LSB] = self.white_sd(frame_s)
+        U[:, ROW_LSB:ROW_RES] = self.lsb
 
     # -- truth-side faults (fms_testbed.navigation.faults kinds) -------------------------------
     def step_bias(self, unit: int, sensor: str, axis: int, size: float) -> None:
