@@ -103,9 +103,11 @@ def from_run_dir(run_dir: str | Path) -> Trajectory:
     path = Path(run_dir) / "timeseries.parquet"
     if not path.is_file():
         raise UserError(f"{run_dir}: no timeseries.parquet (not a run directory)")
+    import pyarrow as pa
+
     try:
         df = pd.read_parquet(path)
-    except Exception as exc:  # pyarrow raises several types for corrupt files
+    except (OSError, ValueError, pa.ArrowException) as exc:  # what a damaged file raises
         raise UserError(f"{path}: cannot read parquet: {exc}") from None
     return from_dataframe(df, where=str(path))
 
