@@ -38,7 +38,7 @@ SPEED_LIMIT_ALT_M = 10000 * FT_M
 
 MIN_CLEAN_CAS_FACTOR = 1.15
 """The lowest CAS guidance flies clean is this multiple of the aircraft's minimum clean CAS
-(``guidance.vertical.MIN_CAS_FACTOR``, the same number): a departure's climb-out speed is
+(``guidance.vertical`` floors its TAS target with it): a departure's climb-out speed is
 planned no lower, so a SID started airborne (clean) flies the turn radii it was planned for."""
 
 ARC_BANK_MARGIN_DEG = 3.0

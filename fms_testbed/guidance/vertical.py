@@ -28,12 +28,12 @@ from dataclasses import dataclass
 
 from fms_testbed.core.atmosphere import cas_to_tas_scalar
 from fms_testbed.core.units import KT_MPS
+from fms_testbed.core.planning import MIN_CLEAN_CAS_FACTOR as MIN_CAS_FACTOR
 from fms_testbed.legs.model import approach_cas_caps
 
-MIN_CAS_FACTOR = 1.15
-"""The TAS target never gives a CAS below this multiple of the aircraft's minimum clean CAS
-(the planned TAS is constant, so high in a SID or STAR the CAS would otherwise fall toward the
-stall)."""
+# MIN_CAS_FACTOR: the TAS target never gives a CAS below this multiple of the aircraft's minimum
+# clean CAS (the planned TAS is constant, so high in a SID or STAR the CAS would otherwise fall
+# toward the stall); the planner's factor, one number for both.
 SPEED_MARGIN_MPS = 2.0 * KT_MPS
 """Aim inside an 'at or below' / 'at or above' speed limit by this much, m/s."""
 
