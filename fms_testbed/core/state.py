@@ -29,7 +29,8 @@ class AircraftState:
     roll_rad, pitch_rad, heading_rad: Euler angles (body to local NED), rad; heading true
     track_rad: ground track (true), rad
     alpha_rad, beta_rad: angle of attack and sideslip, rad
-    gamma_rad: air-relative flight-path angle, rad
+    gamma_rad: ground-relative (inertial) flight-path angle, rad: JSBSim's
+        ``flight-path/gamma-rad`` = atan2(-v_down, v_ground)
     p_rps, q_rps, r_rps: body rates, rad/s
     nx: tangential (wind-axis) load factor, g;  ny: normal (lift-axis) load factor, g
     f_body_mps2: specific force in body axes (forward, right, down), m/s^2, shape (3,)

@@ -137,11 +137,28 @@ def step_matrices(sys, dt_s: float = _DT_S) -> tuple[np.ndarray, np.ndarray]:
 
 
 def step_outputs(sys, u: np.ndarray, t_end_s: float = T_STEP_S, dt_s: float = _DT_S) -> np.ndarray:
-    """Outputs (time × outputs) of ``sys`` for a constant input vector ``u`` from rest, every
-    ``dt_s`` seconds up to ``t_end_s`` seconds."""
-    Phi, Gam = step_matrices(sys, dt_s)
+    """Outputs (time × outputs) of ``sys`` for a constant input vector ``u`` from rest, at
+    ``t_k = k dt_s``, k = 1 … ``t_end_s / dt_s``.
+
+    With A = V diag(λ) V⁻¹ the response is evaluated in closed form, vectorised over time::
+
+        y(t) = Re(C V diag(g(t)) V⁻¹ B u) + D u,   g_i(t) = (e^{λ_i t} - 1) / λ_i  (t at λ_i = 0)
+
+    (exact for a constant input, equal to the zero-order-hold recursion); a (nearly) defective
+    A is stepped with the ``expm`` discretisation (:func:`step_matrices`) instead.
+    """
+    A, B = np.asarray(sys.A), np.asarray(sys.B)
     C, D = np.asarray(sys.C), np.asarray(sys.D)
     n = int(t_end_s / dt_s)
+    lam, V = np.linalg.eig(A)
+    if np.linalg.cond(V) < 1e8:
+        z = np.linalg.solve(V, B @ u)
+        t = dt_s * np.arange(1, n + 1)
+        small = np.abs(lam) < 1e-9
+        lt = np.where(small, 1.0, lam)
+        g = np.where(small[None, :], t[:, None], np.expm1(lam[None, :] * t[:, None]) / lt[None, :])
+        return ((g * z[None, :]) @ (C @ V).T).real + D @ u
+    Phi, Gam = step_matrices(sys, dt_s)
     x = np.zeros(Phi.shape[0])
     out = np.empty((n, C.shape[0]))
     gu = Gam @ u
@@ -157,7 +174,9 @@ class LinearGoals:
 
     gm_db, pm_deg, dm : smallest over the longitudinal loops (dB, deg, α);  zeta : smallest
     closed-loop damping;  max_dv_kmh : max|ΔV| in the altitude step, km/h;  max_dh_m :
-    max|ΔH| in the speed step, m;  cost : soft-goal cost (dimensionless)
+    max|ΔH| in the speed step, m;  cost : soft-goal cost (dimensionless);  h_rise_s : time
+    from the altitude step to 90 % of it, s (the altitude loop's speed);  h_overshoot :
+    overshoot of that step, fraction of the step (its damping)
     """
 
     gm_db: float
@@ -167,6 +186,8 @@ class LinearGoals:
     max_dv_kmh: float
     max_dh_m: float
     cost: float
+    h_rise_s: float = math.nan
+    h_overshoot: float = math.nan
 
 
 def linear_goals(pl: PointLoops, lead_s: float | None = None) -> LinearGoals:
@@ -193,9 +214,12 @@ def linear_goals(pl: PointLoops, lead_s: float | None = None) -> LinearGoals:
     couple += (float(e_end) / RAMP_ERR_M) ** 2
     act = (np.abs(yv[:, 2]).max() + np.abs(yh[:, 2]).max()) / 0.3 + \
         (np.abs(yv[:, 3]).max() + np.abs(yh[:, 3]).max()) / 0.1
+    hit = np.flatnonzero(y >= 0.9)
+    rise = float((hit[0] + 1) * _DT_S) if len(hit) else math.inf
     return LinearGoals(min(m[0] for m in ms), min(m[1] for m in ms), min(m[2] for m in ms),
                        zeta, max_dv, max_dh,
-                       float(track + couple + 0.5 * act + GUST_WEIGHT * gust_rejection(pl)))
+                       float(track + couple + 0.5 * act + GUST_WEIGHT * gust_rejection(pl)),
+                       rise, max(0.0, float(y.max()) - 1.0))
 
 
 def gust_rejection(pl: PointLoops) -> float:
@@ -215,12 +239,29 @@ def gust_rejection(pl: PointLoops) -> float:
     return j
 
 
-def _constraints(g: LinearGoals) -> np.ndarray:
-    """Hard goals plus :data:`TUNE_BUFFER` as ``c ≥ 0`` (each scaled to about one unit)."""
+H_RISE_TOL = 0.02
+"""Altitude-loop goal: the 90 % rise time of the altitude step may exceed the file law's at the
+same point by at most this fraction."""
+H_OVERSHOOT_TOL = 0.01
+"""Altitude-loop goal: the altitude step's overshoot may exceed the file law's at the same point
+by at most this, fraction of the step."""
+
+
+def _constraints(g: LinearGoals, ref: LinearGoals | None = None) -> np.ndarray:
+    """Hard goals plus :data:`TUNE_BUFFER` as ``c ≥ 0`` (each scaled to about one unit); with
+    ``ref`` (the file law's goals at the same point) also the altitude-loop goal: no slower
+    and no less damped than ``ref``::
+
+        t_90 ≤ (1 + H_RISE_TOL) t_90,ref,    overshoot ≤ overshoot_ref + H_OVERSHOOT_TOL
+    """
     b = TUNE_BUFFER
-    return np.array([(g.gm_db - GM_MIN_DB - b["gm_db"]) / 6.0,
-                     (g.pm_deg - PM_MIN_DEG - b["pm_deg"]) / 45.0,
-                     (g.dm - DM_MIN - b["dm"]) / DM_MIN, (g.zeta - ZETA_MIN - b["zeta"]) / ZETA_MIN])
+    c = [(g.gm_db - GM_MIN_DB - b["gm_db"]) / 6.0,
+         (g.pm_deg - PM_MIN_DEG - b["pm_deg"]) / 45.0,
+         (g.dm - DM_MIN - b["dm"]) / DM_MIN, (g.zeta - ZETA_MIN - b["zeta"]) / ZETA_MIN]
+    if ref is not None:
+        c += [((1.0 + H_RISE_TOL) * ref.h_rise_s - g.h_rise_s) / ref.h_rise_s,
+              (ref.h_overshoot + H_OVERSHOOT_TOL - g.h_overshoot) / 0.1]
+    return np.array(c)
 
 
 @dataclass(frozen=True)
@@ -263,23 +304,28 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
 
     u0 = (np.clip([getattr(start, n) for n in NAMES], lo, hi) - lo) / (hi - lo)
     g0 = goals(u0)
+    ref = linear_goals(point_loops(cfg, model, start))
+
+    def cons(g: LinearGoals) -> np.ndarray:
+        return _constraints(g, ref)
+
     u = u0
-    if np.min(_constraints(g0)) < 0:
-        r = minimize(lambda v: -min(np.min(_constraints(goals(v))), 0.2), u0,
+    if np.min(cons(g0)) < 0:
+        r = minimize(lambda v: -min(np.min(cons(goals(v))), 0.2), u0,
                      method="Nelder-Mead", options={"maxfev": 80, "xatol": 0.01, "fatol": 1e-3})
         u = np.clip(r.x, 0.0, 1.0)
     def cost(v):
         return goals(v).cost + REG_WEIGHT * float(np.sum((np.clip(v, 0, 1) - u0) ** 2))
 
     minimize(cost, u, method="SLSQP", bounds=[(0.0, 1.0)] * len(NAMES),
-             constraints=[{"type": "ineq", "fun": lambda v: _constraints(goals(v))}],
+             constraints=[{"type": "ineq", "fun": lambda v: cons(goals(v))}],
              options={"maxiter": max_iter, "ftol": 1e-4, "eps": 1e-3})
     done = list(cache.values())
-    feas = [(uu, g) for uu, g in done if np.min(_constraints(g)) >= 0]
+    feas = [(uu, g) for uu, g in done if np.min(cons(g)) >= 0]
     if feas:
         best_u, gb = min(feas, key=lambda e: cost(e[0]))
     else:
-        best_u, gb = max(done, key=lambda e: np.min(_constraints(e[1])))
+        best_u, gb = max(done, key=lambda e: np.min(cons(e[1])))
     return PointTuning(params(best_u), gb, g0, len(cache), bool(feas))
 
 
@@ -413,17 +459,51 @@ def verify(cfg: AircraftConfig, point: DesignPoint, make_law, duration_s: float 
     return StepCheck(dv, dh, {"alt": a, "speed": s})
 
 
-def _bank_slack(cfg: AircraftConfig, models: list, gains) -> np.ndarray:
-    """Scaled slack of the bank loop's GM and PM goals (plus buffers) at every model."""
+TURN_KAPPA_PER_M = 1.0 / 5000.0
+"""Lateral path-error goal: path curvature of the turn-entry step, 1/m (a 5 km turn radius)."""
+PATH_ERR_TOL = 0.01
+"""Lateral path-error goal: the turn entry's ∫|xtk| dt may exceed the file gains' at the same
+point by at most this fraction."""
+
+
+def path_error_ms(pl: PointLoops) -> float:
+    """Lateral path error of the loops ``pl`` in a turn entry: ∫|xtk| dt (m·s) over
+    :data:`T_STEP_S` after a step of the path curvature to :data:`TURN_KAPPA_PER_M`, all
+    lateral loops closed (bank loop, yaw damper, path law)."""
+    y = step_outputs(pl.closed("lat", ["kappa"], ["xtk"]), np.array([TURN_KAPPA_PER_M]))
+    return float(np.abs(y[:, 0]).sum() * _DT_S)
+
+
+def _bank_slack(cfg: AircraftConfig, models: list, gains, ref_path=None) -> np.ndarray:
+    """Scaled slack of the bank loop's GM and PM goals (plus buffers) at every model and, with
+    ``ref_path`` (the file gains' :func:`path_error_ms` per model), of the path-error goal
+    ``∫|xtk| ≤ (1 + PATH_ERR_TOL) ∫|xtk|_file``."""
     from fms_testbed.sim.inner_steps import replace_gains
 
     c = replace_gains(cfg, "bank", gains)
     out = []
-    for m in models:
-        gm, pm, _ = grid_margins(point_loops(c, m, start_law(cfg)).loop("aileron"))
+    for i, m in enumerate(models):
+        pl = point_loops(c, m, start_law(cfg))
+        gm, pm, _ = grid_margins(pl.loop("aileron"))
         out += [(gm - GM_MIN_DB - TUNE_BUFFER["gm_db"]) / 6.0,
                 (pm - PM_MIN_DEG - TUNE_BUFFER["pm_deg"]) / 45.0]
+        if ref_path is not None:
+            out.append(((1.0 + PATH_ERR_TOL) * ref_path[i] - path_error_ms(pl)) / ref_path[i])
     return np.array(out)
+
+
+def bank_path_errors(cfg: AircraftConfig, models: list, gains=None) -> list[float]:
+    """:func:`path_error_ms` (m·s) at every model with the bank gains ``gains``.
+
+    Parameters
+    ----------
+    cfg : aircraft;  models : linear airframes of the design points
+    gains : bank-loop PID gains (None: the aircraft file's)
+    """
+    from fms_testbed.sim.inner_steps import replace_gains
+
+    c = cfg if gains is None else replace_gains(cfg, "bank", gains)
+    return [path_error_ms(point_loops(c, m, start_law(cfg))) for m in models]
 
 
 def start_law(cfg: AircraftConfig) -> CoupledLawParams:
@@ -435,9 +515,11 @@ def start_law(cfg: AircraftConfig) -> CoupledLawParams:
 
 def tune_bank_loop(cfg: AircraftConfig, models: list, max_evals: int = 60):
     """One bank-loop gain set (k_p, k_d of the aircraft file's ``inner_loops.bank``; the JSBSim
-    system scales them with q̄_ref/q̄) meeting the GM/PM goals plus buffers at every design point:
-    Nelder-Mead on log-gains minimising the squared goal violations plus a pull
-    ``0.05 Σ ln²(k/k0)`` towards the file's gains.
+    system scales them with q̄_ref/q̄) meeting the GM/PM goals plus buffers at every design point
+    without a larger lateral path error in a turn entry than the file's gains at any point
+    (:func:`path_error_ms`, tolerance :data:`PATH_ERR_TOL`; weighted 10× the margins: margin is
+    not bought with path error): Nelder-Mead on log-gains minimising the squared goal
+    violations plus a pull ``0.05 Σ ln²(k/k0)`` towards the file's gains.
 
     Parameters
     ----------
@@ -454,14 +536,17 @@ def tune_bank_loop(cfg: AircraftConfig, models: list, max_evals: int = 60):
     def gains(x):
         return g0.model_copy(update={"kp": float(np.exp(x[0])), "kd": float(np.exp(x[1]))})
 
-    def f(x):
-        sl = _bank_slack(cfg, models, gains(x))
-        return float(np.sum(np.minimum(sl, 0.0) ** 2) * 100 + 0.05 * np.sum((x - x0) ** 2))
+    ref = bank_path_errors(cfg, models)
+    w = np.tile([1.0, 1.0, 10.0], len(models))
 
-    before = float(np.min(_bank_slack(cfg, models, g0)))
+    def f(x):
+        sl = _bank_slack(cfg, models, gains(x), ref)
+        return float(np.sum(w * np.minimum(sl, 0.0) ** 2) * 100 + 0.05 * np.sum((x - x0) ** 2))
+
+    before = float(np.min(_bank_slack(cfg, models, g0, ref)))
     if before >= 0:
         return g0, before, before
     r = minimize(f, x0, method="Nelder-Mead", options={"maxfev": max_evals, "xatol": 0.01})
     best = gains(r.x)
     best = best.model_copy(update={"kp": round(best.kp, 3), "kd": round(best.kd, 3)})
-    return best, before, float(np.min(_bank_slack(cfg, models, best)))
+    return best, before, float(np.min(_bank_slack(cfg, models, best, ref)))
