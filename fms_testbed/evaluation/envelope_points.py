@@ -63,6 +63,11 @@ REG_WEIGHT = 2.0
 """Weight of the pull towards the starting tuning, ``REG_WEIGHT Σ ((x - x0)/(hi - lo))²``: the
 soft cost is flat near its optimum, and without the pull neighbouring points land on unrelated
 optima (a jagged schedule)."""
+NY_TRIM_WEIGHT = 200.0
+"""Weight of the penalty ``NY_TRIM_WEIGHT max(0, (τ - τ_file)/(hi - lo))²`` on an n_y-trim
+time constant slower than the file's: a slower n_y trim lets the n_y tracking error stand
+longer in turbulence (the vertical path error grows), so it is raised only where the hard
+goals need it."""
 DH_STEP_M = 100.0
 """Altitude step of the soft goals and of the nonlinear check, m (inside the ±dH limit)."""
 DV_STEP_FRAC = 0.10
@@ -314,8 +319,12 @@ def tune_point(cfg: AircraftConfig, model: AirframeModel, start: CoupledLawParam
         r = minimize(lambda v: -min(np.min(cons(goals(v))), 0.2), u0,
                      method="Nelder-Mead", options={"maxfev": 80, "xatol": 0.01, "fatol": 1e-3})
         u = np.clip(r.x, 0.0, 1.0)
+    i_trim = NAMES.index("ny_trim_tau_s")
+
     def cost(v):
-        return goals(v).cost + REG_WEIGHT * float(np.sum((np.clip(v, 0, 1) - u0) ** 2))
+        vc = np.clip(v, 0, 1)
+        return (goals(v).cost + REG_WEIGHT * float(np.sum((vc - u0) ** 2))
+                + NY_TRIM_WEIGHT * max(0.0, float(vc[i_trim] - u0[i_trim])) ** 2)
 
     minimize(cost, u, method="SLSQP", bounds=[(0.0, 1.0)] * len(NAMES),
              constraints=[{"type": "ineq", "fun": lambda v: cons(goals(v))}],
