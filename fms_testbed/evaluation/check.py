@@ -226,11 +226,25 @@ def _share_with_workers(db: Database) -> None:
     _WORKER["db_path"] = str(db.path)
 
 
-def _work(airport: str) -> tuple[list[dict], list]:
+def _work(airport: str) -> tuple[list[tuple], list]:
+    """Check one airport in a pool worker: its rows as tuples in :data:`ROW_COLUMNS` order
+    (a compact payload, rebuilt into dicts by the parent) and the records it rejected."""
     db = _WORKER["db"]
     n0 = len(db.issues)
     rows = check_airport(db, airport, _WORKER["perf"], _WORKER["params"])
-    return rows, db.issues[n0:]
+    return [tuple(r[c] for c in ROW_COLUMNS) for r in rows], db.issues[n0:]
+
+
+def schedule(db: Database, airports: list[str], workers: int) -> tuple[list[str], int]:
+    """The order airports are handed to pool workers and the chunk size.
+
+    Largest first (by :meth:`~fms_testbed.procedures.database.Database.record_count`, ties by
+    ident) so the last airports handed out are the small ones and the workers finish together;
+    chunks of about 1/32 of each worker's share keep the per-task overhead small. The rows
+    are sorted afterwards, so the table does not depend on this order.
+    """
+    order = sorted(airports, key=lambda a: (-db.record_count(a), a))
+    return order, max(1, len(order) // (workers * 32))
 
 
 @dataclass
@@ -279,9 +293,9 @@ def run_check(db_path: str | None, perf: Performance, airports: list[str] | None
         _share_with_workers(db)
         with ProcessPoolExecutor(workers, initializer=_init_worker,
                                  initargs=(str(db.path), perf, params)) as ex:
-            for part, issues in ex.map(_work, todo,
-                                       chunksize=max(1, len(todo) // (workers * 8))):
-                rows.extend(part)
+            order, chunk = schedule(db, todo, workers)
+            for part, issues in ex.map(_work, order, chunksize=chunk):
+                rows.extend(dict(zip(ROW_COLUMNS, t)) for t in part)
                 db.issues.extend(issues)
                 if bar:
                     bar.update(1)

@@ -180,6 +180,9 @@ class LegBuilder:
         alt = state.alt_m
         if self.climbing:
             alt = min(alt + dist_m * self.gradient, max(self.alt_cap_m, alt))
+        if not changes:                     # the common case, built without dataclasses.replace
+            return FlightState(state.lat_deg, state.lon_deg, state.track_deg, alt,
+                               state.flyby, state.fix_ident)
         return replace(state, alt_m=alt, **changes)
 
     def as_transition(self, first: int) -> None:

@@ -95,6 +95,11 @@ class Database:
         """Airports/heliports that have procedures (even if every record was rejected), sorted."""
         return sorted(self._keys_by_airport)
 
+    def record_count(self, airport: str) -> int:
+        """Number of primary procedure records (one per leg) of ``airport``, counted without
+        parsing them (0 when it has none): a measure of the work of checking it."""
+        return len(self._raw_procs.get(airport, ()))
+
     def procedure_index(self, airport: str) -> set[tuple[str, str, str, str]]:
         """The sequence keys (type 'D'/'E'/'F', procedure id, route type, transition id) of
         ``airport``, read from the raw records without parsing the legs (cheap enough to

@@ -7,7 +7,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-from fms_testbed.evaluation.check import check_database, invariants, perf_for
+from fms_testbed.evaluation.check import check_database, invariants, perf_for, schedule
 from fms_testbed.procedures.database import load_database
 from fms_testbed.viz.geojson import to_feature_collection
 from fms_testbed.procedures.legrecord import PATH_TERMINATORS
@@ -54,6 +54,17 @@ def test_results_do_not_depend_on_the_number_of_workers():
     one, _ = check_database(None, perf, ["KJFK", "PAFA", "KDLS"], workers=1, progress=False)
     two, _ = check_database(None, perf, ["KJFK", "PAFA", "KDLS"], workers=2, progress=False)
     assert pd.DataFrame(one).equals(pd.DataFrame(two))
+
+
+def test_workers_get_the_largest_airports_first_and_every_airport_once():
+    db = load_database()
+    airports = db.airport_idents()
+    for a in airports:        # counted unparsed: the parsed transitions' legs
+        assert db.record_count(a) == sum(len(s.legs) for s in db.sequences(a)), a
+    order, chunk = schedule(db, airports, 2)
+    assert sorted(order) == airports and chunk >= 1
+    counts = [db.record_count(a) for a in order]
+    assert counts == sorted(counts, reverse=True) and counts[0] > counts[-1]
 
 
 def test_geojson_has_one_feature_per_segment_with_the_issue_fields():
