@@ -54,10 +54,12 @@ import report  # noqa: E402
 
 PAGES = ("fdi_calibration.md", "fdi_false_alarms.md", "detection_limits_without_drift.md",
          "detection_limits_drift.md", "detection_limits_cusum_step.md",
-         "fdi_calibration_cusum.md", "fdi_false_alarms_cusum.md")
+         "fdi_calibration_cusum.md", "fdi_false_alarms_cusum.md", "detection_limits_cusum_22.md",
+         "detection_limits_cusum_50.md", "detection_limits_cusum_100.md")
 """The docs/results pages this bench writes (``--only 'gyro drift'`` with and without
 ``--exclude`` for the two detection-limit pages; ``--only 'gyro step' --sensor-test cusum`` for
-the CUSUM comparison; ``calibrate`` and ``false-alarms`` with ``--sensor-test cusum`` for its
+the CUSUM comparison, ``--only 'x 22'`` (``'x 50'``, ``'x 100'``) with it for one row;
+``calibrate`` and ``false-alarms`` with ``--sensor-test cusum`` for its
 threshold and false alarms)."""
 RATE_PER_H = 3e-3
 """The goal's false-alarm rate (zero in 1,000 one-hour flights: ≤ 3e-3/h at 95 %)."""

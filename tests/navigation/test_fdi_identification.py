@@ -177,3 +177,16 @@ def test_the_cusum_rides_through_a_turn_that_holds_a_scale_factor_bias_in_the_di
     assert first is None and top < FdiTuning().cusum_h
     first, _ = _cusum_flight(np.zeros((3, 3)), step_at_s=200.0)
     assert first is not None and 200.0 < first <= 215.0       # the step after the turn
+
+
+def test_the_cusum_holds_its_reference_so_a_step_in_a_turn_is_not_absorbed():
+    """A 22 °/h step 25 s into the turn, on the misaligned unit: the reference regression
+    (which lags the statistic by the short window) would take the step in as part of ĉ · u
+    and the statistic would fall back; held while the CUSUM is above the freeze level, the
+    step is detected in every seed and the statistic keeps growing (the step stays in the
+    difference)."""
+    h = FdiTuning().cusum_h
+    for seed in range(3):
+        first, top = _cusum_flight(M2_2SIGMA, step_at_s=125.0, seed=seed)
+        assert first is not None and 125.0 < first <= 170.0, (seed, first)
+        assert top > 4.0 * h, (seed, top)

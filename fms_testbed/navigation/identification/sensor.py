@@ -28,6 +28,12 @@ mean and covariance; ū, d̄ the window means, S_uu = Σ (u − ū)(u − ū)ᵀ
 — what the window could not resolve of c (a manoeuvre it has not seen) is a bounded nuisance
 bias: up to κ (``cusum_kappa``) of its posterior σ is taken off the excess before it
 accumulates (the CUSUM of the least favourable bias inside that bound).
+
+The reference lags the statistic by the short window only, so a step would enter the
+regression (as d̄, or in a turn as ĉ · u) while the CUSUM is still accumulating it. While a
+pair's g on some axis of a group exceeds ``cusum_freeze`` × ``cusum_h`` the pair keeps the
+reference (d̄, ĉ, A⁻¹, ū) it had when it crossed that level; below it, the live reference is
+used again.
 """
 
 from __future__ import annotations
@@ -97,6 +103,7 @@ class SensorPairTest:
                          for g in self.groups] if tuning.sensor_test == "cusum" else [])
         self.last_z = np.zeros((n_real, P, 6))
         self.g = np.zeros((2, n_real, P, 6))                           # CUSUM g+, g-
+        self.frozen: dict = {}            # per group: the reference (d̄, ĉ, A⁻¹, ū) in use
         self.design = np.repeat([tuning.cusum_accel_mps2, tuning.cusum_gyro_rps], 3)
 
     def update(self, errs: np.ndarray, f_mps2, w_rps) -> np.ndarray:
@@ -146,13 +153,24 @@ class SensorPairTest:
         lam = var / np.maximum(self.sf[:, cols], 1e-30)
         Ainv = np.linalg.inv(Suu + lam[..., None, None] * np.eye(3))     # (P, 3, 3, 3)
         c_hat = np.einsum("rpaj,pajk->rpak", Sdu, Ainv)
-        du = u - u_bar
-        mu = d_bar + c_hat @ du
+        gp, gm = self.g[0][..., cols], self.g[1][..., cols]
+        # a pair whose CUSUM is above the freeze level keeps the reference it had before
+        live = np.maximum(gp, gm).max(axis=2) <= self.tuning.cusum_freeze * self.tuning.cusum_h
+        R = x.shape[0]
+        if g not in self.frozen:
+            self.frozen[g] = (np.broadcast_to(d_bar, (R,) + d_bar.shape[1:]).copy(),
+                              c_hat.copy(),
+                              np.broadcast_to(Ainv, (R,) + Ainv.shape).copy(),
+                              np.broadcast_to(u_bar, (R, len(self.pairs), 3)).copy())
+        fd, fc, fA, fu = self.frozen[g]
+        fd[live], fc[live], fu[live] = d_bar[live], c_hat[live], u_bar
+        fA[live] = np.broadcast_to(Ainv, (R,) + Ainv.shape)[live]
+        du = u - fu                                                      # (R, P, 3)
+        mu = fd + np.einsum("rpaj,rpj->rpa", fc, du)
         b = self.tuning.cusum_kappa * np.sqrt(np.maximum(
-            var * np.einsum("j,pajk,k->pa", du, Ainv, du), 0.0))
+            var * np.einsum("rpj,rpajk,rpk->rpa", du, fA, du), 0.0))
         dd = self.design[cols]
         e = x - mu
-        gp, gm = self.g[0][..., cols], self.g[1][..., cols]
         np.maximum(gp + dd * (e - b - 0.5 * dd) / var, 0.0, out=gp)
         np.maximum(gm + dd * (-e - b - 0.5 * dd) / var, 0.0, out=gm)
         stat = np.maximum(gp, gm)
