@@ -147,12 +147,15 @@ def _fmt(t, after_s):
 
 
 def _tuning(args) -> FdiTuning:
-    """The default tuning, with ``--sensor-test`` (and ``--cusum-h``) if given."""
+    """The default tuning, with ``--sensor-test`` (and ``--cusum-h``, ``--cusum-freeze``) if
+    given."""
     kw = {}
     if args.sensor_test:
         kw["sensor_test"] = args.sensor_test
     if args.cusum_h:
         kw["cusum_h"] = args.cusum_h
+    if args.cusum_freeze is not None:
+        kw["cusum_freeze"] = args.cusum_freeze
     return FdiTuning(**kw)
 
 
@@ -161,7 +164,8 @@ def _cli(args) -> str:
     out = f" --sensor-test {args.sensor_test}" if args.sensor_test else ""
     run_s = getattr(args, "run_s", HOUR_S)
     out += f" --run-s {run_s:g}" if run_s != HOUR_S else ""
-    return out + (f" --cusum-h {args.cusum_h:g}" if args.cusum_h else "")
+    out += f" --cusum-h {args.cusum_h:g}" if args.cusum_h else ""
+    return out + (f" --cusum-freeze {args.cusum_freeze:g}" if args.cusum_freeze is not None else "")
 
 
 def _rows_cli(args) -> str:
@@ -306,6 +310,8 @@ def main() -> None:
     for c in subs:
         c.add_argument("--sensor-test", choices=("window", "cusum"), default=None)
         c.add_argument("--cusum-h", type=float, default=None)
+        c.add_argument("--cusum-freeze", type=float, default=None,
+                       help="hold the CUSUM's reference above this fraction of h (default: never)")
     args = ap.parse_args()
     run = {"table": table, "calibrate": calibrate, "false-alarms": false_alarms}
     if not args.quick:

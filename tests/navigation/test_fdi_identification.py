@@ -185,8 +185,9 @@ def test_the_cusum_holds_its_reference_so_a_step_in_a_turn_is_not_absorbed():
     and the statistic would fall back; held while the CUSUM is above the freeze level, the
     step is detected in every seed and the statistic keeps growing (the step stays in the
     difference)."""
-    h = FdiTuning().cusum_h
+    tuning = FdiTuning(sensor_test="cusum", cusum_freeze=0.25)
+    h = tuning.cusum_h
     for seed in range(3):
-        first, top = _cusum_flight(M2_2SIGMA, step_at_s=125.0, seed=seed)
+        first, top = _cusum_flight(M2_2SIGMA, step_at_s=125.0, seed=seed, tuning=tuning)
         assert first is not None and 125.0 < first <= 170.0, (seed, first)
         assert top > 4.0 * h, (seed, top)

@@ -27,7 +27,9 @@ class FdiTuning:
     cusum_kappa : the CUSUM's manoeuvre bias bound, in σ of the declared scale-factor and
         misalignment difference times the change of the measured force or rate (dimensionless)
     cusum_freeze : while a pair's CUSUM is above ``cusum_freeze`` × ``cusum_h`` on some axis of
-        a group its reference (regression) is held at its last value (dimensionless)
+        a group its reference (regression) is held at its last value (dimensionless; ``inf``,
+        the default: never held — a held reference has no release rule yet and its fault-free
+        statistic runs away, so ``cusum_h`` is calibrated without it)
     cusum_accel_mps2, cusum_gyro_rps : the CUSUM's design change Δ, m/s² and rad/s
     accel_window_s, gyro_window_s : short windows of the sensor-level step test, s
     reference_s : the reference window before the short one, s
@@ -61,7 +63,7 @@ class FdiTuning:
     k_sensor: float = 6.3
     cusum_h: float = 20.1
     cusum_kappa: float = 2.0
-    cusum_freeze: float = 0.25
+    cusum_freeze: float = float("inf")
     cusum_accel_mps2: float = 0.75e-3 * G0_MPS2
     cusum_gyro_rps: float = 22.0 * 3.141592653589793 / 180.0 / 3600.0
     accel_window_s: float = 1.0
