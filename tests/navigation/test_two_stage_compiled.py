@@ -83,3 +83,17 @@ def test_compiled_step_equals_the_numpy_rules_on_three_units():
 def test_compiled_step_equals_the_numpy_rules_on_two_units_and_one_realisation():
     _run_both(40, 2, 200, 11, track=False)
     _run_both(1, 3, 300, 12, track=False)
+
+
+def test_compiled_pair_flags_equal_the_numpy_pairs():
+    from fms_testbed.navigation.identification.rules import pair_flags
+    from tests.navigation.two_stage_reference import pair_flags as pair_flags_np
+    hits = 0
+    for t, y, sig, nus, mask, _, live in _inputs(300, 3, 40, 5):
+        live = ~live
+        np.testing.assert_array_equal(pair_flags(y, sig, 4.3, live, mask),
+                                      pair_flags_np(y, sig, 4.3, live, mask))
+        np.testing.assert_array_equal(pair_flags(y[:, :2], sig[:, :2], 2.0),
+                                      pair_flags_np(y[:, :2], sig[:, :2], 2.0))
+        hits += pair_flags(y, sig, 4.3, live, mask).sum()
+    assert hits > 100

@@ -8,10 +8,22 @@ from __future__ import annotations
 import numpy as np
 
 from fms_testbed.navigation.identification.rules import (ESTIMATE_FAILED, PAIRS, UNIT_FAILED,
-                                                         fuse, named_unit, pair_flags, ratio,
+                                                         exceeds, fuse, named_unit, ratio,
                                                          three_way, wrapped_difference)
 from fms_testbed.navigation.identification.two_stage import (_EPS_S, BY_INNOVATION, BY_TABLE,
                                                              TwoStage)
+
+def pair_flags(y, sig, k, live=None, mask=None) -> np.ndarray:
+    """(R, 3) bool (ν12, ν13, ν23) of one instant: :func:`exceeds` per pair of live units."""
+    R, U = y.shape[:2]
+    out = np.zeros((R, 3), bool)
+    for p, (a, b) in enumerate(PAIRS):
+        if b < U:
+            out[:, p] = exceeds(y[:, a], y[:, b], sig[:, a], sig[:, b], k, mask)
+            if live is not None:
+                out[:, p] &= live[:, a] & live[:, b]
+    return out
+
 
 def median_of_units(v: np.ndarray, live: np.ndarray) -> np.ndarray:
     """(R, C) median over the live units of ``v`` (R, U, C), per channel (two units: their

@@ -30,74 +30,18 @@ from scipy.stats import chi2
 
 from numba import njit
 
-from fms_testbed.navigation.identification.rules import (ESTIMATE_FAILED, HEADING, MAJORITY,
-                                                         PAIRS, UNIT_FAILED)
+from fms_testbed.navigation.identification.rules import (_PAIR_A, _PAIR_B, ESTIMATE_FAILED,
+                                                         HEADING,
+                                                         UNIT_FAILED, _exceeds, _nan_max,
+                                                         _wrap,
+                                                         _ratio, _table1)
 from fms_testbed.navigation.identification.tuning import FdiTuning
 
 _EPS_S = 1e-9
 
-_PAIR_A = np.array([a for a, _ in PAIRS], np.int64)
-_PAIR_B = np.array([b for _, b in PAIRS], np.int64)
-_NAMED = np.full(8, -1, np.int64)
-for _nu, _src in MAJORITY.items():
-    _NAMED[_nu[0] + 2 * _nu[1] + 4 * _nu[2]] = _src
-
 BY_TABLE, BY_INNOVATION = 1, 2
 """Reasons of an exclusion (:attr:`TwoStage.excluded_by`): stage 2's table on (Z_i, Ẑ, Ẑ_p),
 or the unit's innovation test failing alone."""
-
-
-@njit(cache=True, error_model="numpy")
-def _wrap(d: float) -> float:
-    """d wrapped to [−π, π) (rad)."""
-    return (d + math.pi) % (2.0 * math.pi) - math.pi
-
-
-@njit(cache=True, error_model="numpy")
-def _nan_max(a: float, b: float) -> float:
-    """max(a, b), NaN when either is NaN (numpy's ``maximum``)."""
-    if a != a or b != b:
-        return math.nan
-    return a if a >= b else b
-
-
-@njit(cache=True, error_model="numpy")
-def _exceeds(a, b, sa, sb, k, mask) -> bool:
-    """ν = 1 when some channel c in ``mask`` has |a_c − b_c| > k √(σ_a,c² + σ_b,c²) (heading
-    channel wrapped; a NaN channel never exceeds)."""
-    for c in range(a.shape[0]):
-        d = a[c] - b[c]
-        if c == HEADING:
-            d = _wrap(d)
-        if mask[c] and abs(d) > k * math.sqrt(sa[c] * sa[c] + sb[c] * sb[c]):
-            return True
-    return False
-
-
-@njit(cache=True, error_model="numpy")
-def _ratio(a, b, sa, sb, mask) -> float:
-    """max over the channels of |a − b| / √(σ_a² + σ_b²), 0 outside ``mask``, NaN channels
-    skipped (NaN when every channel is NaN)."""
-    out, seen = -math.inf, False
-    for c in range(a.shape[0]):
-        if mask[c]:
-            d = a[c] - b[c]
-            if c == HEADING:
-                d = _wrap(d)
-            r = abs(d) / math.sqrt(sa[c] * sa[c] + sb[c] * sb[c])
-        else:
-            r = 0.0
-        if r == r:
-            seen = True
-            if r > out:
-                out = r
-    return out if seen else math.nan
-
-
-@njit(cache=True, error_model="numpy")
-def _table1(n1: bool, n2: bool, n3: bool) -> int:
-    """Table 1: the source (0, 1, 2) that (ν12, ν13, ν23) names, −1 for none."""
-    return _NAMED[int(n1) + 2 * int(n2) + 4 * int(n3)]
 
 
 @njit(cache=True, error_model="numpy")
