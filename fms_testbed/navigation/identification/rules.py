@@ -19,6 +19,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numba import njit
 
 PAIRS = ((0, 1), (0, 2), (1, 2))
 """The pairs of three sources in the order of (ν12, ν13, ν23)."""
@@ -32,6 +33,9 @@ HEADING = 8
 _NAMED = np.full(8, -1, np.int64)
 for _nu, _src in MAJORITY.items():
     _NAMED[_nu[0] + 2 * _nu[1] + 4 * _nu[2]] = _src
+
+_PAIR_A = np.array([a for a, _ in PAIRS], np.int64)
+_PAIR_B = np.array([b for _, b in PAIRS], np.int64)
 
 UNIT_FAILED, ESTIMATE_FAILED, PREDICTION_FAILED = 0, 1, 2
 """Verdicts of :func:`three_way` (the failed source of table 1); -1: none named."""
@@ -77,9 +81,74 @@ def ratio(a: np.ndarray, b: np.ndarray, sa: np.ndarray, sb: np.ndarray,
     return np.nanmax(r, axis=-1)
 
 
+@njit(cache=True, error_model="numpy")
+def _wrap(d: float) -> float:
+    """d wrapped to [−π, π) (rad)."""
+    return (d + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True, error_model="numpy")
+def _nan_max(a: float, b: float) -> float:
+    """max(a, b), NaN when either is NaN (numpy's ``maximum``)."""
+    if a != a or b != b:
+        return math.nan
+    return a if a >= b else b
+
+
+@njit(cache=True, error_model="numpy")
+def _exceeds(a, b, sa, sb, k, mask) -> bool:
+    """ν = 1 when some channel c in ``mask`` has |a_c − b_c| > k √(σ_a,c² + σ_b,c²) (heading
+    channel wrapped; a NaN channel never exceeds)."""
+    for c in range(a.shape[0]):
+        d = a[c] - b[c]
+        if c == HEADING:
+            d = _wrap(d)
+        if mask[c] and abs(d) > k * math.sqrt(sa[c] * sa[c] + sb[c] * sb[c]):
+            return True
+    return False
+
+
+@njit(cache=True, error_model="numpy")
+def _ratio(a, b, sa, sb, mask) -> float:
+    """max over the channels of |a − b| / √(σ_a² + σ_b²), 0 outside ``mask``, NaN channels
+    skipped (NaN when every channel is NaN)."""
+    out, seen = -math.inf, False
+    for c in range(a.shape[0]):
+        if mask[c]:
+            d = a[c] - b[c]
+            if c == HEADING:
+                d = _wrap(d)
+            r = abs(d) / math.sqrt(sa[c] * sa[c] + sb[c] * sb[c])
+        else:
+            r = 0.0
+        if r == r:
+            seen = True
+            if r > out:
+                out = r
+    return out if seen else math.nan
+
+
+@njit(cache=True, error_model="numpy")
+def _table1(n1: bool, n2: bool, n3: bool) -> int:
+    """Table 1: the source (0, 1, 2) that (ν12, ν13, ν23) names, −1 for none."""
+    return _NAMED[int(n1) + 2 * int(n2) + 4 * int(n3)]
+
+
+@njit(cache=True, error_model="numpy")
+def _pair_flags(y, sig, k, live, mask, out) -> None:
+    """``out`` (R, 3) ← :func:`pair_flags` (compiled; ``live`` (R, U), ``mask`` (R, C))."""
+    R, U = y.shape[0], y.shape[1]
+    for r in range(R):
+        for p in range(3):
+            a, b = _PAIR_A[p], _PAIR_B[p]
+            out[r, p] = (b < U and live[r, a] and live[r, b]
+                         and _exceeds(y[r, a], y[r, b], sig[r, a], sig[r, b], k, mask[r]))
+
+
 def pair_flags(y: np.ndarray, sig: np.ndarray, k: float, live: np.ndarray | None = None,
                mask: np.ndarray | None = None) -> np.ndarray:
-    """Stage 1 of one instant: (ν12, ν13, ν23) per realisation.
+    """Stage 1 of one instant: (ν12, ν13, ν23) per realisation, ν_ij = 1 when some channel c
+    in ``mask`` has |y_i,c − y_j,c| > k √(σ_i,c² + σ_j,c²) (:func:`exceeds`, compiled).
 
     Parameters
     ----------
@@ -93,15 +162,15 @@ def pair_flags(y: np.ndarray, sig: np.ndarray, k: float, live: np.ndarray | None
     -------
     (R, 3) bool
     """
-    R, U = y.shape[:2]
-    m = None if mask is None else np.asarray(mask, bool)
+    y = np.ascontiguousarray(y, dtype=float)
+    sig = np.ascontiguousarray(sig, dtype=float)
+    R, U, C = y.shape
+    lv = (np.ones((R, U), bool) if live is None
+          else np.ascontiguousarray(np.broadcast_to(np.asarray(live, bool), (R, U))))
+    m = (np.ones((R, C), bool) if mask is None
+         else np.ascontiguousarray(np.broadcast_to(np.asarray(mask, bool), (R, C))))
     out = np.zeros((R, 3), bool)
-    for p, (a, b) in enumerate(PAIRS):
-        if b >= U:
-            continue
-        out[:, p] = exceeds(y[:, a], y[:, b], sig[:, a], sig[:, b], k, m)
-        if live is not None:
-            out[:, p] &= live[:, a] & live[:, b]
+    _pair_flags(y, np.ascontiguousarray(np.broadcast_to(sig, y.shape)), float(k), lv, m, out)
     return out
 
 

@@ -23,12 +23,18 @@ stays out of the output and is still compared.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from scipy.stats import chi2
 
-from fms_testbed.navigation.identification.rules import (ESTIMATE_FAILED, PAIRS, UNIT_FAILED,
-                                                         fuse, named_unit, pair_flags, ratio,
-                                                         three_way, wrapped_difference)
+from numba import njit
+
+from fms_testbed.navigation.identification.rules import (_PAIR_A, _PAIR_B, ESTIMATE_FAILED,
+                                                         HEADING,
+                                                         UNIT_FAILED, _exceeds, _nan_max,
+                                                         _wrap,
+                                                         _ratio, _table1)
 from fms_testbed.navigation.identification.tuning import FdiTuning
 
 _EPS_S = 1e-9
@@ -38,17 +44,181 @@ BY_TABLE, BY_INNOVATION = 1, 2
 or the unit's innovation test failing alone."""
 
 
-def median_of_units(v: np.ndarray, live: np.ndarray) -> np.ndarray:
-    """(R, C) median over the live units of ``v`` (R, U, C), per channel (two units: their
-    mean; none: NaN)."""
-    srt = np.sort(np.where(live[..., None], v, np.nan), axis=1)      # NaN last
-    n = live.sum(axis=1)
-    r = np.arange(v.shape[0])
-    lo = np.clip((n - 1) // 2, 0, v.shape[1] - 1)
-    hi = np.clip(n // 2, 0, v.shape[1] - 1)
-    out = 0.5 * (srt[r, lo] + srt[r, hi])
-    out[n == 0] = np.nan
-    return out
+@njit(cache=True, error_model="numpy")
+def _exclude_unit(r, u, t_s, reason, used, isolated, new_exclude, excluded_by, t_exclude_s,
+                  t_detect_s) -> None:
+    """Unit ``u`` of realisation ``r`` leaves for good at ``t_s`` (s) for ``reason``."""
+    used[r, u] = False
+    isolated[r, u] = False
+    new_exclude[r, u] = True
+    excluded_by[r, u] = reason
+    t_exclude_s[r, u] = np.fmin(t_exclude_s[r, u], t_s)
+    t_detect_s[r] = np.fmin(t_detect_s[r], t_s)                       # detected by stage 2
+
+
+@njit(cache=True, error_model="numpy")
+def _step(t_s, y, sig, nu_sensor, mask, have_pred, z0, s0, y0, live0, have_innov, r_innov,
+          used, isolated, nu, flags, verdict, since, s2_since, gnss_failed, t_gnss_s,
+          stat_max, t_detect_s, t_isolate_s, t_exclude_s, t_estimate_failed_s, excluded_by,
+          new_detect, new_isolate, new_exclude, new_estimate_failed, zhat, shat, last_t_s,
+          track_stats, k_pair, k_est, persist_s, stage2_persist_s, innovation_scale) -> bool:
+    """Both stages of :class:`TwoStage` at ``t_s`` (s) for every realisation r (the module
+    docstring's rules; state arrays updated in place, ``zhat``/``shat`` (R, C) written).
+
+    Stage 1: raw_ij = any_c |y_i − y_j| > k_pair √(σ_i² + σ_j²) over the live pair;
+    ν_ij = raw_ij held ``persist_s``, or the sensor-level verdict; table 1 on ν with three
+    live units names the unit isolated. Estimate over the survivors S (in use, not isolated):
+    Ẑ = y_0 + Σ_S σ⁻² ⊙ wrap(y_i − y_0) / Σ_S σ⁻², σ_Ẑ = (Σ_S σ⁻²)^-½. Prediction (when
+    ``have_pred``): Ẑ_p = Ẑ₀ + median over ``live0`` of wrap(y − y₀), σ_p = σ₀. Stage 2:
+    table 1 on (Z_i, Ẑ, Ẑ_p) at ``k_est`` for each unit in use; (1 1 0) alone for
+    ``stage2_persist_s`` excludes. Innovation stage (when ``have_innov``): ``r_innov`` (R, U)
+    Σ NIS / χ²_{1−α} > ``innovation_scale``; every unit in use failing with no output
+    disagreement names the GNSS, one failing alone under doubt is excluded.
+
+    Returns
+    -------
+    bool : some realisation's estimate failed against its prediction (1 0 1).
+    """
+    R, U, C = y.shape
+    any_est = False
+    med = np.empty(U)
+    for r in range(R):
+        m = mask[r]
+        for u in range(U):
+            new_isolate[r, u] = False
+            new_exclude[r, u] = False
+        new_estimate_failed[r] = False
+        # stage 1
+        n_live = 0
+        for u in range(U):
+            n_live += used[r, u]
+        had_nu = nu[r, 0] != 0 or nu[r, 1] != 0 or nu[r, 2] != 0
+        any_nu = False
+        for p in range(3):
+            a, b = _PAIR_A[p], _PAIR_B[p]
+            pair = b < U and used[r, a] and used[r, b]
+            raw = pair and _exceeds(y[r, a], y[r, b], sig[r, a], sig[r, b], k_pair, m)
+            if track_stats and pair:
+                stat_max[r, 0] = _nan_max(stat_max[r, 0],
+                                          _ratio(y[r, a], y[r, b], sig[r, a], sig[r, b], m))
+            flags[r, p] = raw
+            if raw:
+                if since[r, p] != since[r, p]:
+                    since[r, p] = t_s
+            else:
+                since[r, p] = math.nan
+            v = raw and (t_s - since[r, p] >= persist_s - _EPS_S)
+            v = v or (pair and nu_sensor[r, p])
+            nu[r, p] = v
+            any_nu = any_nu or v
+        if any_nu and t_detect_s[r] != t_detect_s[r]:
+            t_detect_s[r] = t_s
+        new_detect[r] = any_nu and not had_nu
+        named = _table1(nu[r, 0] != 0, nu[r, 1] != 0, nu[r, 2] != 0) if n_live == 3 else -1
+        if named >= 0 and not isolated[r, named]:
+            isolated[r, named] = True
+            new_isolate[r, named] = True
+            t_isolate_s[r, named] = np.fmin(t_isolate_s[r, named], t_s)
+        # the estimate
+        for c in range(C):
+            tot, acc = 0.0, 0.0
+            for u in range(U):
+                inv = 1.0 / (sig[r, u, c] * sig[r, u, c]) if used[r, u] and not isolated[r, u] \
+                    else 0.0
+                d = y[r, u, c] - y[r, 0, c]
+                if c == HEADING:
+                    d = _wrap(d)
+                tot += inv
+                acc += inv * d
+            zhat[r, c] = y[r, 0, c] + acc / tot
+            shat[r, c] = 1.0 / math.sqrt(tot)
+        # stage 2
+        if not have_pred:
+            for u in range(U):
+                verdict[r, u] = -1
+        else:
+            ok = True
+            zp = np.empty(C)
+            for c in range(C):
+                k = 0
+                for u in range(U):
+                    if live0[r, u]:
+                        d = y[r, u, c] - y0[r, u, c]
+                        if c == HEADING:
+                            d = _wrap(d)
+                        med[k] = d
+                        k += 1
+                if k == 0:
+                    zp[c] = math.nan
+                else:
+                    srt = np.sort(med[:k])                  # NaN last, as numpy sorts
+                    zp[c] = z0[r, c] + 0.5 * (srt[(k - 1) // 2] + srt[k // 2])
+                if not (np.isfinite(zp[c]) and np.isfinite(zhat[r, c])):
+                    ok = False
+            sp = s0[r]
+            n_bad, est = 0, False
+            for u in range(U):
+                v = -1
+                if ok and used[r, u]:
+                    v = _table1(_exceeds(y[r, u], zhat[r], sig[r, u], shat[r], k_est, m),
+                                _exceeds(y[r, u], zp, sig[r, u], sp, k_est, m),
+                                _exceeds(zhat[r], zp, shat[r], sp, k_est, m))
+                verdict[r, u] = v
+                n_bad += v == UNIT_FAILED
+                est = est or v == ESTIMATE_FAILED
+            if track_stats:
+                top = 0.0
+                for u in range(U):
+                    q = 0.0
+                    if used[r, u] and ok:
+                        q = _ratio(y[r, u], zhat[r], sig[r, u], shat[r], m)
+                        if q != q:
+                            q = 0.0
+                        elif q == math.inf:
+                            q = 1.7976931348623157e308
+                    top = _nan_max(top, q) if u > 0 else q
+                stat_max[r, 2] = _nan_max(stat_max[r, 2], top)
+            for u in range(U):
+                bad = verdict[r, u] == UNIT_FAILED
+                if bad:
+                    if s2_since[r, u] != s2_since[r, u]:
+                        s2_since[r, u] = t_s
+                else:
+                    s2_since[r, u] = math.nan
+                if (bad and n_bad == 1 and t_s - s2_since[r, u] >= stage2_persist_s - _EPS_S
+                        and used[r, u]):
+                    _exclude_unit(r, u, t_s, BY_TABLE, used, isolated, new_exclude,
+                                  excluded_by, t_exclude_s, t_detect_s)
+            new_estimate_failed[r] = est and not (t_estimate_failed_s[r] == last_t_s)
+            if est:
+                t_estimate_failed_s[r] = t_s
+                any_est = True
+        # the innovation stage
+        if have_innov:
+            top = 0.0
+            for u in range(U):
+                q = r_innov[r, u] if used[r, u] and not gnss_failed[r] else 0.0
+                top = _nan_max(top, q) if u > 0 else q
+            stat_max[r, 3] = _nan_max(stat_max[r, 3], top)
+            n_live, n_fail, all_fail = 0, 0, True
+            for u in range(U):
+                f = r_innov[r, u] > innovation_scale and used[r, u]
+                n_live += used[r, u]
+                n_fail += f
+                all_fail = all_fail and (f or not used[r, u])
+            if (all_fail and n_live > 1 and not (flags[r, 0] or flags[r, 1] or flags[r, 2])
+                    and not gnss_failed[r]):
+                gnss_failed[r] = True
+                t_gnss_s[r] = t_s
+            doubt = nu[r, 0] != 0 or nu[r, 1] != 0 or nu[r, 2] != 0 or n_live < U
+            for u in range(U):
+                doubt = doubt or (isolated[r, u] and used[r, u])
+            if n_fail == 1 and n_live > 1 and doubt and not gnss_failed[r]:
+                for u in range(U):
+                    if r_innov[r, u] > innovation_scale and used[r, u]:
+                        _exclude_unit(r, u, t_s, BY_INNOVATION, used, isolated, new_exclude,
+                                      excluded_by, t_exclude_s, t_detect_s)
+    return any_est
 
 
 class TwoStage:
@@ -130,28 +300,6 @@ class TwoStage:
         self._nis_sum += e[1]
         self._dof_sum += e[2]
 
-    def innovation_fails(self, t_s: float) -> np.ndarray:
-        """(R, U) bool: the windowed χ² test of each unit's innovations over ``window_s``
-        fails at false-alarm probability ``alpha`` (Σ NIS > innovation_scale × χ²_{1−α}(Σ dof))."""
-        buf = self._nis
-        while buf and buf[0][0] < t_s - self.tuning.window_s:
-            _, n, d = buf.pop(0)
-            self._nis_sum -= n
-            self._dof_sum -= d
-        if not buf:
-            self._nis_sum[:] = 0.0
-            return np.zeros(self.used.shape, bool)
-        q = np.full(self._dof_sum.shape, np.inf)
-        for d in np.unique(self._dof_sum[self._dof_sum > 0]):
-            if d not in self._isf:
-                self._isf[d] = chi2.isf(self.tuning.alpha, int(d))
-            q[self._dof_sum == d] = self._isf[d]
-        r = self._nis_sum / q
-        live = self.used & ~self.gnss_failed[:, None]
-        np.maximum(self.stat_max[:, 3], np.where(live, r, 0.0).max(axis=1),
-                   out=self.stat_max[:, 3])
-        return r > self.tuning.innovation_scale
-
     def add_baro_test(self, t_s: float, failed: np.ndarray) -> None:
         """Record the units' baro channel tests at ``t_s`` (s): ``failed`` (R, U) bool where
         |ν| > k_residual √S. Every unit in use failing ``baro_fails`` times within
@@ -169,117 +317,80 @@ class TwoStage:
 
     def update(self, t_s: float, y: np.ndarray, sig: np.ndarray,
                nu_sensor: np.ndarray | None = None, mask: np.ndarray | None = None) -> None:
-        """Both stages at ``t_s`` (s).
+        """Both stages at ``t_s`` (s), in one compiled call (:func:`_step`) over all realisations.
 
         Parameters
         ----------
         y : (R, U, C) the units' comparison vectors (position m, velocity m/s, attitude rad;
             channel 8 is the heading);  sig : (R, U, C) their σ
         nu_sensor : (R, 3) bool sensor-level pair verdicts (None: none)
-        mask : (C,) bool channels compared (None: all)
+        mask : (C,) or (R, C) bool channels compared (None: all)
         """
-        self._clear_news()
-        self._stage1(t_s, y, sig, nu_sensor, mask)
-        surv = self.used & ~self.isolated
-        zhat, shat = fuse(y, sig, surv)
-        self._stage2(t_s, y, sig, zhat, shat, mask)
-        self._innovation_stage(t_s)
+        y = np.ascontiguousarray(y, dtype=float)
+        sig = np.ascontiguousarray(sig, dtype=float)
+        R, U, C = y.shape
+        m = (np.ones((R, C), bool) if mask is None
+             else np.ascontiguousarray(np.broadcast_to(np.asarray(mask, bool), (R, C))))
+        nus = (np.zeros((R, 3), bool) if nu_sensor is None
+               else np.ascontiguousarray(np.broadcast_to(np.asarray(nu_sensor, bool), (R, 3))))
+        pred = self._prediction(t_s)
+        have_pred = pred is not None
+        if not have_pred:
+            pred = (np.zeros((R, C)), np.zeros((R, C)), y, self.used)   # unread placeholders
+        r_innov = self._innovation_ratio(t_s) if self._nis else None
+        tu = self.tuning
+        zhat, shat = np.empty((R, C)), np.empty((R, C))
+        est = _step(float(t_s), y, sig, nus, m, have_pred, pred[0], pred[1], pred[2],
+                    pred[3], r_innov is not None,
+                    np.zeros((R, U)) if r_innov is None else r_innov,
+                    self.used, self.isolated, self.nu, self.flags, self.verdict, self._since,
+                    self._s2_since, self.gnss_failed, self.t_gnss_s, self.stat_max,
+                    self.t_detect_s, self.t_isolate_s, self.t_exclude_s,
+                    self.t_estimate_failed_s, self.excluded_by, self.new_detect,
+                    self.new_isolate, self.new_exclude, self.new_estimate_failed, zhat, shat,
+                    float(self._last_t), self.track_stats, tu.k_pair, tu.k_est, tu.persist_s,
+                    tu.stage2_persist_s, tu.innovation_scale)
+        if est:                               # the prediction restarts from the estimate
+            e = (self.verdict == ESTIMATE_FAILED).any(axis=1)
+            for h in self._hist:
+                h[1][e], h[3][e] = zhat[e], y[e]
         self._remember(t_s, zhat, shat, y)
 
-    def _stage1(self, t_s, y, sig, nu_sensor, mask) -> None:
-        tu, live = self.tuning, self.used
-        raw = pair_flags(y, sig, tu.k_pair, live, mask)
-        for a, b in PAIRS if self.track_stats else ():
-            if b < self.n:
-                r = np.where(live[:, a] & live[:, b],
-                             ratio(y[:, a], y[:, b], sig[:, a], sig[:, b], mask), 0.0)
-                np.maximum(self.stat_max[:, 0], r, out=self.stat_max[:, 0])
-        self.flags = raw
-        s = self._since
-        s[raw & np.isnan(s)] = t_s
-        s[~raw] = np.nan
-        nu = raw & (t_s - s >= tu.persist_s - _EPS_S)
-        if nu_sensor is not None:
-            lp = np.zeros_like(raw)
-            for p, (a, b) in enumerate(PAIRS):
-                if b < self.n:
-                    lp[:, p] = live[:, a] & live[:, b]
-            nu |= np.asarray(nu_sensor, bool) & lp
-        first = nu.any(axis=1) & np.isnan(self.t_detect_s)
-        self.t_detect_s[first] = t_s
-        self.new_detect = nu.any(axis=1) & ~self.nu.astype(bool).any(axis=1)
-        self.nu = nu.astype(np.int64)
-        named = named_unit(self.nu, live.sum(axis=1))
-        r = np.nonzero(named >= 0)[0]
-        new = r[~self.isolated[r, named[r]]]
-        self.isolated[new, named[new]] = True
-        self.new_isolate[new, named[new]] = True
-        self.t_isolate_s[new, named[new]] = np.fmin(self.t_isolate_s[new, named[new]], t_s)
-
-    def _prediction(self, t_s: float, y: np.ndarray):
-        """Ẑ_p, σ_p from the estimate ``predict_s`` ago (None until there is one)."""
+    def _prediction(self, t_s: float):
+        """(Ẑ, σ_Ẑ, y, live) of the step ``predict_s`` ago, the start of the prediction Ẑ_p
+        (None until there is one)."""
         h = self._hist
         while len(h) > 1 and h[1][0] <= t_s - self.tuning.predict_s + _EPS_S:
             h.pop(0)
         if not h or h[0][0] > t_s - self.tuning.predict_s + _EPS_S:
             return None
-        _, z0, s0, y0, live0 = h[0]
-        return z0 + median_of_units(wrapped_difference(y, y0), live0), s0
+        return h[0][1:]
 
-    def _stage2(self, t_s, y, sig, zhat, shat, mask) -> None:
-        pred = self._prediction(t_s, y)
-        if pred is None:
-            self.verdict[:] = -1
-            return
-        zp, sp = pred
-        ok = np.isfinite(zp).all(axis=1) & np.isfinite(zhat).all(axis=1)
-        v = np.full(self.used.shape, -1, np.int64)
-        if ok.any():
-            v[ok] = three_way(y[ok], sig[ok], zhat[ok], shat[ok], zp[ok], sp[ok],
-                              self.tuning.k_est, mask)
-        v[~self.used] = -1
-        self.verdict = v
-        if self.track_stats:
-            r = np.where(self.used & ok[:, None],
-                         ratio(y, zhat[:, None], sig, shat[:, None], mask), 0.0)
-            np.maximum(self.stat_max[:, 2], np.nan_to_num(r).max(axis=1),
-                       out=self.stat_max[:, 2])
-        bad = v == UNIT_FAILED
-        s = self._s2_since
-        s[bad & np.isnan(s)] = t_s
-        s[~bad] = np.nan
-        alone = bad & (bad.sum(axis=1, keepdims=True) == 1)
-        ripe = alone & (t_s - s >= self.tuning.stage2_persist_s - _EPS_S)
-        self._exclude(ripe, t_s, BY_TABLE)
-        est = (v == ESTIMATE_FAILED).any(axis=1)
-        self.new_estimate_failed = est & ~(self.t_estimate_failed_s == self._last_t)
-        self.t_estimate_failed_s[est] = t_s
-        if est.any():                         # the prediction restarts from the estimate
-            for e in self._hist:
-                e[1][est], e[3][est] = zhat[est], y[est]
+    def _innovation_ratio(self, t_s: float) -> np.ndarray | None:
+        """(R, U) Σ NIS / χ²_{1−α}(Σ dof) over the last ``window_s`` (0 where no dof; None when
+        the window holds no innovation)."""
+        buf = self._nis
+        while buf and buf[0][0] < t_s - self.tuning.window_s:
+            _, n, d = buf.pop(0)
+            self._nis_sum -= n
+            self._dof_sum -= d
+        if not buf:
+            self._nis_sum[:] = 0.0
+            return None
+        q = np.full(self._dof_sum.shape, np.inf)
+        for d in np.unique(self._dof_sum[self._dof_sum > 0]):
+            if d not in self._isf:
+                self._isf[d] = chi2.isf(self.tuning.alpha, int(d))
+            q[self._dof_sum == d] = self._isf[d]
+        return self._nis_sum / q
 
-    def _innovation_stage(self, t_s) -> None:
-        if not self._nis:
-            return
-        fails = self.innovation_fails(t_s) & self.used
-        n_live = self.used.sum(axis=1)
-        gnss = ((fails | ~self.used).all(axis=1) & (n_live > 1) & ~self.flags.any(axis=1)
-                & ~self.gnss_failed)
-        self.gnss_failed |= gnss
-        self.t_gnss_s[gnss] = t_s
-        doubt = self.nu.any(axis=1) | (n_live < self.n) | (self.isolated & self.used).any(1)
-        one = (fails.sum(axis=1) == 1) & (n_live > 1) & doubt & ~self.gnss_failed
-        self._exclude(fails & one[:, None], t_s, BY_INNOVATION)
-
-    def _exclude(self, which: np.ndarray, t_s: float, reason: int) -> None:
-        which = which & self.used
-        self.used &= ~which
-        self.isolated &= ~which
-        self.new_exclude |= which
-        self.excluded_by[which] = reason
-        self.t_exclude_s[which] = np.fmin(self.t_exclude_s[which], t_s)
-        hit = which.any(axis=1)
-        self.t_detect_s[hit] = np.fmin(self.t_detect_s[hit], t_s)     # detected by stage 2
+    def innovation_fails(self, t_s: float) -> np.ndarray:
+        """(R, U) bool: the windowed χ² test of each unit's innovations over ``window_s``
+        fails at false-alarm probability ``alpha`` (Σ NIS > innovation_scale × χ²_{1−α}(Σ dof))."""
+        r = self._innovation_ratio(t_s)
+        if r is None:
+            return np.zeros(self.used.shape, bool)
+        return r > self.tuning.innovation_scale
 
     def _remember(self, t_s, zhat, shat, y) -> None:
         self._last_t = t_s
@@ -288,4 +399,4 @@ class TwoStage:
     _last_t = np.nan
 
 
-__all__ = ["BY_INNOVATION", "BY_TABLE", "TwoStage", "median_of_units"]
+__all__ = ["BY_INNOVATION", "BY_TABLE", "TwoStage"]
