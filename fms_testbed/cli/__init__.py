@@ -97,11 +97,23 @@ def _on_sigint(signum, frame) -> None:  # pragma: no cover - exercised in a subp
     raise KeyboardInterrupt
 
 
+def _quiet_signal_unraisable(unraisable) -> None:  # pragma: no cover - in a subprocess
+    """``sys.unraisablehook``: the exit or interrupt our signal handlers raise inside a callback
+    that cannot propagate it (llvmlite's object-cache notification while numba compiles) is
+    not reported as an ignored exception with its traceback — :func:`main` ends with the
+    signal's exit code from its record; every other unraisable exception is reported as usual."""
+    if issubclass(unraisable.exc_type, (SystemExit, KeyboardInterrupt)) and (
+            _terminated or _interrupted.is_set()):
+        return
+    sys.__unraisablehook__(unraisable)
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; return the process exit code."""
     if threading.current_thread() is threading.main_thread():
         signal.signal(signal.SIGTERM, _exit_on_sigterm)
         signal.signal(signal.SIGINT, _on_sigint)
+        sys.unraisablehook = _quiet_signal_unraisable
     parser = build_parser()
     args = parser.parse_args(argv)
     logging.basicConfig(

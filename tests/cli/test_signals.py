@@ -58,3 +58,28 @@ def test_sigterm_removes_the_jsbsim_sandbox(tmp_path, settle_s):
     assert p.returncode == 128 + signal.SIGTERM, err[-2000:]
     assert "Traceback" not in err
     assert not list((tmp_path / "tmp").glob("fms-testbed-jsbsim-*"))
+
+
+def test_an_exit_raised_by_our_handler_inside_a_callback_is_not_reported(monkeypatch):
+    """The SIGTERM/SIGINT handlers' exception raised inside a callback that cannot propagate it
+    (llvmlite's object-cache notification while numba compiles) is not handed to Python's
+    report ('Exception ignored in ...' with a traceback); any other unraisable exception, or
+    the same one with no signal recorded, is."""
+    import types
+    from fms_testbed import cli
+
+    reported = []
+    monkeypatch.setattr(sys, "__unraisablehook__", lambda u: reported.append(u.exc_type))
+
+    def unraisable(exc):
+        return types.SimpleNamespace(exc_type=type(exc), exc_value=exc, exc_traceback=None,
+                                     err_msg="Exception ignored in", object=None)
+
+    monkeypatch.setattr(cli, "_terminated", [])
+    cli._quiet_signal_unraisable(unraisable(SystemExit(143)))
+    assert reported == [SystemExit]                            # no signal recorded: reported
+    monkeypatch.setattr(cli, "_terminated", [signal.SIGTERM])
+    cli._quiet_signal_unraisable(unraisable(SystemExit(143)))
+    assert reported == [SystemExit]                            # our own exit: quiet
+    cli._quiet_signal_unraisable(unraisable(ValueError("a bug")))
+    assert reported == [SystemExit, ValueError]                # anything else: reported

@@ -57,23 +57,186 @@ def _exclude_unit(r, u, t_s, reason, used, isolated, new_exclude, excluded_by, t
 
 
 @njit(cache=True, error_model="numpy")
+def _stage1(r, t_s, y, sig, nu_sensor, m, used, isolated, nu, flags, since, stat_max,
+            t_detect_s, t_isolate_s, new_detect, new_isolate, track_stats, k_pair,
+            persist_s) -> None:
+    """Stage 1 of realisation ``r``: raw_ij = any_c |y_i − y_j| > k_pair √(σ_i² + σ_j²) over
+    the live pair; ν_ij = raw_ij held ``persist_s``, or the sensor-level verdict; table 1 on ν
+    with three live units names the unit isolated."""
+    U = y.shape[1]
+    n_live = 0
+    for u in range(U):
+        n_live += used[r, u]
+    had_nu = nu[r, 0] != 0 or nu[r, 1] != 0 or nu[r, 2] != 0
+    any_nu = False
+    for p in range(3):
+        a, b = _PAIR_A[p], _PAIR_B[p]
+        pair = b < U and used[r, a] and used[r, b]
+        raw = pair and _exceeds(y[r, a], y[r, b], sig[r, a], sig[r, b], k_pair, m)
+        if track_stats and pair:
+            stat_max[r, 0] = _nan_max(stat_max[r, 0],
+                                      _ratio(y[r, a], y[r, b], sig[r, a], sig[r, b], m))
+        flags[r, p] = raw
+        if raw:
+            if since[r, p] != since[r, p]:
+                since[r, p] = t_s
+        else:
+            since[r, p] = math.nan
+        v = raw and (t_s - since[r, p] >= persist_s - _EPS_S)
+        v = v or (pair and nu_sensor[r, p])
+        nu[r, p] = v
+        any_nu = any_nu or v
+    if any_nu and t_detect_s[r] != t_detect_s[r]:
+        t_detect_s[r] = t_s
+    new_detect[r] = any_nu and not had_nu
+    named = _table1(nu[r, 0] != 0, nu[r, 1] != 0, nu[r, 2] != 0) if n_live == 3 else -1
+    if named >= 0 and not isolated[r, named]:
+        isolated[r, named] = True
+        new_isolate[r, named] = True
+        t_isolate_s[r, named] = np.fmin(t_isolate_s[r, named], t_s)
+
+
+@njit(cache=True, error_model="numpy")
+def _estimate(r, y, sig, used, isolated, zhat, shat) -> None:
+    """The estimate of realisation ``r`` over the survivors S (in use, not isolated):
+    Ẑ = y_0 + Σ_S σ⁻² ⊙ wrap(y_i − y_0) / Σ_S σ⁻², σ_Ẑ = (Σ_S σ⁻²)^-½."""
+    U, C = y.shape[1], y.shape[2]
+    for c in range(C):
+        tot, acc = 0.0, 0.0
+        for u in range(U):
+            inv = 1.0 / (sig[r, u, c] * sig[r, u, c]) if used[r, u] and not isolated[r, u] \
+                else 0.0
+            d = y[r, u, c] - y[r, 0, c]
+            if c == HEADING:
+                d = _wrap(d)
+            tot += inv
+            acc += inv * d
+        zhat[r, c] = y[r, 0, c] + acc / tot
+        shat[r, c] = 1.0 / math.sqrt(tot)
+
+
+@njit(cache=True, error_model="numpy")
+def _prediction(r, y, z0, y0, live0, zhat, med, zp) -> bool:
+    """Ẑ_p of realisation ``r`` into ``zp``: Ẑ₀ + median over ``live0`` of wrap(y − y₀); True
+    when Ẑ_p and Ẑ are finite in every component."""
+    U, C = y.shape[1], y.shape[2]
+    ok = True
+    for c in range(C):
+        k = 0
+        for u in range(U):
+            if live0[r, u]:
+                d = y[r, u, c] - y0[r, u, c]
+                if c == HEADING:
+                    d = _wrap(d)
+                med[k] = d
+                k += 1
+        if k == 0:
+            zp[c] = math.nan
+        else:
+            srt = np.sort(med[:k])                  # NaN last, as numpy sorts
+            zp[c] = z0[r, c] + 0.5 * (srt[(k - 1) // 2] + srt[k // 2])
+        if not (np.isfinite(zp[c]) and np.isfinite(zhat[r, c])):
+            ok = False
+    return ok
+
+
+@njit(cache=True, error_model="numpy")
+def _stage2_statistic(r, y, sig, m, used, ok, zhat, shat, stat_max) -> None:
+    """Calibration record of realisation ``r``: the largest |Z_i − Ẑ|/σ over the units in use."""
+    U = y.shape[1]
+    top = 0.0
+    for u in range(U):
+        q = 0.0
+        if used[r, u] and ok:
+            q = _ratio(y[r, u], zhat[r], sig[r, u], shat[r], m)
+            if q != q:
+                q = 0.0
+            elif q == math.inf:
+                q = 1.7976931348623157e308
+        top = _nan_max(top, q) if u > 0 else q
+    stat_max[r, 2] = _nan_max(stat_max[r, 2], top)
+
+
+@njit(cache=True, error_model="numpy")
+def _stage2(r, t_s, y, sig, m, s0, used, isolated, verdict, s2_since, stat_max, t_detect_s,
+            t_exclude_s, t_estimate_failed_s, excluded_by, new_exclude, new_estimate_failed,
+            zhat, shat, last_t_s, track_stats, k_est, stage2_persist_s, ok, zp) -> bool:
+    """Stage 2 of realisation ``r``: table 1 on (Z_i, Ẑ, Ẑ_p) at ``k_est`` for each unit in use;
+    (1 1 0) alone for ``stage2_persist_s`` excludes. Returns: the estimate failed (1 0 1)."""
+    U = y.shape[1]
+    sp = s0[r]
+    n_bad, est = 0, False
+    for u in range(U):
+        v = -1
+        if ok and used[r, u]:
+            v = _table1(_exceeds(y[r, u], zhat[r], sig[r, u], shat[r], k_est, m),
+                        _exceeds(y[r, u], zp, sig[r, u], sp, k_est, m),
+                        _exceeds(zhat[r], zp, shat[r], sp, k_est, m))
+        verdict[r, u] = v
+        n_bad += v == UNIT_FAILED
+        est = est or v == ESTIMATE_FAILED
+    if track_stats:
+        _stage2_statistic(r, y, sig, m, used, ok, zhat, shat, stat_max)
+    for u in range(U):
+        bad = verdict[r, u] == UNIT_FAILED
+        if bad:
+            if s2_since[r, u] != s2_since[r, u]:
+                s2_since[r, u] = t_s
+        else:
+            s2_since[r, u] = math.nan
+        if (bad and n_bad == 1 and t_s - s2_since[r, u] >= stage2_persist_s - _EPS_S
+                and used[r, u]):
+            _exclude_unit(r, u, t_s, BY_TABLE, used, isolated, new_exclude,
+                          excluded_by, t_exclude_s, t_detect_s)
+    new_estimate_failed[r] = est and not (t_estimate_failed_s[r] == last_t_s)
+    if est:
+        t_estimate_failed_s[r] = t_s
+    return est
+
+
+@njit(cache=True, error_model="numpy")
+def _innovation_stage(r, t_s, r_innov, used, isolated, nu, flags, gnss_failed, t_gnss_s,
+                      stat_max, t_detect_s, t_exclude_s, excluded_by, new_exclude,
+                      innovation_scale) -> None:
+    """Innovation stage of realisation ``r``: ``r_innov`` (R, U) Σ NIS / χ²_{1−α} >
+    ``innovation_scale``; every unit in use failing with no output disagreement names the
+    GNSS, one failing alone under doubt is excluded."""
+    U = r_innov.shape[1]
+    top = 0.0
+    for u in range(U):
+        q = r_innov[r, u] if used[r, u] and not gnss_failed[r] else 0.0
+        top = _nan_max(top, q) if u > 0 else q
+    stat_max[r, 3] = _nan_max(stat_max[r, 3], top)
+    n_live, n_fail, all_fail = 0, 0, True
+    for u in range(U):
+        f = r_innov[r, u] > innovation_scale and used[r, u]
+        n_live += used[r, u]
+        n_fail += f
+        all_fail = all_fail and (f or not used[r, u])
+    if (all_fail and n_live > 1 and not (flags[r, 0] or flags[r, 1] or flags[r, 2])
+            and not gnss_failed[r]):
+        gnss_failed[r] = True
+        t_gnss_s[r] = t_s
+    doubt = nu[r, 0] != 0 or nu[r, 1] != 0 or nu[r, 2] != 0 or n_live < U
+    for u in range(U):
+        doubt = doubt or (isolated[r, u] and used[r, u])
+    if n_fail == 1 and n_live > 1 and doubt and not gnss_failed[r]:
+        for u in range(U):
+            if r_innov[r, u] > innovation_scale and used[r, u]:
+                _exclude_unit(r, u, t_s, BY_INNOVATION, used, isolated, new_exclude,
+                              excluded_by, t_exclude_s, t_detect_s)
+
+
+@njit(cache=True, error_model="numpy")
 def _step(t_s, y, sig, nu_sensor, mask, have_pred, z0, s0, y0, live0, have_innov, r_innov,
           used, isolated, nu, flags, verdict, since, s2_since, gnss_failed, t_gnss_s,
           stat_max, t_detect_s, t_isolate_s, t_exclude_s, t_estimate_failed_s, excluded_by,
           new_detect, new_isolate, new_exclude, new_estimate_failed, zhat, shat, last_t_s,
           track_stats, k_pair, k_est, persist_s, stage2_persist_s, innovation_scale) -> bool:
     """Both stages of :class:`TwoStage` at ``t_s`` (s) for every realisation r (the module
-    docstring's rules; state arrays updated in place, ``zhat``/``shat`` (R, C) written).
-
-    Stage 1: raw_ij = any_c |y_i − y_j| > k_pair √(σ_i² + σ_j²) over the live pair;
-    ν_ij = raw_ij held ``persist_s``, or the sensor-level verdict; table 1 on ν with three
-    live units names the unit isolated. Estimate over the survivors S (in use, not isolated):
-    Ẑ = y_0 + Σ_S σ⁻² ⊙ wrap(y_i − y_0) / Σ_S σ⁻², σ_Ẑ = (Σ_S σ⁻²)^-½. Prediction (when
-    ``have_pred``): Ẑ_p = Ẑ₀ + median over ``live0`` of wrap(y − y₀), σ_p = σ₀. Stage 2:
-    table 1 on (Z_i, Ẑ, Ẑ_p) at ``k_est`` for each unit in use; (1 1 0) alone for
-    ``stage2_persist_s`` excludes. Innovation stage (when ``have_innov``): ``r_innov`` (R, U)
-    Σ NIS / χ²_{1−α} > ``innovation_scale``; every unit in use failing with no output
-    disagreement names the GNSS, one failing alone under doubt is excluded.
+    docstring's rules; state arrays updated in place, ``zhat``/``shat`` (R, C) written):
+    :func:`_stage1`, :func:`_estimate`, the prediction (when ``have_pred``) and
+    :func:`_stage2`, :func:`_innovation_stage` (when ``have_innov``).
 
     Returns
     -------
@@ -82,142 +245,31 @@ def _step(t_s, y, sig, nu_sensor, mask, have_pred, z0, s0, y0, live0, have_innov
     R, U, C = y.shape
     any_est = False
     med = np.empty(U)
+    zp = np.empty(C)
     for r in range(R):
         m = mask[r]
         for u in range(U):
             new_isolate[r, u] = False
             new_exclude[r, u] = False
         new_estimate_failed[r] = False
-        # stage 1
-        n_live = 0
-        for u in range(U):
-            n_live += used[r, u]
-        had_nu = nu[r, 0] != 0 or nu[r, 1] != 0 or nu[r, 2] != 0
-        any_nu = False
-        for p in range(3):
-            a, b = _PAIR_A[p], _PAIR_B[p]
-            pair = b < U and used[r, a] and used[r, b]
-            raw = pair and _exceeds(y[r, a], y[r, b], sig[r, a], sig[r, b], k_pair, m)
-            if track_stats and pair:
-                stat_max[r, 0] = _nan_max(stat_max[r, 0],
-                                          _ratio(y[r, a], y[r, b], sig[r, a], sig[r, b], m))
-            flags[r, p] = raw
-            if raw:
-                if since[r, p] != since[r, p]:
-                    since[r, p] = t_s
-            else:
-                since[r, p] = math.nan
-            v = raw and (t_s - since[r, p] >= persist_s - _EPS_S)
-            v = v or (pair and nu_sensor[r, p])
-            nu[r, p] = v
-            any_nu = any_nu or v
-        if any_nu and t_detect_s[r] != t_detect_s[r]:
-            t_detect_s[r] = t_s
-        new_detect[r] = any_nu and not had_nu
-        named = _table1(nu[r, 0] != 0, nu[r, 1] != 0, nu[r, 2] != 0) if n_live == 3 else -1
-        if named >= 0 and not isolated[r, named]:
-            isolated[r, named] = True
-            new_isolate[r, named] = True
-            t_isolate_s[r, named] = np.fmin(t_isolate_s[r, named], t_s)
-        # the estimate
-        for c in range(C):
-            tot, acc = 0.0, 0.0
-            for u in range(U):
-                inv = 1.0 / (sig[r, u, c] * sig[r, u, c]) if used[r, u] and not isolated[r, u] \
-                    else 0.0
-                d = y[r, u, c] - y[r, 0, c]
-                if c == HEADING:
-                    d = _wrap(d)
-                tot += inv
-                acc += inv * d
-            zhat[r, c] = y[r, 0, c] + acc / tot
-            shat[r, c] = 1.0 / math.sqrt(tot)
-        # stage 2
+        _stage1(r, t_s, y, sig, nu_sensor, m, used, isolated, nu, flags, since, stat_max,
+                t_detect_s, t_isolate_s, new_detect, new_isolate, track_stats, k_pair,
+                persist_s)
+        _estimate(r, y, sig, used, isolated, zhat, shat)
         if not have_pred:
             for u in range(U):
                 verdict[r, u] = -1
         else:
-            ok = True
-            zp = np.empty(C)
-            for c in range(C):
-                k = 0
-                for u in range(U):
-                    if live0[r, u]:
-                        d = y[r, u, c] - y0[r, u, c]
-                        if c == HEADING:
-                            d = _wrap(d)
-                        med[k] = d
-                        k += 1
-                if k == 0:
-                    zp[c] = math.nan
-                else:
-                    srt = np.sort(med[:k])                  # NaN last, as numpy sorts
-                    zp[c] = z0[r, c] + 0.5 * (srt[(k - 1) // 2] + srt[k // 2])
-                if not (np.isfinite(zp[c]) and np.isfinite(zhat[r, c])):
-                    ok = False
-            sp = s0[r]
-            n_bad, est = 0, False
-            for u in range(U):
-                v = -1
-                if ok and used[r, u]:
-                    v = _table1(_exceeds(y[r, u], zhat[r], sig[r, u], shat[r], k_est, m),
-                                _exceeds(y[r, u], zp, sig[r, u], sp, k_est, m),
-                                _exceeds(zhat[r], zp, shat[r], sp, k_est, m))
-                verdict[r, u] = v
-                n_bad += v == UNIT_FAILED
-                est = est or v == ESTIMATE_FAILED
-            if track_stats:
-                top = 0.0
-                for u in range(U):
-                    q = 0.0
-                    if used[r, u] and ok:
-                        q = _ratio(y[r, u], zhat[r], sig[r, u], shat[r], m)
-                        if q != q:
-                            q = 0.0
-                        elif q == math.inf:
-                            q = 1.7976931348623157e308
-                    top = _nan_max(top, q) if u > 0 else q
-                stat_max[r, 2] = _nan_max(stat_max[r, 2], top)
-            for u in range(U):
-                bad = verdict[r, u] == UNIT_FAILED
-                if bad:
-                    if s2_since[r, u] != s2_since[r, u]:
-                        s2_since[r, u] = t_s
-                else:
-                    s2_since[r, u] = math.nan
-                if (bad and n_bad == 1 and t_s - s2_since[r, u] >= stage2_persist_s - _EPS_S
-                        and used[r, u]):
-                    _exclude_unit(r, u, t_s, BY_TABLE, used, isolated, new_exclude,
-                                  excluded_by, t_exclude_s, t_detect_s)
-            new_estimate_failed[r] = est and not (t_estimate_failed_s[r] == last_t_s)
-            if est:
-                t_estimate_failed_s[r] = t_s
+            ok = _prediction(r, y, z0, y0, live0, zhat, med, zp)
+            if _stage2(r, t_s, y, sig, m, s0, used, isolated, verdict, s2_since, stat_max,
+                       t_detect_s, t_exclude_s, t_estimate_failed_s, excluded_by,
+                       new_exclude, new_estimate_failed, zhat, shat, last_t_s, track_stats,
+                       k_est, stage2_persist_s, ok, zp):
                 any_est = True
-        # the innovation stage
         if have_innov:
-            top = 0.0
-            for u in range(U):
-                q = r_innov[r, u] if used[r, u] and not gnss_failed[r] else 0.0
-                top = _nan_max(top, q) if u > 0 else q
-            stat_max[r, 3] = _nan_max(stat_max[r, 3], top)
-            n_live, n_fail, all_fail = 0, 0, True
-            for u in range(U):
-                f = r_innov[r, u] > innovation_scale and used[r, u]
-                n_live += used[r, u]
-                n_fail += f
-                all_fail = all_fail and (f or not used[r, u])
-            if (all_fail and n_live > 1 and not (flags[r, 0] or flags[r, 1] or flags[r, 2])
-                    and not gnss_failed[r]):
-                gnss_failed[r] = True
-                t_gnss_s[r] = t_s
-            doubt = nu[r, 0] != 0 or nu[r, 1] != 0 or nu[r, 2] != 0 or n_live < U
-            for u in range(U):
-                doubt = doubt or (isolated[r, u] and used[r, u])
-            if n_fail == 1 and n_live > 1 and doubt and not gnss_failed[r]:
-                for u in range(U):
-                    if r_innov[r, u] > innovation_scale and used[r, u]:
-                        _exclude_unit(r, u, t_s, BY_INNOVATION, used, isolated, new_exclude,
-                                      excluded_by, t_exclude_s, t_detect_s)
+            _innovation_stage(r, t_s, r_innov, used, isolated, nu, flags, gnss_failed,
+                              t_gnss_s, stat_max, t_detect_s, t_exclude_s, excluded_by,
+                              new_exclude, innovation_scale)
     return any_est
 
 
