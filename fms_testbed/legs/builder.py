@@ -181,8 +181,9 @@ class LegBuilder:
         if self.climbing:
             alt = min(alt + dist_m * self.gradient, max(self.alt_cap_m, alt))
         if not changes:                     # the common case, built without dataclasses.replace
-            return FlightState(state.lat_deg, state.lon_deg, state.track_deg, alt,
-                               state.flyby, state.fix_ident)
+            return FlightState(lat_deg=state.lat_deg, lon_deg=state.lon_deg,
+                               track_deg=state.track_deg, alt_m=alt, flyby=state.flyby,
+                               fix_ident=state.fix_ident)
         return replace(state, alt_m=alt, **changes)
 
     def as_transition(self, first: int) -> None:

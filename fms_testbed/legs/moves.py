@@ -55,8 +55,8 @@ def commit(b: LegBuilder, t: LegBuilder) -> None:
 
 def fix_state(b: LegBuilder, state: FlightState, fix: Fix) -> FlightState:
     """State placed at a fix with its fly-over/fly-by flag from the current record."""
-    return FlightState(fix.lat_deg, fix.lon_deg, state.track_deg, state.alt_m,
-                       not b.leg.rec.fly_over, fix.ident)
+    return FlightState(lat_deg=fix.lat_deg, lon_deg=fix.lon_deg, track_deg=state.track_deg,
+                       alt_m=state.alt_m, flyby=not b.leg.rec.fly_over, fix_ident=fix.ident)
 
 
 def turn_dir(b: LegBuilder) -> str | None:
